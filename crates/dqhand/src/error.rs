@@ -1,0 +1,56 @@
+//! Typed errors of the library: each names the bad input and what is wrong with it.
+
+use std::path::PathBuf;
+
+/// What went wrong, with the input (file, joint, vertex) it concerns.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// A file was read but its content is malformed or unsupported.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong in it, lowercase, quoting the bad value.
+        message: String,
+    },
+    /// A skeleton, mesh or pose is inconsistent (no file involved).
+    #[error("{0}")]
+    Invalid(String),
+    /// A name (joint, DOF, node) is not known; lists the valid ones.
+    #[error("unknown {kind} {name:?}; valid: {valid}")]
+    UnknownName {
+        /// What kind of name: "joint", "degree of freedom", "node".
+        kind: &'static str,
+        /// The name given.
+        name: String,
+        /// The valid names, comma-separated.
+        valid: String,
+    },
+}
+
+impl Error {
+    /// Attaches a file path to an `Invalid` error so that the message names the input.
+    #[must_use]
+    pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
+        match self {
+            Error::Invalid(message) => Error::File { path: path.into(), message },
+            Error::UnknownName { kind, name, valid } => Error::File {
+                path: path.into(),
+                message: format!("unknown {kind} {name:?}; valid: {valid}"),
+            },
+            other => other,
+        }
+    }
+}
+
+/// The library's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,204 @@
+//! glTF 2.0 export as `.glb`: the rigged, skinned model (rest pose, joint hierarchy, inverse
+//! bind matrices, JOINTS/WEIGHTS), or a posed static mesh. Vertex order and count are kept.
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+
+use super::{check_lengths, write_bytes};
+use crate::model::Model;
+use crate::Result;
+
+const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+
+/// Accumulates the binary chunk, buffer views and accessors of one GLB.
+#[derive(Default)]
+struct Glb {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Glb {
+    /// Appends one accessor over `bytes` (4-byte aligned); returns its index.
+    fn accessor(&mut self, bytes: &[u8], count: usize, component: u32, kind: &str, target: Option<u32>, bounds: Option<([f32; 3], [f32; 3])>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(view);
+        let mut acc = json!({ "bufferView": self.views.len() - 1, "componentType": component, "count": count, "type": kind });
+        if let Some((min, max)) = bounds {
+            acc["min"] = json!(min);
+            acc["max"] = json!(max);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
+    }
+
+    fn floats<const N: usize>(&mut self, data: &[[f32; N]], kind: &str, target: Option<u32>) -> usize {
+        let bytes: Vec<u8> = data.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        self.accessor(&bytes, data.len(), FLOAT, kind, target, None)
+    }
+
+    fn positions(&mut self, p: &[[f32; 3]]) -> usize {
+        let mut min = [f32::INFINITY; 3];
+        let mut max = [f32::NEG_INFINITY; 3];
+        for v in p {
+            for c in 0..3 {
+                min[c] = min[c].min(v[c]);
+                max[c] = max[c].max(v[c]);
+            }
+        }
+        let bytes: Vec<u8> = p.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        self.accessor(&bytes, p.len(), FLOAT, "VEC3", Some(ARRAY_BUFFER), Some((min, max)))
+    }
+
+    fn indices(&mut self, i: &[u32]) -> usize {
+        let bytes: Vec<u8> = i.iter().flat_map(|x| x.to_le_bytes()).collect();
+        self.accessor(&bytes, i.len(), UNSIGNED_INT, "SCALAR", Some(ELEMENT_ARRAY_BUFFER), None)
+    }
+
+    /// Serialises the GLB container: header, JSON chunk (space-padded), BIN chunk.
+    fn finish(mut self, mut doc: Value) -> Vec<u8> {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        doc["asset"] = json!({ "version": "2.0", "generator": concat!("dqhand ", env!("CARGO_PKG_VERSION")) });
+        doc["buffers"] = json!([{ "byteLength": self.bin.len() }]);
+        doc["bufferViews"] = Value::Array(self.views);
+        doc["accessors"] = Value::Array(self.accessors);
+        let mut text = serde_json::to_vec(&doc).expect("JSON values serialise");
+        while text.len() % 4 != 0 {
+            text.push(b' ');
+        }
+        let total = 12 + 8 + text.len() + 8 + self.bin.len();
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&text);
+        out.extend_from_slice(&(self.bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&self.bin);
+        out
+    }
+}
+
+/// A skin-toned, slightly rough PBR material.
+fn skin_material() -> Value {
+    json!([{ "name": "skin", "pbrMetallicRoughness": { "baseColorFactor": [0.87, 0.67, 0.56, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6 } }])
+}
+
+/// Writes the model as a rigged, skinned GLB in its rest pose, which three.js and Blender load
+/// and animate: the joint hierarchy as nodes (rest TRS), one skin with the inverse bind
+/// matrices, one primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
+/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences).
+///
+/// # Errors
+/// [`crate::Error::Io`] if the file cannot be written.
+pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
+    let mesh = &model.mesh;
+    let skeleton = &model.skeleton;
+    let mut glb = Glb::default();
+    let positions = mesh.positions();
+    let mut attributes = json!({
+        "POSITION": glb.positions(&positions),
+        "NORMAL": glb.floats(&mesh.normals(), "VEC3", Some(ARRAY_BUFFER)),
+    });
+    if !mesh.uvs().is_empty() {
+        attributes["TEXCOORD_0"] = json!(glb.floats(mesh.uvs(), "VEC2", Some(ARRAY_BUFFER)));
+    }
+    let sets = if mesh.max_influences() > 4 { 2 } else { 1 };
+    for set in 0..sets {
+        let mut joints = Vec::with_capacity(positions.len() * 8);
+        let mut weights = Vec::with_capacity(positions.len() * 4);
+        for v in 0..positions.len() {
+            let infl: Vec<(usize, f32)> = mesh.influences(v).skip(set * 4).take(4).collect();
+            for s in 0..4 {
+                let (j, w) = infl.get(s).copied().unwrap_or((0, 0.0));
+                joints.extend_from_slice(&(j as u16).to_le_bytes());
+                weights.push(w);
+            }
+        }
+        let ja = glb.accessor(&joints, positions.len(), UNSIGNED_SHORT, "VEC4", Some(ARRAY_BUFFER), None);
+        let wa = glb.floats(&weights.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect::<Vec<_>>(), "VEC4", Some(ARRAY_BUFFER));
+        attributes[format!("JOINTS_{set}")] = json!(ja);
+        attributes[format!("WEIGHTS_{set}")] = json!(wa);
+    }
+    let indices = glb.indices(mesh.indices());
+    let ibm: Vec<[f32; 16]> = mesh.inverse_bind().iter().map(|m| glam::Mat4::from(*m).to_cols_array()).collect();
+    let ibm = glb.floats(&ibm, "MAT4", None);
+
+    let joints = skeleton.joints();
+    let mut nodes: Vec<Value> = joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let mut node = json!({
+                "name": j.name,
+                "translation": j.rest.translation.to_array(),
+                "rotation": j.rest.rotation.to_array(),
+            });
+            if j.rest.scale != glam::Vec3::ONE {
+                node["scale"] = json!(j.rest.scale.to_array());
+            }
+            let children: Vec<usize> = (0..joints.len()).filter(|&c| joints[c].parent == Some(i)).collect();
+            if !children.is_empty() {
+                node["children"] = json!(children);
+            }
+            node
+        })
+        .collect();
+    let mesh_node = nodes.len();
+    nodes.push(json!({ "name": "hand", "mesh": 0, "skin": 0 }));
+    let mut roots: Vec<usize> = (0..joints.len()).filter(|&i| joints[i].parent.is_none()).collect();
+    roots.push(mesh_node);
+    let doc = json!({
+        "scene": 0,
+        "scenes": [{ "nodes": roots }],
+        "nodes": nodes,
+        "meshes": [{ "name": "hand", "primitives": [{ "attributes": attributes, "indices": indices, "material": 0 }] }],
+        "materials": skin_material(),
+        "skins": [{ "name": "hand", "inverseBindMatrices": ibm, "joints": (0..joints.len()).collect::<Vec<_>>(), "skeleton": roots[0] }],
+    });
+    write_bytes(path, &glb.finish(doc))
+}
+
+/// Writes a posed static mesh (positions, normals, texture coordinates if any) as GLB.
+///
+/// * `positions`, `normals` — #V; `uvs` — #V or empty; `indices` — #F × 3.
+///
+/// # Errors
+/// [`crate::Error::Io`] if the file cannot be written; [`crate::Error::Invalid`] if the
+/// array lengths disagree.
+pub fn write_posed_glb(path: &Path, positions: &[[f32; 3]], normals: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[u32]) -> Result<()> {
+    check_lengths(positions, normals, indices)?;
+    let mut glb = Glb::default();
+    let mut attributes = json!({
+        "POSITION": glb.positions(positions),
+        "NORMAL": glb.floats(normals, "VEC3", Some(ARRAY_BUFFER)),
+    });
+    if uvs.len() == positions.len() {
+        attributes["TEXCOORD_0"] = json!(glb.floats(uvs, "VEC2", Some(ARRAY_BUFFER)));
+    }
+    let indices = glb.indices(indices);
+    let doc = json!({
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "name": "posed hand", "mesh": 0 }],
+        "meshes": [{ "name": "posed hand", "primitives": [{ "attributes": attributes, "indices": indices, "material": 0 }] }],
+        "materials": skin_material(),
+    });
+    write_bytes(path, &glb.finish(doc))
+}

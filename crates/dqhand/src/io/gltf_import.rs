@@ -1,0 +1,243 @@
+//! glTF 2.0 import (`.glb` and `.gltf`) of a skinned mesh, parsed with the `gltf` crate.
+//!
+//! Reads the node hierarchy (the skin's joints and their ancestors), inverse bind matrices,
+//! and every triangle primitive of the meshes bound to the first skin: POSITION, NORMAL,
+//! TEXCOORD_0, JOINTS_0/1 and WEIGHTS_0/1. Primitives are concatenated in file order, so
+//! vertex order and count are kept. Every accessor is bounds-checked before it is read, so a
+//! truncated or inconsistent file gives an error, never a panic.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use base64::Engine as _;
+use glam::{Affine3A, Mat4, Quat, Vec3};
+
+use crate::kinematics::{Joint, Skeleton, Transform};
+use crate::model::Model;
+use crate::skin::{MeshData, Part, SkinnedMesh};
+use crate::{Error, Result};
+
+/// Loads the first skinned mesh of a glTF 2.0 file.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read, [`Error::File`] naming the file and the problem
+/// for anything malformed or unsupported (see the module docs).
+pub fn load_gltf(path: &Path) -> Result<Model> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+    load_gltf_bytes(&bytes, path).map_err(|e| e.in_file(path))
+}
+
+fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
+    let bad = |m: String| Error::Invalid(m);
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
+    let buffers = load_buffers(&gltf, path)?;
+    for accessor in gltf.accessors() {
+        check_accessor(&accessor, &buffers).map_err(bad)?;
+    }
+    let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
+
+    let skinned: Vec<gltf::Node<'_>> = gltf.nodes().filter(|n| n.mesh().is_some() && n.skin().is_some()).collect();
+    let first = skinned.first().ok_or_else(|| bad("no skinned mesh: no node has both a mesh and a skin".into()))?;
+    let skin = first.skin().expect("filtered on skin");
+    let mut warnings = Vec::new();
+    let other = skinned.iter().filter(|n| n.skin().map(|s| s.index()) != Some(skin.index())).count();
+    if other > 0 {
+        warnings.push(format!("{other} mesh nodes bound to other skins were ignored; only skin {} is read", skin.index()));
+    }
+
+    // Skeleton: the skin's joints and all their ancestors, in node order.
+    let mut parent = HashMap::new();
+    for node in gltf.nodes() {
+        for child in node.children() {
+            parent.insert(child.index(), node.index());
+        }
+    }
+    let mut keep = vec![false; gltf.nodes().len()];
+    for joint in skin.joints() {
+        let mut n = Some(joint.index());
+        while let Some(i) = n {
+            if keep[i] {
+                break;
+            }
+            keep[i] = true;
+            n = parent.get(&i).copied();
+        }
+    }
+    let node_to_joint: HashMap<usize, usize> =
+        keep.iter().enumerate().filter(|(_, &k)| k).enumerate().map(|(j, (n, _))| (n, j)).collect();
+    let mut joints = Vec::with_capacity(node_to_joint.len());
+    for node in gltf.nodes().filter(|n| keep[n.index()]) {
+        let (t, r, s) = node.transform().decomposed();
+        joints.push(Joint {
+            name: node.name().map_or_else(|| format!("node{}", node.index()), str::to_owned),
+            parent: parent.get(&node.index()).and_then(|p| node_to_joint.get(p)).copied(),
+            rest: Transform { translation: Vec3::from(t), rotation: Quat::from_array(r), scale: Vec3::from(s) },
+        });
+    }
+    let skeleton = Skeleton::new(joints)?;
+
+    let skin_joints: Vec<usize> = skin.joints().map(|n| node_to_joint[&n.index()]).collect();
+    let mut inverse_bind = vec![Affine3A::IDENTITY; skeleton.len()];
+    if let Some(ibm) = skin.reader(get).read_inverse_bind_matrices() {
+        let ibm: Vec<[[f32; 4]; 4]> = ibm.collect();
+        if ibm.len() != skin_joints.len() {
+            return Err(bad(format!("skin has {} joints but {} inverse bind matrices", skin_joints.len(), ibm.len())));
+        }
+        for (k, m) in ibm.iter().enumerate() {
+            let m = Mat4::from_cols_array_2d(m);
+            if m.row(3) != glam::Vec4::W {
+                return Err(bad(format!("inverse bind matrix of joint {:?} is not affine", skeleton.joints()[skin_joints[k]].name)));
+            }
+            inverse_bind[skin_joints[k]] = Affine3A::from_mat4(m);
+        }
+    }
+
+    let mut data = MeshData { inverse_bind, ..MeshData::default() };
+    let mut stride = 0;
+    let mut primitives = Vec::new();
+    for node in &skinned {
+        if node.skin().map(|s| s.index()) != Some(skin.index()) {
+            continue;
+        }
+        let mesh = node.mesh().expect("filtered on mesh");
+        for prim in mesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                return Err(bad(format!("mesh {:?} primitive {} uses mode {:?}; only triangles are supported", mesh.name().unwrap_or(""), prim.index(), prim.mode())));
+            }
+            let has_second = prim.get(&gltf::Semantic::Joints(1)).is_some() && prim.get(&gltf::Semantic::Weights(1)).is_some();
+            stride = stride.max(if has_second { 8 } else { 4 });
+            primitives.push((mesh.name().unwrap_or("mesh").to_owned(), prim));
+        }
+    }
+    for (name, prim) in &primitives {
+        let where_ = format!("mesh {name:?} primitive {}", prim.index());
+        let reader = prim.reader(get);
+        let positions: Vec<[f32; 3]> =
+            reader.read_positions().ok_or_else(|| bad(format!("{where_} has no POSITION accessor")))?.collect();
+        let n = positions.len();
+        let base = data.positions.len() as u32;
+        let mut influences = vec![(0u32, 0f32); n * stride];
+        for set in 0..stride / 4 {
+            let js = reader.read_joints(set as u32).ok_or_else(|| bad(format!("{where_} has no JOINTS_{set} accessor")))?;
+            let ws = reader.read_weights(set as u32).ok_or_else(|| bad(format!("{where_} has no WEIGHTS_{set} accessor")))?;
+            let (js, ws): (Vec<[u16; 4]>, Vec<[f32; 4]>) = (js.into_u16().collect(), ws.into_f32().collect());
+            if js.len() != n || ws.len() != n {
+                return Err(bad(format!("{where_}: JOINTS_{set}/WEIGHTS_{set} have {}/{} entries for {n} vertices", js.len(), ws.len())));
+            }
+            for v in 0..n {
+                for c in 0..4 {
+                    let j = usize::from(js[v][c]);
+                    let w = ws[v][c];
+                    let joint = match skin_joints.get(j) {
+                        Some(&s) => s as u32,
+                        None if w == 0.0 => 0,
+                        None => return Err(bad(format!("{where_}: vertex {v} uses joint {j}, but the skin has {} joints", skin_joints.len()))),
+                    };
+                    influences[v * stride + set * 4 + c] = (joint, w);
+                }
+            }
+        }
+        let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(Iterator::collect);
+        let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..n as u32).collect(),
+        };
+        if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
+            return Err(bad(format!("{where_}: index {i} is out of range for {n} vertices")));
+        }
+        if normals.as_ref().is_some_and(|v| v.len() != n) || uvs.as_ref().is_some_and(|v| v.len() != n) {
+            return Err(bad(format!("{where_}: NORMAL or TEXCOORD_0 count differs from POSITION ({n})")));
+        }
+        let start = data.indices.len();
+        data.parts.push(Part { name: name.clone(), vertices: base as usize..base as usize + n, indices: start..start + indices.len() });
+        data.indices.extend(indices.iter().map(|i| i + base));
+        // Normals and UVs are kept only if every primitive has them.
+        match normals {
+            Some(v) if data.normals.len() == base as usize => data.normals.extend(v),
+            _ => data.normals.clear(),
+        }
+        match uvs {
+            Some(v) if data.uvs.len() == base as usize => data.uvs.extend(v),
+            _ => data.uvs.clear(),
+        }
+        data.positions.extend(positions);
+        data.joints.extend(influences.iter().map(|i| i.0));
+        data.weights.extend(influences.iter().map(|i| i.1));
+    }
+    if data.normals.len() != data.positions.len() && !data.normals.is_empty() {
+        data.normals.clear();
+    }
+    if data.uvs.len() != data.positions.len() {
+        data.uvs.clear();
+    }
+    data.stride = stride.max(1);
+    let (mesh, mesh_warnings) = SkinnedMesh::new(data)?;
+    warnings.extend(mesh_warnings);
+    let name = path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into_owned());
+    Ok(Model { description: format!("glTF file {name}"), skeleton, mesh, warnings })
+}
+
+/// The bytes of every buffer: the GLB binary chunk, a `data:` URI, or a file beside `path`.
+fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
+    let mut out = Vec::new();
+    for buffer in gltf.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                gltf.blob.clone().ok_or_else(|| Error::Invalid("buffer 0 refers to a GLB binary chunk the file does not have".into()))?
+            }
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                let b64 = uri.split_once(";base64,").map(|s| s.1).ok_or_else(|| {
+                    Error::Invalid(format!("buffer {} has a data URI that is not base64", buffer.index()))
+                })?;
+                base64::engine::general_purpose::STANDARD
+                    .decode(b64)
+                    .map_err(|e| Error::Invalid(format!("buffer {} has invalid base64: {e}", buffer.index())))?
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                if uri.contains("://") {
+                    return Err(Error::Invalid(format!("buffer {} refers to {uri:?}; only local files are read", buffer.index())));
+                }
+                let file = path.parent().unwrap_or(Path::new(".")).join(uri);
+                std::fs::read(&file).map_err(|e| Error::Invalid(format!("buffer {} file {}: {e}", buffer.index(), file.display())))?
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(Error::Invalid(format!(
+                "buffer {} is truncated: {} bytes of the declared {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            )));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Checks that an accessor's elements lie inside its buffer view and the view inside its
+/// buffer, so that reading it cannot go out of bounds.
+fn check_accessor(a: &gltf::Accessor<'_>, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    let i = a.index();
+    if a.sparse().is_some() {
+        return Err(format!("accessor {i} is sparse; sparse accessors are not supported"));
+    }
+    let view = a.view().ok_or_else(|| format!("accessor {i} has no buffer view"))?;
+    let buffer = &buffers[view.buffer().index()];
+    if view.offset() + view.length() > buffer.len() {
+        return Err(format!(
+            "buffer view {} (bytes {}..{}) reaches past the end of buffer {} ({} bytes)",
+            view.index(),
+            view.offset(),
+            view.offset() + view.length(),
+            view.buffer().index(),
+            buffer.len()
+        ));
+    }
+    let elem = a.dimensions().multiplicity() * a.data_type().size();
+    let stride = view.stride().unwrap_or(elem);
+    if a.count() > 0 && a.offset() + stride * (a.count() - 1) + elem > view.length() {
+        return Err(format!("accessor {i} ({} elements) reaches past the end of buffer view {}", a.count(), view.index()));
+    }
+    Ok(())
+}

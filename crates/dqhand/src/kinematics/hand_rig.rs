@@ -1,0 +1,164 @@
+//! The hand rig: a joint model bound to a concrete skeleton with WebXR joint names.
+//!
+//! It resolves each degree of freedom to a joint index and a rotation axis in that joint's
+//! frame once, so turning a [`Pose`] into local transforms each frame is a short loop.
+
+use glam::{Affine3A, Quat, Vec3};
+
+use super::{webxr, JointModel, Motion, Pose, Skeleton, Transform};
+use crate::{Error, Result};
+
+/// One resolved degree of freedom.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RigDof {
+    joint: usize,
+    axis: Vec3,
+    min: f32,
+    max: f32,
+}
+
+/// Whether joint limits are applied when posing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Limits {
+    /// Angles are clamped to the joint model's anatomical ranges (the default).
+    #[default]
+    Anatomical,
+    /// Angles are used as given.
+    Off,
+}
+
+/// A [`JointModel`] resolved on a skeleton whose joints carry WebXR names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HandRig {
+    skeleton: Skeleton,
+    model: JointModel,
+    dofs: Vec<RigDof>,
+    wrist: usize,
+}
+
+impl HandRig {
+    /// Resolves `model` on `skeleton`. A skeleton whose WebXR joints are stored as siblings
+    /// (as WebXR and the generic-hand asset do) is first re-parented into the anatomical chain
+    /// wrist → metacarpal → phalanges, keeping every rest transform.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] if a joint the model needs is missing.
+    pub fn new(skeleton: &Skeleton, model: JointModel) -> Result<Self> {
+        let skeleton = skeleton.reparented(webxr::anatomical_parent)?;
+        let wrist = skeleton.find("wrist").ok_or_else(|| missing("wrist"))?;
+        let world = skeleton.rest_world();
+        let pos = |name: &str| -> Option<Vec3> { skeleton.find(name).map(|i| world[i].translation.into()) };
+        // Radial points from the little finger toward the index; palmar is the wrist's −Y.
+        let radial: Vec3 = match (pos("index-finger-phalanx-proximal"), pos("pinky-finger-phalanx-proximal")) {
+            (Some(i), Some(p)) => (i - p).normalize_or_zero(),
+            _ => Vec3::ZERO,
+        };
+        let palmar = -Vec3::from(world[wrist].matrix3.y_axis).normalize_or_zero();
+        let mut dofs = Vec::new();
+        for d in model.dofs() {
+            let joint = skeleton.find(d.bone).ok_or_else(|| missing(d.bone))?;
+            let axis = match d.motion {
+                Motion::Flex => Vec3::NEG_X,
+                Motion::Abd => {
+                    let away = match d.bone {
+                        b if b.starts_with("thumb") => palmar,
+                        b if b.starts_with("ring") || b.starts_with("pinky") => -radial,
+                        _ => radial,
+                    };
+                    Vec3::Y * abduction_sign(&skeleton, &world, joint, away)
+                }
+            };
+            dofs.push(RigDof { joint, axis, min: d.min_deg.to_radians(), max: d.max_deg.to_radians() });
+        }
+        Ok(Self { skeleton, model, dofs, wrist })
+    }
+
+    /// The anatomical skeleton the rig poses (same joint indices as the input skeleton).
+    #[must_use]
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// The joint model.
+    #[must_use]
+    pub fn model(&self) -> JointModel {
+        self.model
+    }
+
+    /// Clamps the pose's angles to the anatomical ranges; returns the indices of the DOFs that
+    /// were out of range.
+    ///
+    /// # Panics
+    /// If the pose has the wrong number of angles.
+    pub fn clamp(&self, pose: &mut Pose) -> Vec<usize> {
+        assert_eq!(pose.angles.len(), self.dofs.len(), "pose angle count");
+        let mut clamped = Vec::new();
+        for (i, (a, d)) in pose.angles.iter_mut().zip(&self.dofs).enumerate() {
+            let c = a.clamp(d.min, d.max);
+            if c != *a {
+                clamped.push(i);
+                *a = c;
+            }
+        }
+        clamped
+    }
+
+    /// Writes the local transform of every joint for `pose`: the rest transforms, the wrist
+    /// replaced by the tracker pose, each moving joint turned by `rest · R(abd) · R(flex)`.
+    ///
+    /// * `locals` — #joints output, overwritten. Allocates nothing.
+    ///
+    /// # Panics
+    /// If `locals` or `pose.angles` have the wrong length.
+    pub fn locals(&self, pose: &Pose, limits: Limits, locals: &mut [Transform]) {
+        assert_eq!(pose.angles.len(), self.dofs.len(), "pose angle count");
+        assert_eq!(locals.len(), self.skeleton.len(), "locals: one per joint");
+        for (l, j) in locals.iter_mut().zip(self.skeleton.joints()) {
+            *l = j.rest;
+        }
+        if let Some(w) = pose.wrist {
+            let (rotation, translation) = w.to_rotation_translation();
+            let world = Affine3A::from_rotation_translation(rotation, translation);
+            let parent = self.skeleton.joints()[self.wrist].parent.map(|p| self.parent_world(p));
+            let local = parent.map_or(world, |p| p.inverse() * world);
+            locals[self.wrist] = Transform { scale: locals[self.wrist].scale, ..Transform::from_affine(&local) };
+        }
+        for (&a, d) in pose.angles.iter().zip(&self.dofs) {
+            let angle = match limits {
+                Limits::Anatomical => a.clamp(d.min, d.max),
+                Limits::Off => a,
+            };
+            let l = &mut locals[d.joint];
+            l.rotation = (l.rotation * Quat::from_axis_angle(d.axis, angle)).normalize();
+        }
+    }
+
+    /// Rest world transform of a joint above the wrist (fixed: only the wrist and below move).
+    fn parent_world(&self, joint: usize) -> Affine3A {
+        let joints = self.skeleton.joints();
+        let mut m = joints[joint].rest.to_affine();
+        let mut j = joint;
+        while let Some(p) = joints[j].parent {
+            m = joints[p].rest.to_affine() * m;
+            j = p;
+        }
+        m
+    }
+}
+
+/// +1 if turning `joint` about its +Y axis moves its child away along `away`, else −1.
+fn abduction_sign(skeleton: &Skeleton, world: &[Affine3A], joint: usize, away: Vec3) -> f32 {
+    let child = skeleton.joints().iter().position(|j| j.parent == Some(joint));
+    let Some(child) = child else { return 1.0 };
+    let tip: Vec3 = world[child].translation.into();
+    let turned = world[joint] * Affine3A::from_rotation_y(0.1) * world[joint].inverse();
+    if (turned.transform_point3(tip) - tip).dot(away) >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+fn missing(name: &str) -> Error {
+    Error::Invalid(format!("skeleton has no joint {name:?}; joint angles need the WebXR hand joint names"))
+}

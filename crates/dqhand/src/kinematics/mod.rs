@@ -1,0 +1,16 @@
+//! Kinematics layer (paper 4.3): skeleton, joint models and limits, poses, forward kinematics.
+
+mod forward_kinematics;
+mod hand_rig;
+mod joint_model;
+mod pose;
+mod skeleton;
+mod transform;
+pub mod webxr;
+
+pub use forward_kinematics::forward_kinematics;
+pub use hand_rig::{HandRig, Limits};
+pub use joint_model::{Dof, JointModel, Motion};
+pub use pose::Pose;
+pub use skeleton::{Joint, Skeleton};
+pub use transform::Transform;

@@ -1,0 +1,36 @@
+//! A hand pose: the wrist's 6-DOF pose plus one angle per degree of freedom.
+
+use crate::math::DualQuat;
+
+/// What a glove and tracker report each frame (paper Figure 1, input layer).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pose {
+    /// The wrist's world transform (the tracker), `None` to keep the rest wrist.
+    pub wrist: Option<DualQuat>,
+    /// Joint angles in radians, in the order of [`JointModel::dofs`](super::JointModel::dofs).
+    pub angles: Vec<f32>,
+}
+
+impl Pose {
+    /// The rest pose of a model with `dof_count` degrees of freedom: all angles zero.
+    #[must_use]
+    pub fn rest(dof_count: usize) -> Self {
+        Self { wrist: None, angles: vec![0.0; dof_count] }
+    }
+
+    /// Interpolates toward `end` by `t` in [0, 1]: angles linearly, the wrist by ScLERP
+    /// (a missing wrist stands for the identity).
+    ///
+    /// # Panics
+    /// If the poses have different angle counts.
+    #[must_use]
+    pub fn interpolate(&self, end: &Pose, t: f32) -> Pose {
+        assert_eq!(self.angles.len(), end.angles.len(), "poses of different joint models");
+        let angles = self.angles.iter().zip(&end.angles).map(|(a, b)| a + (b - a) * t).collect();
+        let wrist = match (self.wrist, end.wrist) {
+            (None, None) => None,
+            (a, b) => Some(a.unwrap_or(DualQuat::IDENTITY).sclerp(b.unwrap_or(DualQuat::IDENTITY), t)),
+        };
+        Pose { wrist, angles }
+    }
+}

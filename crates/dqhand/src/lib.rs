@@ -1,0 +1,24 @@
+//! dqhand: a dual quaternion virtual hand (Chen, Zhu, Wan, Feng, "Dual quaternion based
+//! virtual hand interaction modeling", Sci China Inf Sci 56:032103, 2013).
+//!
+//! Layers, as in the paper's Figure 1:
+//! * [`math`] — dual quaternions and screws on top of glam;
+//! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
+//! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
+//! * [`hand`] — the built-in hand;
+//! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
+//! * [`model`] — a skeleton and its skinned mesh, posed frame by frame.
+//!
+//! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
+//! are `[x, y, z, w]`; joints carry WebXR hand joint names.
+
+mod error;
+pub mod gesture;
+pub mod hand;
+pub mod io;
+pub mod kinematics;
+pub mod math;
+pub mod model;
+pub mod skin;
+
+pub use error::{Error, Result};

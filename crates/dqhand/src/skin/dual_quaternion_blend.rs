@@ -1,0 +1,48 @@
+//! Dual quaternion blending (DQB), the paper's pseudo-muscle layer (section 4.4).
+//!
+//! Paper eq. (3)/(4): `b̂ = Σ wᵢ q̂ᵢ`, each `q̂ᵢ` first sign-aligned to the heaviest
+//! influence (Kavan et al. 2008, "Geometric skinning with approximate dual quaternion
+//! blending", ACM TOG 27:105), then divided by `‖b₀‖` — always, as the paper insists, since
+//! only the normalised blend is a rigid transform free of collapse and candy wrapper.
+//! Positions by eq. (5), normals by eq. (6).
+
+use glam::Affine3A;
+
+use super::kernel::{inv_len, rotate, Blend, Chunk, Lanes};
+use super::skinned_mesh::LANES;
+use crate::math::DualQuat;
+
+/// Blend parameters: real part `(x, y, z, w)`, then dual part.
+pub(crate) const W: usize = 8;
+
+/// The unit dual quaternion of a skinning matrix's rigid part.
+pub(crate) fn params(m: &Affine3A) -> [f32; W] {
+    DualQuat::from_mat4(&(*m).into()).to_array()
+}
+
+pub(crate) struct Dqb;
+
+impl Blend<W> for Dqb {
+    const ALIGN: bool = true;
+
+    #[inline(always)]
+    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
+        for l in 0..LANES {
+            let s = inv_len(b[0][l] * b[0][l] + b[1][l] * b[1][l] + b[2][l] * b[2][l] + b[3][l] * b[3][l]);
+            let (x, y, z, a0) = (b[0][l] * s, b[1][l] * s, b[2][l] * s, b[3][l] * s);
+            let (ex, ey, ez, ae) = (b[4][l] * s, b[5][l] * s, b[6][l] * s, b[7][l] * s);
+            // Eq. (5): translation 2(a₀ d_ε − a_ε d₀ + d₀ × d_ε).
+            let t = [
+                2.0 * (a0 * ex - ae * x + (y * ez - z * ey)),
+                2.0 * (a0 * ey - ae * y + (z * ex - x * ez)),
+                2.0 * (a0 * ez - ae * z + (x * ey - y * ex)),
+            ];
+            let p = rotate([x, y, z, a0], [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let n = rotate([x, y, z, a0], [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            for i in 0..3 {
+                out.p[i][l] = p[i] + t[i];
+                out.n[i][l] = n[i];
+            }
+        }
+    }
+}

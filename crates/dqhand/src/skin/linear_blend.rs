@@ -1,0 +1,47 @@
+//! Linear blending (LB, "linear blend skinning"): `v' = Σ wᵢ Mᵢ v`.
+//!
+//! Cheapest of the three, and the reference for the paper's artifacts: blended matrices are
+//! not rotations, so bent joints collapse and twisted ones pinch (the candy wrapper).
+
+use glam::Affine3A;
+
+use super::kernel::{inv_len, Blend, Chunk, Lanes};
+use super::skinned_mesh::LANES;
+
+/// Blend parameters: the rows of the 3×4 matrix `[R | t]`.
+pub(crate) const W: usize = 12;
+
+/// The 3×4 rows of a skinning matrix.
+pub(crate) fn params(m: &Affine3A) -> [f32; W] {
+    let (c, t) = (m.matrix3, m.translation);
+    [c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x, c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y, c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z]
+}
+
+pub(crate) struct Lb;
+
+impl Blend<W> for Lb {
+    const ALIGN: bool = false;
+
+    /// Positions by the blended matrix; normals by its cofactor matrix (the inverse transpose
+    /// up to the determinant), whose rows are cross products of the other two rows.
+    #[inline(always)]
+    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
+        for l in 0..LANES {
+            let r = [[b[0][l], b[1][l], b[2][l]], [b[4][l], b[5][l], b[6][l]], [b[8][l], b[9][l], b[10][l]]];
+            let t = [b[3][l], b[7][l], b[11][l]];
+            let (p, n) = ([rest.p[0][l], rest.p[1][l], rest.p[2][l]], [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            for i in 0..3 {
+                out.p[i][l] = r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2] + t[i];
+            }
+            let cross = |a: [f32; 3], b: [f32; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+            let cof = [cross(r[1], r[2]), cross(r[2], r[0]), cross(r[0], r[1])];
+            let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let m = [dot(cof[0], n), dot(cof[1], n), dot(cof[2], n)];
+            // A mirroring blend (negative determinant) would turn the normal inside out.
+            let s = inv_len(dot(m, m)).copysign(dot(r[0], cof[0]));
+            for i in 0..3 {
+                out.n[i][l] = m[i] * s;
+            }
+        }
+    }
+}

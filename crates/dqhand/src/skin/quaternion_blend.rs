@@ -1,0 +1,40 @@
+//! Quaternion blending (QB): rotations blended as quaternions, translations linearly.
+//!
+//! `q = normalize(Σ wᵢ sᵢ qᵢ)`, `t = Σ wᵢ tᵢ`, `v' = q v q* + t`. The blended rotation is a
+//! true rotation, but about the model origin rather than the joint, which is what produces
+//! the paper's Figure 5 artifacts away from the origin.
+
+use glam::Affine3A;
+
+use super::kernel::{inv_len, rotate, Blend, Chunk, Lanes};
+use super::skinned_mesh::LANES;
+use crate::math::DualQuat;
+
+/// Blend parameters: the rotation `(x, y, z, w)`, then the translation and a zero.
+pub(crate) const W: usize = 8;
+
+/// The rotation quaternion and translation of a skinning matrix's rigid part.
+pub(crate) fn params(m: &Affine3A) -> [f32; W] {
+    let (q, t) = DualQuat::from_mat4(&(*m).into()).to_rotation_translation();
+    [q.x, q.y, q.z, q.w, t.x, t.y, t.z, 0.0]
+}
+
+pub(crate) struct Qb;
+
+impl Blend<W> for Qb {
+    const ALIGN: bool = true;
+
+    #[inline(always)]
+    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
+        for l in 0..LANES {
+            let s = inv_len(b[0][l] * b[0][l] + b[1][l] * b[1][l] + b[2][l] * b[2][l] + b[3][l] * b[3][l]);
+            let q = [b[0][l] * s, b[1][l] * s, b[2][l] * s, b[3][l] * s];
+            let p = rotate(q, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let n = rotate(q, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            for i in 0..3 {
+                out.p[i][l] = p[i] + b[4 + i][l];
+                out.n[i][l] = n[i];
+            }
+        }
+    }
+}

@@ -1,0 +1,314 @@
+//! A skinned triangle mesh stored for speed: structure of arrays, influences packed per vertex.
+
+use glam::{Affine3A, Vec3};
+
+use crate::{Error, Result};
+
+/// Vertices are processed in chunks of this many; arrays are padded to a multiple of it.
+pub const LANES: usize = 8;
+
+/// Most influences a vertex may have (glTF's JOINTS_0 and JOINTS_1).
+pub const MAX_INFLUENCES: usize = 8;
+
+/// A named range of a mesh, one glTF primitive: its vertices and triangle indices.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Part {
+    /// Name of the glTF mesh the primitive belongs to.
+    pub name: String,
+    /// First vertex and vertex count.
+    pub vertices: core::ops::Range<usize>,
+    /// Range in the flat triangle index array (a multiple of three long).
+    pub indices: core::ops::Range<usize>,
+}
+
+/// A skinned mesh as read from a file or built by the hand generator, before validation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    /// Rest positions (m), #V.
+    pub positions: Vec<[f32; 3]>,
+    /// Rest normals, #V, or empty to compute them from the triangles.
+    pub normals: Vec<[f32; 3]>,
+    /// Texture coordinates, #V, or empty.
+    pub uvs: Vec<[f32; 2]>,
+    /// Influences per vertex in `joints` and `weights` (1 to 8).
+    pub stride: usize,
+    /// Joint index of each influence, #V × stride.
+    pub joints: Vec<u32>,
+    /// Weight of each influence, #V × stride.
+    pub weights: Vec<f32>,
+    /// Triangle vertex indices, #F × 3, counter-clockwise seen from outside.
+    pub indices: Vec<u32>,
+    /// Primitives; empty means one part spanning everything.
+    pub parts: Vec<Part>,
+    /// Inverse bind matrix of each skeleton joint, #joints.
+    pub inverse_bind: Vec<Affine3A>,
+}
+
+/// A validated skinned mesh in structure-of-arrays layout.
+///
+/// Positions and normals are stored as separate `x`, `y`, `z` arrays padded to a multiple
+/// of [`LANES`]; each vertex has exactly [`Self::influences_per_vertex`] (joint, weight) slots,
+/// heaviest first, zero-weight padding pointing at the heaviest joint. Weights sum to one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinnedMesh {
+    vertex_count: usize,
+    pub(crate) pos: [Vec<f32>; 3],
+    pub(crate) nrm: [Vec<f32>; 3],
+    pub(crate) k: usize,
+    pub(crate) joints: Vec<u16>,
+    pub(crate) weights: Vec<f32>,
+    max_influences: usize,
+    uvs: Vec<[f32; 2]>,
+    indices: Vec<u32>,
+    parts: Vec<Part>,
+    inverse_bind: Vec<Affine3A>,
+}
+
+impl SkinnedMesh {
+    /// Validates and packs mesh data. Returns the mesh and warnings (weights renormalised).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a non-finite value, a joint index out of range, a vertex with no
+    /// positive weight or a negative weight, a triangle index out of range, a non-invertible
+    /// inverse bind matrix, or inconsistent array lengths. The message names the vertex,
+    /// triangle or joint.
+    pub fn new(data: MeshData) -> Result<(Self, Vec<String>)> {
+        let n = data.positions.len();
+        let joint_count = data.inverse_bind.len();
+        let bad = |m: String| Err(Error::Invalid(m));
+        if n == 0 {
+            return bad("mesh has no vertices".into());
+        }
+        if !(1..=MAX_INFLUENCES).contains(&data.stride) {
+            return bad(format!("{} influences per vertex; 1 to {MAX_INFLUENCES} are supported", data.stride));
+        }
+        if data.joints.len() != n * data.stride || data.weights.len() != n * data.stride {
+            return bad(format!("influence arrays do not match the {n} vertices"));
+        }
+        if !data.normals.is_empty() && data.normals.len() != n {
+            return bad(format!("{} normals for {n} vertices", data.normals.len()));
+        }
+        if !data.uvs.is_empty() && data.uvs.len() != n {
+            return bad(format!("{} texture coordinates for {n} vertices", data.uvs.len()));
+        }
+        if joint_count == 0 || joint_count > usize::from(u16::MAX) {
+            return bad(format!("{joint_count} joints; 1 to 65535 are supported"));
+        }
+        if data.indices.len() % 3 != 0 {
+            return bad(format!("{} triangle indices is not a multiple of three", data.indices.len()));
+        }
+        if let Some((t, &i)) = data.indices.iter().enumerate().find(|(_, &i)| i as usize >= n) {
+            return bad(format!("triangle {} uses vertex {i}, but there are only {n} vertices", t / 3));
+        }
+        if let Some(v) = data.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return bad(format!("vertex {v} has a non-finite position {:?}", data.positions[v]));
+        }
+        if let Some(v) = data.normals.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return bad(format!("vertex {v} has a non-finite normal {:?}", data.normals[v]));
+        }
+        for (j, m) in data.inverse_bind.iter().enumerate() {
+            let det = m.matrix3.determinant();
+            if !m.is_finite() || det.abs() < 1e-12 {
+                return bad(format!("inverse bind matrix of joint {j} is not invertible (determinant {det})"));
+            }
+        }
+
+        let mut warnings = Vec::new();
+        let mut renormalised = 0usize;
+        let mut slots: Vec<Vec<(u16, f32)>> = Vec::with_capacity(n);
+        for v in 0..n {
+            let mut inf = Vec::with_capacity(data.stride);
+            for s in 0..data.stride {
+                let (j, w) = (data.joints[v * data.stride + s], data.weights[v * data.stride + s]);
+                if !w.is_finite() || w < 0.0 {
+                    return bad(format!("vertex {v} has an invalid weight {w}"));
+                }
+                if w == 0.0 {
+                    continue;
+                }
+                if j as usize >= joint_count {
+                    return bad(format!("vertex {v} is bound to joint {j}, but the skin has only {joint_count} joints"));
+                }
+                inf.push((j as u16, w));
+            }
+            let sum: f32 = inf.iter().map(|i| i.1).sum();
+            if inf.is_empty() || sum <= 0.0 {
+                return bad(format!("vertex {v} has no positive weight"));
+            }
+            if (sum - 1.0).abs() > 1e-3 {
+                renormalised += 1;
+            }
+            inf.iter_mut().for_each(|i| i.1 /= sum);
+            inf.sort_by(|a, b| b.1.total_cmp(&a.1));
+            slots.push(inf);
+        }
+        if renormalised > 0 {
+            warnings.push(format!("weights of {renormalised} vertices did not sum to one and were normalised"));
+        }
+
+        let max_influences = slots.iter().map(Vec::len).max().unwrap_or(1);
+        let k = if max_influences <= 4 { 4 } else { MAX_INFLUENCES };
+        let padded = n.div_ceil(LANES) * LANES;
+        let mut joints = vec![0u16; padded * k];
+        let mut weights = vec![0f32; padded * k];
+        for (v, inf) in slots.iter().enumerate() {
+            for s in 0..k {
+                let (j, w) = inf.get(s).copied().unwrap_or((inf[0].0, 0.0));
+                joints[v * k + s] = j;
+                weights[v * k + s] = w;
+            }
+        }
+        // Padding vertices: full weight on joint 0 at the origin, outputs ignored.
+        for v in n..padded {
+            weights[v * k] = 1.0;
+        }
+
+        let normals = if data.normals.is_empty() {
+            vertex_normals(&data.positions, &data.indices)
+        } else {
+            data.normals.iter().map(|&m| Vec3::from(m).normalize_or(Vec3::Y).to_array()).collect()
+        };
+        let column = |src: &[[f32; 3]], c: usize| {
+            let mut col: Vec<f32> = src.iter().map(|p| p[c]).collect();
+            col.resize(padded, 0.0);
+            col
+        };
+        let parts = if data.parts.is_empty() {
+            vec![Part { name: "mesh".into(), vertices: 0..n, indices: 0..data.indices.len() }]
+        } else {
+            data.parts
+        };
+        let mesh = Self {
+            vertex_count: n,
+            pos: [0, 1, 2].map(|c| column(&data.positions, c)),
+            nrm: [0, 1, 2].map(|c| column(&normals, c)),
+            k,
+            joints,
+            weights,
+            max_influences,
+            uvs: data.uvs,
+            indices: data.indices,
+            parts,
+            inverse_bind: data.inverse_bind,
+        };
+        Ok((mesh, warnings))
+    }
+
+    /// Number of vertices.
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Influence slots per vertex in the packed arrays (4 or 8).
+    #[must_use]
+    pub fn influences_per_vertex(&self) -> usize {
+        self.k
+    }
+
+    /// The largest number of non-zero influences of any vertex.
+    #[must_use]
+    pub fn max_influences(&self) -> usize {
+        self.max_influences
+    }
+
+    /// Histogram: element `i` counts the vertices with `i` non-zero influences.
+    #[must_use]
+    pub fn influence_histogram(&self) -> Vec<usize> {
+        let mut h = vec![0; self.k + 1];
+        for v in 0..self.vertex_count {
+            h[self.weights[v * self.k..][..self.k].iter().filter(|&&w| w > 0.0).count()] += 1;
+        }
+        h
+    }
+
+    /// The (joint, weight) influences of vertex `v`, heaviest first, zero weights omitted.
+    pub fn influences(&self, v: usize) -> impl Iterator<Item = (usize, f32)> + '_ {
+        let s = v * self.k;
+        self.joints[s..s + self.k].iter().zip(&self.weights[s..s + self.k]).filter(|p| *p.1 > 0.0).map(|(&j, &w)| (j as usize, w))
+    }
+
+    /// Number of vertices whose heaviest influence is each joint, #joints.
+    #[must_use]
+    pub fn vertices_per_joint(&self) -> Vec<usize> {
+        let mut c = vec![0; self.inverse_bind.len()];
+        for v in 0..self.vertex_count {
+            c[self.joints[v * self.k] as usize] += 1;
+        }
+        c
+    }
+
+    /// Rest position of vertex `v` (m).
+    #[must_use]
+    pub fn position(&self, v: usize) -> Vec3 {
+        Vec3::new(self.pos[0][v], self.pos[1][v], self.pos[2][v])
+    }
+
+    /// Rest normal of vertex `v` (unit).
+    #[must_use]
+    pub fn normal(&self, v: usize) -> Vec3 {
+        Vec3::new(self.nrm[0][v], self.nrm[1][v], self.nrm[2][v])
+    }
+
+    /// Rest positions, #V.
+    #[must_use]
+    pub fn positions(&self) -> Vec<[f32; 3]> {
+        (0..self.vertex_count).map(|v| self.position(v).to_array()).collect()
+    }
+
+    /// Rest normals, #V.
+    #[must_use]
+    pub fn normals(&self) -> Vec<[f32; 3]> {
+        (0..self.vertex_count).map(|v| self.normal(v).to_array()).collect()
+    }
+
+    /// Texture coordinates, #V or empty.
+    #[must_use]
+    pub fn uvs(&self) -> &[[f32; 2]] {
+        &self.uvs
+    }
+
+    /// Triangle vertex indices, #F × 3.
+    #[must_use]
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// The primitives the mesh was made of.
+    #[must_use]
+    pub fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+
+    /// Inverse bind matrix of each skeleton joint, #joints.
+    #[must_use]
+    pub fn inverse_bind(&self) -> &[Affine3A] {
+        &self.inverse_bind
+    }
+
+    /// Number of joints that influence at least one vertex (the paper's "bones").
+    #[must_use]
+    pub fn bone_count(&self) -> usize {
+        self.vertices_per_joint().iter().filter(|&&c| c > 0).count()
+    }
+}
+
+/// Area-weighted vertex normals of a triangle mesh, #V (unit; +Y where undefined).
+#[must_use]
+pub fn vertex_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> {
+    let mut acc = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(positions[i as usize]));
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            acc[i as usize] += n;
+        }
+    }
+    acc.into_iter().map(|n| n.normalize_or(Vec3::Y).to_array()).collect()
+}
