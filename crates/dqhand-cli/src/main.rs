@@ -1,1 +1,53 @@
-fn main(){}
+//! The `dqhand` command: inspect, pose, benchmark and demo skinned hands.
+//!
+//! `main` only turns the result of a subcommand into an exit code: 0 on success, 1 with a
+//! one-line error on stderr otherwise (clap exits with 2 on bad usage).
+
+mod bench;
+mod demo;
+mod info;
+mod skin;
+
+use clap::{Parser, Subcommand};
+
+/// Dual quaternion virtual hand: LB, QB and DQB skinning of the built-in hand or any
+/// skinned glTF 2.0 file.
+#[derive(Parser)]
+#[command(name = "dqhand", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print meshes, vertex and triangle counts, the skeleton tree and influences per vertex.
+    Info(info::Args),
+    /// Pose a mesh with LB, QB or DQB and write it with normals (.ply, .obj or .glb).
+    Skin(skin::Args),
+    /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
+    Bench(bench::Args),
+    /// Pose the built-in hand through the gesture library and write the meshes.
+    Demo(demo::Args),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(a) => info::run(&a),
+        Command::Skin(a) => skin::run(&a),
+        Command::Bench(a) => bench::run(&a),
+        Command::Demo(a) => demo::run(&a),
+    };
+    if let Err(e) = result {
+        eprintln!("dqhand: error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Prints the warnings of a load or pose step, one line each.
+pub(crate) fn warn_all(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("dqhand: warning: {w}");
+    }
+}

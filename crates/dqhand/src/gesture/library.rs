@@ -121,3 +121,16 @@ pub const GESTURES: [Gesture; 14] = [
     Gesture { name: "four", angles_deg: &[&THUMB_IN] },
     Gesture { name: "five", angles_deg: &[] },
 ];
+
+/// The whole library as one animation: each gesture reached from the previous one in
+/// `steps` frames (angles interpolated linearly), back to the first at the end.
+#[must_use]
+pub fn tour(model: JointModel, steps: usize) -> Vec<Pose> {
+    let poses: Vec<Pose> = GESTURES.iter().map(|g| g.pose(model)).collect();
+    let mut frames = Vec::with_capacity(poses.len() * steps);
+    for (i, a) in poses.iter().enumerate() {
+        let b = &poses[(i + 1) % poses.len()];
+        frames.extend((0..steps).map(|s| a.interpolate(b, s as f32 / steps as f32)));
+    }
+    frames
+}

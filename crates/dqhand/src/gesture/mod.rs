@@ -2,4 +2,4 @@
 
 mod library;
 
-pub use library::{gesture, Gesture, GESTURES};
+pub use library::{gesture, tour, Gesture, GESTURES};

@@ -86,6 +86,7 @@ pub struct Deformer {
     lb: Vec<[f32; lb::W]>,
     quat: Vec<[f32; dqb::W]>,
     signs: Vec<f32>,
+    portable: bool,
 }
 
 impl Deformer {
@@ -93,7 +94,14 @@ impl Deformer {
     #[must_use]
     pub fn new(method: Method, joint_count: usize) -> Self {
         let (lbn, qn) = if method == Method::Lb { (joint_count, 0) } else { (0, joint_count) };
-        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![0.0; qn * qn] }
+        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![0.0; qn * qn], portable: false }
+    }
+
+    /// The same deformer on the portable kernel, even where the AVX2 + FMA one would run
+    /// (for comparing the two; results agree to rounding).
+    #[must_use]
+    pub fn portable(self) -> Self {
+        Self { portable: true, ..self }
     }
 
     /// The method.
@@ -123,7 +131,7 @@ impl Deformer {
                 for (d, m) in self.lb.iter_mut().zip(skinning) {
                     *d = lb::params(m);
                 }
-                kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[] }, p, n);
+                kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], portable: self.portable }, p, n);
             }
             Method::Qb | Method::Dqb => {
                 assert_eq!(self.quat.len(), skinning.len(), "deformer made for another joint count");
@@ -139,7 +147,7 @@ impl Deformer {
                         self.signs[h * j + i] = if dot < 0.0 { -1.0 } else { 1.0 };
                     }
                 }
-                let frame = Frame { params: &self.quat, signs: &self.signs };
+                let frame = Frame { params: &self.quat, signs: &self.signs, portable: self.portable };
                 if self.method == Method::Qb {
                     kernel::deform::<{ qb::W }, qb::Qb>(mesh, &frame, p, n);
                 } else {

@@ -33,6 +33,8 @@ pub(crate) struct Frame<'a, const W: usize> {
     pub params: &'a [[f32; W]],
     /// `signs[h * joints + j]`: ±1 aligning joint `j` to joint `h` (unused without `ALIGN`).
     pub signs: &'a [f32],
+    /// Use the portable kernel even where the AVX2 one would run.
+    pub portable: bool,
 }
 
 /// Deforms every vertex of `mesh`; writes `positions` and `normals` (each padded length).
@@ -43,12 +45,25 @@ pub(crate) fn deform<const W: usize, B: Blend<W>>(
     normals: &mut [[f32; 3]],
 ) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if !frame.portable && simd_available() {
         // SAFETY: the CPU supports the features the function is compiled for.
         unsafe { deform_avx2::<W, B>(mesh, frame, positions, normals) };
         return;
     }
-    deform_any::<W, B>(mesh, frame, positions, normals);
+    deform_any::<W, B, false>(mesh, frame, positions, normals);
+}
+
+/// Whether the AVX2 + FMA kernel runs on this CPU.
+#[must_use]
+pub fn simd_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -59,24 +74,24 @@ unsafe fn deform_avx2<const W: usize, B: Blend<W>>(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    deform_any::<W, B>(mesh, frame, positions, normals);
+    deform_any::<W, B, true>(mesh, frame, positions, normals);
 }
 
 #[inline(always)]
-fn deform_any<const W: usize, B: Blend<W>>(
+fn deform_any<const W: usize, B: Blend<W>, const AVX: bool>(
     mesh: &SkinnedMesh,
     frame: &Frame<'_, W>,
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
     match mesh.k {
-        4 => chunks::<W, 4, B>(mesh, frame, positions, normals),
-        _ => chunks::<W, 8, B>(mesh, frame, positions, normals),
+        4 => chunks::<W, 4, B, AVX>(mesh, frame, positions, normals),
+        _ => chunks::<W, 8, B, AVX>(mesh, frame, positions, normals),
     }
 }
 
 #[inline(always)]
-fn chunks<const W: usize, const K: usize, B: Blend<W>>(
+fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     mesh: &SkinnedMesh,
     frame: &Frame<'_, W>,
     positions: &mut [[f32; 3]],
@@ -85,33 +100,20 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>>(
     let padded = mesh.pos[0].len();
     assert!(positions.len() == padded && normals.len() == padded, "output buffers: padded vertex count");
     assert_eq!(mesh.k, K);
+    // Every packed joint index is below the mesh's joint count (checked when the mesh was
+    // built), so these two checks make every parameter and sign lookup in bounds.
     let joints = frame.params.len();
+    assert_eq!(joints, mesh.inverse_bind().len(), "one parameter row per joint");
     assert!(!B::ALIGN || frame.signs.len() == joints * joints, "sign table: joints²");
     let lanes = |a: &[f32], base: usize| -> Lanes { a[base..base + LANES].try_into().unwrap() };
     let mut rest = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
     let mut out = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
+    let mut b = [[0.0f32; LANES]; W];
+    let (all_js, all_ws) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0);
     for base in (0..padded).step_by(LANES) {
-        let mut acc = [[0.0f32; W]; LANES];
-        for (l, acc) in acc.iter_mut().enumerate() {
-            let s = (base + l) * K;
-            let js: &[u16; K] = mesh.joints[s..s + K].try_into().unwrap();
-            let ws: &[f32; K] = mesh.weights[s..s + K].try_into().unwrap();
-            let h = js[0] as usize * joints;
-            for k in 0..K {
-                let j = js[k] as usize;
-                let w = if B::ALIGN { ws[k] * frame.signs[h + j] } else { ws[k] };
-                let p = &frame.params[j];
-                for c in 0..W {
-                    acc[c] += w * p[c];
-                }
-            }
-        }
-        let mut b = [[0.0f32; LANES]; W];
-        for (c, bc) in b.iter_mut().enumerate() {
-            for l in 0..LANES {
-                bc[l] = acc[l][c];
-            }
-        }
+        let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
+        let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
+        blend::<W, K, AVX>(frame, B::ALIGN, js, ws, &mut b);
         for c in 0..3 {
             rest.p[c] = lanes(&mesh.pos[c], base);
             rest.n[c] = lanes(&mesh.nrm[c], base);
@@ -120,6 +122,39 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>>(
         for l in 0..LANES {
             positions[base + l] = [out.p[0][l], out.p[1][l], out.p[2][l]];
             normals[base + l] = [out.n[0][l], out.n[1][l], out.n[2][l]];
+        }
+    }
+}
+
+/// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]`.
+///
+/// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
+/// is transposed to one array per component.
+#[inline(always)]
+fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, js: &[[u16; K]; LANES], ws: &[[f32; K]; LANES], b: &mut [Lanes; W]) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
+        // joint indices are in bounds (see `chunks`).
+        unsafe { avx2::blend::<W, K>(frame, align, js, ws, b) };
+        return;
+    }
+    let joints = frame.params.len();
+    let mut acc = [[0.0f32; W]; LANES];
+    for (l, acc) in acc.iter_mut().enumerate() {
+        let h = usize::from(js[l][0]) * joints;
+        for k in 0..K {
+            let j = usize::from(js[l][k]);
+            let w = if align { ws[l][k] * frame.signs[h + j] } else { ws[l][k] };
+            let p = &frame.params[j];
+            for c in 0..W {
+                acc[c] += w * p[c];
+            }
+        }
+    }
+    for (c, bc) in b.iter_mut().enumerate() {
+        for l in 0..LANES {
+            bc[l] = acc[l][c];
         }
     }
 }
@@ -141,4 +176,80 @@ pub(crate) fn rotate(q: [f32; 4], v: [f32; 3]) -> [f32; 3] {
 #[inline(always)]
 pub(crate) fn inv_len(sq: f32) -> f32 {
     1.0 / sq.max(1e-30).sqrt()
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    //! The blend step with AVX2 and FMA: one fused multiply-add per influence and block of
+    //! eight parameters, then an in-register 8×8 transpose.
+
+    use core::arch::x86_64::*;
+
+    use super::{Frame, Lanes, LANES};
+
+    /// As the portable `blend`, for `W` = 8 or 16.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn blend<const W: usize, const K: usize>(
+        frame: &Frame<'_, W>,
+        align: bool,
+        js: &[[u16; K]; LANES],
+        ws: &[[f32; K]; LANES],
+        b: &mut [Lanes; W],
+    ) {
+        const { assert!(W == 8 || W == 16) };
+        let joints = frame.params.len();
+        let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
+        for l in 0..LANES {
+            let h = usize::from(js[l][0]) * joints;
+            for k in 0..K {
+                let j = usize::from(js[l][k]);
+                let mut w = ws[l][k];
+                if align {
+                    w *= *frame.signs.get_unchecked(h + j);
+                }
+                let wv = _mm256_set1_ps(w);
+                let p = frame.params.get_unchecked(j).as_ptr();
+                for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
+                    r[l] = _mm256_fmadd_ps(wv, _mm256_loadu_ps(p.add(8 * blk)), r[l]);
+                }
+            }
+        }
+        for (blk, r) in rows.iter().enumerate().take(W / 8) {
+            let t = transpose(r);
+            for (c, v) in t.iter().enumerate() {
+                _mm256_storeu_ps(b[8 * blk + c].as_mut_ptr(), *v);
+            }
+        }
+    }
+
+    /// 8×8 transpose: row `l` of the input (a vertex) becomes lane `l` of every output.
+    #[inline(always)]
+    unsafe fn transpose(r: &[__m256; 8]) -> [__m256; 8] {
+        let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+        let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+        let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+        let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+        let t4 = _mm256_unpacklo_ps(r[4], r[5]);
+        let t5 = _mm256_unpackhi_ps(r[4], r[5]);
+        let t6 = _mm256_unpacklo_ps(r[6], r[7]);
+        let t7 = _mm256_unpackhi_ps(r[6], r[7]);
+        let s0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+        let s1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+        let s2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+        let s3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+        let s4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+        let s5 = _mm256_shuffle_ps::<0xEE>(t4, t6);
+        let s6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+        let s7 = _mm256_shuffle_ps::<0xEE>(t5, t7);
+        [
+            _mm256_permute2f128_ps::<0x20>(s0, s4),
+            _mm256_permute2f128_ps::<0x20>(s1, s5),
+            _mm256_permute2f128_ps::<0x20>(s2, s6),
+            _mm256_permute2f128_ps::<0x20>(s3, s7),
+            _mm256_permute2f128_ps::<0x31>(s0, s4),
+            _mm256_permute2f128_ps::<0x31>(s1, s5),
+            _mm256_permute2f128_ps::<0x31>(s2, s6),
+            _mm256_permute2f128_ps::<0x31>(s3, s7),
+        ]
+    }
 }

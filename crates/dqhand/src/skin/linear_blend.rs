@@ -8,13 +8,13 @@ use glam::Affine3A;
 use super::kernel::{inv_len, Blend, Chunk, Lanes};
 use super::skinned_mesh::LANES;
 
-/// Blend parameters: the rows of the 3×4 matrix `[R | t]`.
-pub(crate) const W: usize = 12;
+/// Blend parameters: the rows of the 3×4 matrix `[R | t]`, padded to two blocks of eight.
+pub(crate) const W: usize = 16;
 
 /// The 3×4 rows of a skinning matrix.
 pub(crate) fn params(m: &Affine3A) -> [f32; W] {
     let (c, t) = (m.matrix3, m.translation);
-    [c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x, c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y, c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z]
+    [c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x, c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y, c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z, 0.0, 0.0, 0.0, 0.0]
 }
 
 pub(crate) struct Lb;

@@ -7,5 +7,6 @@ mod linear_blend;
 mod quaternion_blend;
 mod skinned_mesh;
 
+pub use kernel::simd_available;
 pub use deformer::{skinning_transforms, Deformed, Deformer, Method};
 pub use skinned_mesh::{vertex_normals, MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};

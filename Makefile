@@ -1,0 +1,32 @@
+# dqhand — `make demo` sets up and runs the main job; `make test` sets up and runs every test.
+# Both install what a fresh machine lacks (the Rust toolchain is expected, Node for assets).
+
+CARGO ?= cargo
+NPM ?= npm
+WEBXR_HAND := third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb
+
+.PHONY: demo test build assets bench clean
+
+demo: build
+	./target/release/dqhand demo --out out/demo
+
+build:
+	$(CARGO) build --release --locked -p dqhand-cli
+
+# Third-party test assets come from the npm registry through third_party/package-lock.json;
+# nothing third-party is committed.
+assets: $(WEBXR_HAND)
+
+$(WEBXR_HAND): third_party/package.json third_party/package-lock.json
+	cd third_party && $(NPM) ci --no-audit --no-fund
+	touch $@
+
+test: assets
+	$(CARGO) test --locked --workspace
+
+bench: build
+	./target/release/dqhand bench
+
+clean:
+	$(CARGO) clean
+	rm -rf out third_party/node_modules

@@ -1,0 +1,190 @@
+//! Skeleton, joint models, limits and forward kinematics (paper 4.3).
+
+mod support;
+
+use dqhand::hand::{build, HandParams, Side};
+use dqhand::kinematics::{forward_kinematics, HandRig, Joint, JointModel, Limits, Motion, Pose, Skeleton, Transform};
+use dqhand::model::PoseBuffers;
+use dqhand::Error;
+use glam::{Affine3A, Quat, Vec3};
+use proptest::prelude::*;
+
+/// Paper eq. (1): the fingertip of a planar finger, x toward the palm, y along the finger.
+fn equation_1(l: [f32; 3], t: [f32; 3]) -> (f32, f32) {
+    let (a, b, c) = (t[0], t[0] + t[1], t[0] + t[1] + t[2]);
+    (l[2] * c.sin() + l[1] * b.sin() + l[0] * a.sin(), l[2] * c.cos() + l[1] * b.cos() + l[0] * a.cos())
+}
+
+/// A planar finger: MCP at the origin, bones along −Z, flexion about −X (the joint models'
+/// convention), so eq. (1)'s y is −Z and its x is −Y.
+fn finger(l: [f32; 3]) -> Skeleton {
+    let names = ["mcp", "pip", "dip", "tip"];
+    let joints = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| Joint {
+            name: (*n).into(),
+            parent: i.checked_sub(1),
+            rest: Transform::from_rotation_translation(Quat::IDENTITY, if i == 0 { Vec3::ZERO } else { Vec3::NEG_Z * l[i - 1] }),
+        })
+        .collect();
+    Skeleton::new(joints).unwrap()
+}
+
+fn tip_in_finger_plane(world: &[Affine3A], tip: usize) -> (f32, f32) {
+    let p = world[tip].translation;
+    (-p.y, -p.z)
+}
+
+proptest! {
+    #[test]
+    fn fingertip_matches_paper_equation_1(
+        l in (0.01f32..0.08, 0.01f32..0.05, 0.01f32..0.04),
+        t in (-0.5f32..1.6, 0.0f32..1.9, -0.2f32..1.6),
+    ) {
+        let (l, t) = ([l.0, l.1, l.2], [t.0, t.1, t.2]);
+        let skeleton = finger(l);
+        let mut locals = skeleton.rest_locals();
+        for (j, &angle) in t.iter().enumerate() {
+            locals[j].rotation = Quat::from_axis_angle(Vec3::NEG_X, angle);
+        }
+        let mut world = vec![Affine3A::IDENTITY; 4];
+        forward_kinematics(&skeleton, &locals, &mut world);
+        let (x, y) = tip_in_finger_plane(&world, 3);
+        let (ex, ey) = equation_1(l, t);
+        assert_close!(x, ex, 1e-5);
+        assert_close!(y, ey, 1e-5);
+    }
+
+    #[test]
+    fn built_in_index_finger_matches_equation_1(t in (0.0f32..1.5, 0.0f32..1.9, 0.0f32..1.5)) {
+        let model = build(&HandParams::default()).unwrap();
+        let rig = HandRig::new(&model.skeleton, JointModel::Paper).unwrap();
+        let names = ["index-finger-phalanx-proximal", "index-finger-phalanx-intermediate", "index-finger-phalanx-distal", "index-finger-tip"];
+        let idx: Vec<usize> = names.iter().map(|n| model.skeleton.find(n).unwrap()).collect();
+        let rest = model.skeleton.rest_world();
+        let l = [0, 1, 2].map(|i| Vec3::from(rest[idx[i + 1]].translation).distance(rest[idx[i]].translation.into()));
+        let mut pose = Pose::rest(JointModel::Paper.dof_count());
+        for (i, n) in names[..3].iter().enumerate() {
+            pose.angles[JointModel::Paper.dof_index(&format!("{n}.flex")).unwrap()] = [t.0, t.1, t.2][i];
+        }
+        let mut buffers = PoseBuffers::new(rig.skeleton());
+        rig.locals(&pose, Limits::Off, &mut buffers.locals);
+        buffers.evaluate(rig.skeleton(), model.mesh.inverse_bind());
+        // The tip in the MCP's rest frame, which is where eq. (1) is written.
+        let tip = rest[idx[0]].inverse().transform_point3(buffers.world[idx[3]].translation.into());
+        let (ex, ey) = equation_1(l, [t.0, t.1, t.2]);
+        assert_close!(-tip.y, ex, 1e-5);
+        assert_close!(-tip.z, ey, 1e-5);
+        assert_close!(tip.x, 0.0, 1e-5);
+    }
+}
+
+#[test]
+fn paper_model_has_table_1_dofs_and_full_adds_the_thumb() {
+    let paper: Vec<_> = JointModel::Paper.dofs().collect();
+    assert_eq!(paper.len(), 18);
+    // Table 1: TDIP 1, TPIP 1, DIP 4, PIP 4, MCP 2 × 4.
+    let count = |suffix: &str, m: Motion| paper.iter().filter(|d| d.bone.ends_with(suffix) && d.motion == m).count();
+    assert_eq!(count("phalanx-distal", Motion::Flex), 5);
+    assert_eq!(count("phalanx-intermediate", Motion::Flex), 4);
+    assert_eq!(count("phalanx-proximal", Motion::Flex), 5);
+    assert_eq!(count("phalanx-proximal", Motion::Abd), 4);
+    assert!(paper.iter().all(|d| !d.bone.ends_with("metacarpal")), "palm joints and thumb root are fixed");
+    assert_eq!(JointModel::Full.dof_count(), 23);
+    assert!(JointModel::Full.dof_index("thumb-metacarpal.flex").is_ok());
+    assert!(JointModel::Full.dof_index("thumb-metacarpal.abd").is_ok());
+    for d in JointModel::Full.dofs() {
+        assert!(d.min_deg < d.max_deg && d.min_deg <= 0.0 && d.max_deg > 0.0, "{} range", d.name());
+    }
+    match JointModel::Paper.dof_index("thumb-metacarpal.flex") {
+        Err(Error::UnknownName { valid, .. }) => assert!(valid.contains("index-finger-phalanx-proximal.abd")),
+        other => panic!("expected UnknownName, got {other:?}"),
+    }
+}
+
+#[test]
+fn limits_clamp_by_default_and_can_be_switched_off() {
+    let model = build(&HandParams::default()).unwrap();
+    let rig = HandRig::new(&model.skeleton, JointModel::Paper).unwrap();
+    let pip = JointModel::Paper.dof_index("index-finger-phalanx-intermediate.flex").unwrap();
+    let mut pose = Pose::rest(18);
+    pose.angles[pip] = 150f32.to_radians();
+    let mut clamped = pose.clone();
+    assert_eq!(rig.clamp(&mut clamped), vec![pip]);
+    assert_close!(clamped.angles[pip], 110f32.to_radians(), 1e-6);
+    let locals = |limits| {
+        let mut l = model.skeleton.rest_locals();
+        rig.locals(&pose, limits, &mut l);
+        l
+    };
+    let j = model.skeleton.find("index-finger-phalanx-intermediate").unwrap();
+    let angle = |l: &[Transform]| (model.skeleton.joints()[j].rest.rotation.inverse() * l[j].rotation).angle_between(Quat::IDENTITY);
+    assert_close!(angle(&locals(Limits::Anatomical)), 110f32.to_radians(), 1e-4);
+    assert_close!(angle(&locals(Limits::Off)), 150f32.to_radians(), 1e-4);
+}
+
+#[test]
+fn flexion_curls_toward_the_palm_and_abduction_spreads_on_both_sides() {
+    for side in [Side::Left, Side::Right] {
+        let model = build(&HandParams { side, ..HandParams::default() }).unwrap();
+        let rig = HandRig::new(&model.skeleton, JointModel::Full).unwrap();
+        let tips = |pose: &Pose| {
+            let mut b = PoseBuffers::new(rig.skeleton());
+            rig.locals(pose, Limits::Anatomical, &mut b.locals);
+            b.evaluate(rig.skeleton(), model.mesh.inverse_bind());
+            let at = |n: &str| Vec3::from(b.world[model.skeleton.find(n).unwrap()].translation);
+            (at("index-finger-tip"), at("middle-finger-tip"), at("pinky-finger-tip"), at("ring-finger-tip"))
+        };
+        let rest = tips(&Pose::rest(23));
+        let mut pose = Pose::rest(23);
+        pose.angles[JointModel::Full.dof_index("index-finger-phalanx-intermediate.flex").unwrap()] = 1.0;
+        pose.angles[JointModel::Full.dof_index("index-finger-phalanx-proximal.abd").unwrap()] = 0.3;
+        pose.angles[JointModel::Full.dof_index("pinky-finger-phalanx-proximal.abd").unwrap()] = 0.3;
+        let moved = tips(&pose);
+        // Palm down (+Y dorsal): flexion moves the index tip down.
+        assert!(moved.0.y < rest.0.y - 0.01, "{side:?}: index tip {:?} -> {:?}", rest.0, moved.0);
+        assert!(moved.0.distance(moved.1) > rest.0.distance(rest.1), "{side:?}: index spreads from middle");
+        assert!(moved.2.distance(moved.3) > rest.2.distance(rest.3), "{side:?}: pinky spreads from ring");
+        assert_eq!(moved.1, rest.1, "{side:?}: the middle finger does not move");
+    }
+}
+
+#[test]
+fn wrist_pose_places_the_hand() {
+    let model = build(&HandParams::default()).unwrap();
+    let rig = HandRig::new(&model.skeleton, JointModel::Paper).unwrap();
+    let wrist = dqhand::math::DualQuat::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.1, 1.2, -0.3));
+    let mut b = PoseBuffers::new(rig.skeleton());
+    rig.locals(&Pose { wrist: Some(wrist), angles: vec![0.0; 18] }, Limits::Anatomical, &mut b.locals);
+    b.evaluate(rig.skeleton(), model.mesh.inverse_bind());
+    let rest = model.skeleton.rest_world();
+    for (j, w) in b.world.iter().enumerate() {
+        assert_close!(Vec3::from(w.translation), wrist.transform_point3(rest[j].translation.into()), 1e-5);
+    }
+}
+
+#[test]
+fn reparenting_keeps_rest_world_transforms() {
+    let model = build(&HandParams::default()).unwrap();
+    let flat = model.skeleton.reparented(|n| (n != "wrist").then_some("wrist")).unwrap();
+    assert!(flat.joints().iter().skip(1).all(|j| j.parent == Some(0)));
+    for (a, b) in flat.rest_world().iter().zip(model.skeleton.rest_world()) {
+        assert!(a.abs_diff_eq(b, 1e-5));
+    }
+    let back = flat.reparented(dqhand::kinematics::webxr::anatomical_parent).unwrap();
+    assert_eq!(back.joints().iter().map(|j| j.parent).collect::<Vec<_>>(), model.skeleton.joints().iter().map(|j| j.parent).collect::<Vec<_>>());
+}
+
+#[test]
+fn malformed_skeletons_are_rejected() {
+    let j = |name: &str, parent| Joint { name: name.into(), parent, rest: Transform::IDENTITY };
+    let err = |joints| Skeleton::new(joints).unwrap_err().to_string();
+    assert!(err(vec![j("a", None), j("a", Some(0))]).contains("\"a\" is used twice"));
+    assert!(err(vec![j("a", Some(1)), j("b", Some(0))]).contains("cycle"));
+    assert!(err(vec![j("a", Some(7))]).contains("invalid parent"));
+    let mut nan = j("n", None);
+    nan.rest.translation.x = f32::NAN;
+    assert!(err(vec![nan]).contains("non-finite"));
+    assert!(HandRig::new(&finger([0.1; 3]), JointModel::Paper).unwrap_err().to_string().contains("wrist"));
+}

@@ -1,0 +1,50 @@
+//! Shared test helpers.
+#![allow(dead_code)]
+
+use glam::{Quat, Vec3};
+use proptest::prelude::*;
+
+/// Asserts `|a - b| <= tol` for anything with a distance, printing both values, the
+/// tolerance and the difference.
+#[macro_export]
+macro_rules! assert_close {
+    ($a:expr, $b:expr, $tol:expr) => {{
+        let (a, b, tol) = ($a, $b, $tol);
+        let d = $crate::support::Distance::distance(&a, &b);
+        assert!(d <= tol, "assert_close failed:\n  left:  {:?}\n  right: {:?}\n  tolerance {} < difference {}", a, b, tol, d);
+    }};
+}
+
+/// Distance between two values of the same kind.
+pub trait Distance {
+    fn distance(&self, other: &Self) -> f32;
+}
+
+impl Distance for f32 {
+    fn distance(&self, other: &Self) -> f32 {
+        (self - other).abs()
+    }
+}
+
+impl Distance for Vec3 {
+    fn distance(&self, other: &Self) -> f32 {
+        (*self - *other).length()
+    }
+}
+
+impl Distance for [f32; 3] {
+    fn distance(&self, other: &Self) -> f32 {
+        Vec3::from(*self).distance(Vec3::from(*other))
+    }
+}
+
+pub fn vec3(range: f32) -> impl Strategy<Value = Vec3> {
+    (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Uniformly distributed-enough unit quaternions (axis on the sphere, any angle).
+pub fn rotation() -> impl Strategy<Value = Quat> {
+    (vec3(1.0), -3.1f32..3.1).prop_filter_map("axis too short", |(axis, angle)| {
+        (axis.length() > 0.1).then(|| Quat::from_axis_angle(axis.normalize(), angle))
+    })
+}
