@@ -110,10 +110,10 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     let mut out = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
     let mut b = [[0.0f32; LANES]; W];
     let (all_js, all_ws) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0);
-    for base in (0..padded).step_by(LANES) {
+    for (base, &kc) in (0..padded).step_by(LANES).zip(&mesh.chunk_influences) {
         let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
         let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
-        blend::<W, K, AVX>(frame, B::ALIGN, js, ws, &mut b);
+        blend::<W, K, AVX>(frame, B::ALIGN, usize::from(kc), js, ws, &mut b);
         for c in 0..3 {
             rest.p[c] = lanes(&mesh.pos[c], base);
             rest.n[c] = lanes(&mesh.nrm[c], base);
@@ -126,24 +126,25 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     }
 }
 
-/// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]`.
+/// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]` over the
+/// first `kc` influence slots (the chunk's largest influence count).
 ///
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, js: &[[u16; K]; LANES], ws: &[[f32; K]; LANES], b: &mut [Lanes; W]) {
+fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, kc: usize, js: &[[u16; K]; LANES], ws: &[[f32; K]; LANES], b: &mut [Lanes; W]) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
         // joint indices are in bounds (see `chunks`).
-        unsafe { avx2::blend::<W, K>(frame, align, js, ws, b) };
+        unsafe { avx2::blend::<W, K>(frame, align, kc, js, ws, b) };
         return;
     }
     let joints = frame.params.len();
     let mut acc = [[0.0f32; W]; LANES];
     for (l, acc) in acc.iter_mut().enumerate() {
         let h = usize::from(js[l][0]) * joints;
-        for k in 0..K {
+        for k in 0..kc.min(K) {
             let j = usize::from(js[l][k]);
             let w = if align { ws[l][k] * frame.signs[h + j] } else { ws[l][k] };
             let p = &frame.params[j];
@@ -192,6 +193,7 @@ mod avx2 {
     pub(super) unsafe fn blend<const W: usize, const K: usize>(
         frame: &Frame<'_, W>,
         align: bool,
+        kc: usize,
         js: &[[u16; K]; LANES],
         ws: &[[f32; K]; LANES],
         b: &mut [Lanes; W],
@@ -201,7 +203,7 @@ mod avx2 {
         let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
         for l in 0..LANES {
             let h = usize::from(js[l][0]) * joints;
-            for k in 0..K {
+            for k in 0..kc.min(K) {
                 let j = usize::from(js[l][k]);
                 let mut w = ws[l][k];
                 if align {

@@ -57,6 +57,9 @@ pub struct SkinnedMesh {
     pub(crate) k: usize,
     pub(crate) joints: Vec<u16>,
     pub(crate) weights: Vec<f32>,
+    /// Per chunk of [`LANES`] vertices, the most non-zero influences of any of its vertices:
+    /// the blend loop stops there (weights are sorted, so the rest are zero).
+    pub(crate) chunk_influences: Vec<u8>,
     max_influences: usize,
     uvs: Vec<[f32; 2]>,
     indices: Vec<u32>,
@@ -163,6 +166,10 @@ impl SkinnedMesh {
             weights[v * k] = 1.0;
         }
 
+        let chunk_influences = slots
+            .chunks(LANES)
+            .map(|c| c.iter().map(Vec::len).max().unwrap_or(1) as u8)
+            .collect();
         let normals = if data.normals.is_empty() {
             vertex_normals(&data.positions, &data.indices)
         } else {
@@ -185,6 +192,7 @@ impl SkinnedMesh {
             k,
             joints,
             weights,
+            chunk_influences,
             max_influences,
             uvs: data.uvs,
             indices: data.indices,
