@@ -7,15 +7,15 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum Error {
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{}: {reason}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The operating system's reason.
-        source: std::io::Error,
+        /// The operating system's reason (part of the message, so not also a `source`).
+        reason: std::io::Error,
     },
     /// A file was read but its content is malformed or unsupported.
-    #[error("{path}: {message}")]
+    #[error("{}: {message}", path.display())]
     File {
         /// The file.
         path: PathBuf,
@@ -38,6 +38,11 @@ pub enum Error {
 }
 
 impl Error {
+    /// A function that wraps an I/O error on `path` (for `map_err`).
+    pub fn io(path: &std::path::Path) -> impl Fn(std::io::Error) -> Self + '_ {
+        move |reason| Error::Io { path: path.into(), reason }
+    }
+
     /// Attaches a file path to an `Invalid` error so that the message names the input.
     #[must_use]
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {

@@ -11,6 +11,8 @@ use std::path::Path;
 
 use base64::Engine as _;
 use glam::{Affine3A, Mat4, Quat, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::Semantic;
 
 use crate::kinematics::{Joint, Skeleton, Transform};
 use crate::model::Model;
@@ -23,12 +25,18 @@ use crate::{Error, Result};
 /// [`Error::Io`] if the file cannot be read, [`Error::File`] naming the file and the problem
 /// for anything malformed or unsupported (see the module docs).
 pub fn load_gltf(path: &Path) -> Result<Model> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.into(), source })?;
+    let bytes = std::fs::read(path).map_err(Error::io(path))?;
     load_gltf_bytes(&bytes, path).map_err(|e| e.in_file(path))
 }
 
 fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
     let bad = |m: String| Error::Invalid(m);
+    if bytes.len() >= 12 && &bytes[..4] == b"glTF" {
+        let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        if declared > bytes.len() {
+            return Err(bad(format!("truncated GLB: {} bytes of the declared {declared}", bytes.len())));
+        }
+    }
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(&gltf, path)?;
     for accessor in gltf.accessors() {
@@ -78,6 +86,7 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
 
     let skin_joints: Vec<usize> = skin.joints().map(|n| node_to_joint[&n.index()]).collect();
     let mut inverse_bind = vec![Affine3A::IDENTITY; skeleton.len()];
+    check_kind(skin.inverse_bind_matrices(), &format!("skin {} inverse bind matrix", skin.index()), Dimensions::Mat4, &[DataType::F32])?;
     if let Some(ibm) = skin.reader(get).read_inverse_bind_matrices() {
         let ibm: Vec<[[f32; 4]; 4]> = ibm.collect();
         if ibm.len() != skin_joints.len() {
@@ -111,6 +120,20 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
     }
     for (name, prim) in &primitives {
         let where_ = format!("mesh {name:?} primitive {}", prim.index());
+        let (f32_only, uv_types, small_uint) = (&[DataType::F32][..], &[DataType::F32, DataType::U8, DataType::U16][..], &[DataType::U8, DataType::U16][..]);
+        let mut kinds = vec![
+            (Semantic::Positions, "POSITION", Dimensions::Vec3, f32_only),
+            (Semantic::Normals, "NORMAL", Dimensions::Vec3, f32_only),
+            (Semantic::TexCoords(0), "TEXCOORD_0", Dimensions::Vec2, uv_types),
+        ];
+        for set in 0..stride as u32 / 4 {
+            kinds.push((Semantic::Joints(set), if set == 0 { "JOINTS_0" } else { "JOINTS_1" }, Dimensions::Vec4, small_uint));
+            kinds.push((Semantic::Weights(set), if set == 0 { "WEIGHTS_0" } else { "WEIGHTS_1" }, Dimensions::Vec4, uv_types));
+        }
+        for (semantic, label, dims, types) in kinds {
+            check_kind(prim.get(&semantic), &format!("{where_} {label}"), dims, types)?;
+        }
+        check_kind(prim.indices(), &format!("{where_} index"), Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32])?;
         let reader = prim.reader(get);
         let positions: Vec<[f32; 3]> =
             reader.read_positions().ok_or_else(|| bad(format!("{where_} has no POSITION accessor")))?.collect();
@@ -224,20 +247,39 @@ fn check_accessor(a: &gltf::Accessor<'_>, buffers: &[Vec<u8>]) -> std::result::R
     }
     let view = a.view().ok_or_else(|| format!("accessor {i} has no buffer view"))?;
     let buffer = &buffers[view.buffer().index()];
-    if view.offset() + view.length() > buffer.len() {
+    if view.offset().checked_add(view.length()).is_none_or(|end| end > buffer.len()) {
         return Err(format!(
             "buffer view {} (bytes {}..{}) reaches past the end of buffer {} ({} bytes)",
             view.index(),
             view.offset(),
-            view.offset() + view.length(),
+            view.offset().saturating_add(view.length()),
             view.buffer().index(),
             buffer.len()
         ));
     }
     let elem = a.dimensions().multiplicity() * a.data_type().size();
     let stride = view.stride().unwrap_or(elem);
-    if a.count() > 0 && a.offset() + stride * (a.count() - 1) + elem > view.length() {
-        return Err(format!("accessor {i} ({} elements) reaches past the end of buffer view {}", a.count(), view.index()));
+    let end = (a.count().checked_sub(1))
+        .and_then(|last| stride.checked_mul(last))
+        .and_then(|x| x.checked_add(a.offset()))
+        .and_then(|x| x.checked_add(elem));
+    match end {
+        None if a.count() == 0 => Err(format!("accessor {i} has no elements")),
+        Some(end) if end <= view.length() => Ok(()),
+        _ => Err(format!("accessor {i} ({} elements) reaches past the end of buffer view {}", a.count(), view.index())),
     }
-    Ok(())
+}
+
+/// Checks that an accessor has the element type glTF prescribes for its use, since reading
+/// one of another type is not supported by the `gltf` crate's readers.
+fn check_kind(a: Option<gltf::Accessor<'_>>, what: &str, dims: Dimensions, types: &[DataType]) -> Result<()> {
+    match a {
+        Some(a) if a.dimensions() != dims || !types.contains(&a.data_type()) => Err(Error::Invalid(format!(
+            "{what} accessor {} is {:?} {:?}; expected {dims:?} of {types:?}",
+            a.index(),
+            a.dimensions(),
+            a.data_type()
+        ))),
+        _ => Ok(()),
+    }
 }

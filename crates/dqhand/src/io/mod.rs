@@ -55,10 +55,10 @@ fn check_lengths(positions: &[[f32; 3]], normals: &[[f32; 3]], indices: &[u32]) 
 
 /// Creates a file, returning it and a function that names the file in a later write error.
 fn create(path: &Path) -> Result<(std::fs::File, impl Fn(std::io::Error) -> Error + '_)> {
-    let file = std::fs::File::create(path).map_err(|source| Error::Io { path: path.into(), source })?;
-    Ok((file, move |source| Error::Io { path: path.into(), source }))
+    let file = std::fs::File::create(path).map_err(Error::io(path))?;
+    Ok((file, Error::io(path)))
 }
 
 fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).map_err(|source| Error::Io { path: path.into(), source })
+    std::fs::write(path, bytes).map_err(Error::io(path))
 }

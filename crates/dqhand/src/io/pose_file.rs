@@ -77,7 +77,7 @@ impl PoseFile {
     /// # Errors
     /// [`Error::Io`] or [`Error::File`] naming the file and the problem.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.into(), source })?;
+        let text = std::fs::read_to_string(path).map_err(Error::io(path))?;
         serde_json::from_str(&text).map_err(|e| Error::File { path: path.into(), message: format!("not a valid pose file: {e}") })
     }
 

@@ -201,13 +201,13 @@ mod avx2 {
         const { assert!(W == 8 || W == 16) };
         let joints = frame.params.len();
         let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
-        for l in 0..LANES {
-            let h = usize::from(js[l][0]) * joints;
-            for k in 0..kc.min(K) {
+        // Influence-major, lanes unrolled: the accumulators stay in registers.
+        for k in 0..kc.min(K) {
+            for l in 0..LANES {
                 let j = usize::from(js[l][k]);
                 let mut w = ws[l][k];
                 if align {
-                    w *= *frame.signs.get_unchecked(h + j);
+                    w *= *frame.signs.get_unchecked(usize::from(js[l][0]) * joints + j);
                 }
                 let wv = _mm256_set1_ps(w);
                 let p = frame.params.get_unchecked(j).as_ptr();

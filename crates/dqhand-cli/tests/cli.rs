@@ -1,0 +1,269 @@
+//! The `dqhand` command run as a user runs it: help, info, skin, bench, demo and bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::{json, Value};
+
+/// A fresh, empty directory for one test.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dqhand-cli-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+/// Runs `dqhand` with `args`.
+fn dqhand<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dqhand")).args(args).output().expect("run dqhand")
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts that the command exited with `code`, showing its output if not.
+#[track_caller]
+fn assert_exit(out: &Output, code: i32) {
+    assert_eq!(out.status.code(), Some(code), "exit status {:?}\nstdout:\n{}\nstderr:\n{}", out.status, stdout(out), stderr(out));
+}
+
+/// Runs `dqhand` expecting success; returns stdout.
+#[track_caller]
+fn run_ok<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> String {
+    let out = dqhand(args);
+    assert_exit(&out, 0);
+    stdout(&out)
+}
+
+/// Runs `dqhand` expecting a failure of the command (exit 1) reported as one line
+/// `dqhand: error: …` on stderr; returns that line.
+#[track_caller]
+fn run_error<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> String {
+    let out = dqhand(args);
+    assert_exit(&out, 1);
+    let err = stderr(&out);
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one line on stderr, got:\n{err}");
+    assert!(lines[0].starts_with("dqhand: error:"), "{err}");
+    lines[0].to_owned()
+}
+
+fn write_json(path: &Path, value: &Value) {
+    std::fs::write(path, serde_json::to_string_pretty(value).unwrap()).expect("write JSON");
+}
+
+fn path_arg(path: &Path) -> String {
+    path.to_str().expect("UTF-8 temp path").to_owned()
+}
+
+const BUILTIN_VERTICES: usize = 8668;
+
+// ---------------------------------------------------------------------------------------------
+// Help
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn help_works_for_every_command() {
+    let top = run_ok(&["--help"]);
+    for sub in ["info", "skin", "bench", "demo"] {
+        assert!(top.contains(sub), "top-level help does not list {sub}:\n{top}");
+        let help = run_ok(&[sub, "--help"]);
+        assert!(help.contains("Usage"), "`dqhand {sub} --help`:\n{help}");
+    }
+    let skin = run_ok(&["skin", "--help"]);
+    for option in ["--mesh", "--pose", "--method", "--out", "--no-limits"] {
+        assert!(skin.contains(option), "`dqhand skin --help` lacks {option}:\n{skin}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// info
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn info_builtin_describes_the_placeholder_hand() {
+    let out = run_ok(&["info", "builtin"]);
+    assert!(out.contains(&BUILTIN_VERTICES.to_string()), "no vertex count {BUILTIN_VERTICES}:\n{out}");
+    assert!(out.contains("placeholder"), "{out}");
+    for joint in dqhand::kinematics::webxr::JOINT_NAMES {
+        assert!(out.contains(joint), "joint {joint} not listed:\n{out}");
+    }
+}
+
+#[test]
+fn info_reads_an_exported_glb() {
+    let dir = temp_dir("info-glb");
+    let hand = dir.join("hand.glb");
+    dqhand::io::write_skinned_glb(&dqhand::hand::build(&Default::default()).unwrap(), &hand).unwrap();
+    let out = run_ok(&["info", &path_arg(&hand)]);
+    assert!(out.contains("hand.glb") && out.contains(&BUILTIN_VERTICES.to_string()), "{out}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// skin
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn skin_writes_every_method_and_format() {
+    let dir = temp_dir("skin");
+    let pose = dir.join("pose.json");
+    write_json(&pose, &json!({ "angles_deg": { "index-finger-phalanx-intermediate.flex": 90, "thumb-metacarpal.flex": 20 } }));
+    for method in ["lb", "qb", "dqb"] {
+        for ext in ["ply", "obj", "glb"] {
+            let out = dir.join(format!("hand-{method}.{ext}"));
+            let printed = run_ok(&["skin", "--mesh", "builtin", "--pose", &path_arg(&pose), "--method", method, "--out", &path_arg(&out)]);
+            assert!(printed.contains(&BUILTIN_VERTICES.to_string()), "{printed}");
+            let size = std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0);
+            assert!(size > 0, "{} not written", out.display());
+        }
+    }
+}
+
+#[test]
+fn skin_accepts_no_limits() {
+    let dir = temp_dir("skin-no-limits");
+    let pose = dir.join("pose.json");
+    write_json(&pose, &json!({ "angles_deg": { "index-finger-phalanx-intermediate.flex": 150 } }));
+    let (clamped, free) = (dir.join("clamped.obj"), dir.join("free.obj"));
+
+    let out = dqhand(&["skin", "--pose", &path_arg(&pose), "--out", &path_arg(&clamped)]);
+    assert_exit(&out, 0);
+    assert!(stderr(&out).contains("clamped"), "no clamping warning:\n{}", stderr(&out));
+
+    let out = dqhand(&["skin", "--pose", &path_arg(&pose), "--no-limits", "--out", &path_arg(&free)]);
+    assert_exit(&out, 0);
+    assert!(!stderr(&out).contains("clamped"), "{}", stderr(&out));
+    assert_ne!(std::fs::read(&clamped).unwrap(), std::fs::read(&free).unwrap(), "--no-limits made no difference");
+}
+
+#[test]
+fn skin_without_pose_writes_the_rest_pose() {
+    let out = temp_dir("skin-rest").join("rest.ply");
+    run_ok(&["skin", "--out", &path_arg(&out)]);
+    assert!(out.is_file());
+}
+
+// ---------------------------------------------------------------------------------------------
+// bench
+// ---------------------------------------------------------------------------------------------
+
+fn positive_number(report: &Value, pointer: &str) -> f64 {
+    let x = report.pointer(pointer).and_then(Value::as_f64).unwrap_or_else(|| panic!("no number at {pointer} in {report}"));
+    assert!(x.is_finite() && x > 0.0, "{pointer} = {x} is not positive and finite");
+    x
+}
+
+#[test]
+fn bench_json_reports_every_method() {
+    let out = run_ok(&["bench", "--frames", "30", "--json"]);
+    let lines: Vec<&str> = out.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one JSON line:\n{out}");
+    let report: Value = serde_json::from_str(lines[0]).expect("a JSON object");
+    assert_eq!(report["mesh"], "builtin");
+    assert_eq!(report["vertices"], BUILTIN_VERTICES);
+    assert_eq!(report["bones"], 20);
+    for method in ["lb", "qb", "dqb"] {
+        positive_number(&report, &format!("/methods/{method}/us_per_frame"));
+        positive_number(&report, &format!("/methods/{method}/fps"));
+    }
+    positive_number(&report, "/ratios/dqb_over_lb");
+    positive_number(&report, "/ratios/dqb_over_qb");
+}
+
+// ---------------------------------------------------------------------------------------------
+// demo
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn demo_writes_the_hand_and_every_gesture() {
+    let dir = temp_dir("demo");
+    run_ok(&["demo", "--out", &path_arg(&dir)]);
+    assert!(dir.join("hand.glb").is_file(), "hand.glb missing");
+    let gestures = dqhand::gesture::GESTURES;
+    assert!(!gestures.is_empty());
+    for (i, g) in gestures.iter().enumerate() {
+        let stem = format!("{i:02}-{}", g.name);
+        for suffix in ["pose.json", "lb.glb", "qb.glb", "dqb.glb"] {
+            let file = dir.join(format!("{stem}.{suffix}"));
+            assert!(file.is_file(), "{} missing", file.display());
+        }
+    }
+    // The rigged hand it writes loads back.
+    let model = dqhand::io::load_gltf(&dir.join("hand.glb")).expect("demo's hand.glb loads");
+    assert_eq!(model.mesh.vertex_count(), BUILTIN_VERTICES);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn info_missing_file_is_a_one_line_error() {
+    let line = run_error(&["info", "/nonexistent.glb"]);
+    assert!(line.contains("/nonexistent.glb"), "{line}");
+}
+
+#[test]
+fn io_error_reason_is_printed_once() {
+    let line = run_error(&["info", "/nonexistent.glb"]);
+    assert_eq!(line.matches("(os error").count(), 1, "{line}");
+}
+
+#[test]
+fn info_truncated_glb_is_a_one_line_error() {
+    let dir = temp_dir("info-truncated");
+    let hand = dir.join("truncated-hand.glb");
+    dqhand::io::write_skinned_glb(&dqhand::hand::build(&Default::default()).unwrap(), &hand).unwrap();
+    let bytes = std::fs::read(&hand).unwrap();
+    std::fs::write(&hand, &bytes[..bytes.len() / 2]).unwrap();
+    let line = run_error(&["info", &path_arg(&hand)]);
+    assert!(line.contains("truncated-hand.glb"), "{line}");
+}
+
+#[test]
+fn skin_unknown_dof_lists_valid_names() {
+    let dir = temp_dir("skin-unknown-dof");
+    let pose = dir.join("typo.pose.json");
+    write_json(&pose, &json!({ "angles_deg": { "index-finger-knuckle.flex": 30 } }));
+    let line = run_error(&["skin", "--pose", &path_arg(&pose), "--out", &path_arg(&dir.join("x.ply"))]);
+    for part in ["typo.pose.json", "index-finger-knuckle.flex", "valid", "index-finger-phalanx-proximal.flex"] {
+        assert!(line.contains(part), "{part:?} not in {line}");
+    }
+    assert!(!dir.join("x.ply").exists());
+}
+
+#[test]
+fn skin_invalid_pose_json_names_the_file() {
+    let dir = temp_dir("skin-bad-json");
+    let pose = dir.join("broken.pose.json");
+    std::fs::write(&pose, "{ \"angles_deg\": ").unwrap();
+    let line = run_error(&["skin", "--pose", &path_arg(&pose), "--out", &path_arg(&dir.join("x.ply"))]);
+    assert!(line.contains("broken.pose.json"), "{line}");
+}
+
+#[test]
+fn skin_unknown_output_format_is_an_error() {
+    let out = temp_dir("skin-bad-ext").join("hand.stl");
+    let line = run_error(&["skin", "--out", &path_arg(&out)]);
+    assert!(line.contains("hand.stl"), "{line}");
+}
+
+#[test]
+fn unknown_method_is_a_usage_error() {
+    let out = temp_dir("skin-bad-method").join("x.ply");
+    let result = dqhand(&["skin", "--method", "foo", "--out", &path_arg(&out)]);
+    assert_exit(&result, 2);
+    assert!(stderr(&result).contains("foo"), "{}", stderr(&result));
+    assert!(!out.exists());
+}
+
+#[test]
+fn unknown_subcommand_is_a_usage_error() {
+    assert_exit(&dqhand(&["frobnicate"]), 2);
+    assert_exit(&dqhand::<&str>(&[]), 2);
+}
