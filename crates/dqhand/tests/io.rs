@@ -697,3 +697,30 @@ fn angle_beyond_limits_is_clamped_only_with_anatomical_limits() {
     assert!(free_warnings.is_empty(), "{free_warnings:?}");
     assert!(max_moved(&free, &clamped, &all) > 0.005, "Limits::Off clamped the angle");
 }
+
+#[test]
+fn several_meshes_and_primitives_are_concatenated_in_file_order() {
+    // The minimal quad with its primitive listed twice, plus a second mesh node on the same
+    // skin: 3 primitives of 4 vertices, kept in file order.
+    let path = faulty_gltf("multi-primitive", Fault::None);
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let primitive = doc["meshes"][0]["primitives"][0].clone();
+    doc["meshes"][0]["primitives"].as_array_mut().unwrap().push(primitive.clone());
+    doc["meshes"].as_array_mut().unwrap().push(json!({ "name": "second", "primitives": [primitive] }));
+    doc["nodes"].as_array_mut().unwrap().push(json!({ "name": "quad2", "mesh": 1, "skin": 0 }));
+    doc["scenes"][0]["nodes"].as_array_mut().unwrap().push(json!(3));
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+
+    let model = io::load_gltf(&path).unwrap();
+    let single = io::load_gltf(&faulty_gltf("single-primitive", Fault::None)).unwrap();
+    assert_eq!(model.mesh.vertex_count(), 12);
+    assert_eq!(model.mesh.triangle_count(), 6);
+    let parts: Vec<_> = model.mesh.parts().iter().map(|p| (p.name.as_str(), p.vertices.clone(), p.indices.clone())).collect();
+    assert_eq!(parts, vec![("quad", 0..4, 0..6), ("quad", 4..8, 6..12), ("second", 8..12, 12..18)]);
+    for v in 0..12 {
+        assert_eq!(model.mesh.position(v), single.mesh.position(v % 4));
+        assert_eq!(influences(&model, v), influences(&single, v % 4));
+    }
+    // Each primitive's indices are offset to its own vertices.
+    assert_eq!(&model.mesh.indices()[12..18], &[8, 9, 10, 8, 10, 11]);
+}

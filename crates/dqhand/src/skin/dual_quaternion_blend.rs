@@ -2,13 +2,15 @@
 //!
 //! Paper eq. (3)/(4): `b̂ = Σ wᵢ q̂ᵢ`, each `q̂ᵢ` first sign-aligned to the heaviest
 //! influence (Kavan et al. 2008, "Geometric skinning with approximate dual quaternion
-//! blending", ACM TOG 27:105), then divided by `‖b₀‖` — always, as the paper insists, since
+//! blending", ACM TOG 27:105), then normalised by `‖b₀‖` — always, as the paper insists, since
 //! only the normalised blend is a rigid transform free of collapse and candy wrapper.
-//! Positions by eq. (5), normals by eq. (6).
+//! Positions by eq. (5), normals by eq. (6). Both are quadratic in `b̂`, so the kernel
+//! divides their rotation and translation terms by `‖b₀‖²` once instead of dividing `b̂` by
+//! `‖b₀‖`: the same result without a square root.
 
 use glam::Affine3A;
 
-use super::kernel::{inv_len, rotate, Blend, Chunk, Lanes};
+use super::kernel::{recip, rotate, Blend, Chunk, Lanes};
 use super::skinned_mesh::LANES;
 use crate::math::DualQuat;
 
@@ -28,17 +30,19 @@ impl Blend<W> for Dqb {
     #[inline(always)]
     fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
         for l in 0..LANES {
-            let s = inv_len(b[0][l] * b[0][l] + b[1][l] * b[1][l] + b[2][l] * b[2][l] + b[3][l] * b[3][l]);
-            let (x, y, z, a0) = (b[0][l] * s, b[1][l] * s, b[2][l] * s, b[3][l] * s);
-            let (ex, ey, ez, ae) = (b[4][l] * s, b[5][l] * s, b[6][l] * s, b[7][l] * s);
+            let (x, y, z, a0) = (b[0][l], b[1][l], b[2][l], b[3][l]);
+            let (ex, ey, ez, ae) = (b[4][l], b[5][l], b[6][l], b[7][l]);
+            // Eq. (5) is quadratic in b̂, so dividing once by ‖b₀‖² normalises it exactly.
+            let inv_sq = recip(x * x + y * y + z * z + a0 * a0);
+            let k = 2.0 * inv_sq;
             // Eq. (5): translation 2(a₀ d_ε − a_ε d₀ + d₀ × d_ε).
             let t = [
-                2.0 * (a0 * ex - ae * x + (y * ez - z * ey)),
-                2.0 * (a0 * ey - ae * y + (z * ex - x * ez)),
-                2.0 * (a0 * ez - ae * z + (x * ey - y * ex)),
+                k * (a0 * ex - ae * x + (y * ez - z * ey)),
+                k * (a0 * ey - ae * y + (z * ex - x * ez)),
+                k * (a0 * ez - ae * z + (x * ey - y * ex)),
             ];
-            let p = rotate([x, y, z, a0], [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
-            let n = rotate([x, y, z, a0], [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            let p = rotate([x, y, z, a0], inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let n = rotate([x, y, z, a0], inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + t[i];
                 out.n[i][l] = n[i];

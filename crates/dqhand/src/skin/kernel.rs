@@ -160,17 +160,25 @@ fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, 
     }
 }
 
-/// Rotates `v` by the unit quaternion `(x, y, z, w)` lane-wise: `v + 2d × (d × v + w v)`,
-/// the rotation part of paper eq. (5) and all of eq. (6).
+/// Rotates `v` by the quaternion `q = (x, y, z, w)` of squared norm `1 / inv_sq`, lane-wise:
+/// `v + 2 d × (d × v + w v) / ‖q‖²` — the rotation part of paper eq. (5) and all of eq. (6)
+/// for the normalised `q / ‖q‖`, without a square root.
 #[inline(always)]
-pub(crate) fn rotate(q: [f32; 4], v: [f32; 3]) -> [f32; 3] {
+pub(crate) fn rotate(q: [f32; 4], inv_sq: f32, v: [f32; 3]) -> [f32; 3] {
     let [x, y, z, w] = q;
     let c1 = [y * v[2] - z * v[1] + w * v[0], z * v[0] - x * v[2] + w * v[1], x * v[1] - y * v[0] + w * v[2]];
+    let k = 2.0 * inv_sq;
     [
-        v[0] + 2.0 * (y * c1[2] - z * c1[1]),
-        v[1] + 2.0 * (z * c1[0] - x * c1[2]),
-        v[2] + 2.0 * (x * c1[1] - y * c1[0]),
+        v[0] + k * (y * c1[2] - z * c1[1]),
+        v[1] + k * (z * c1[0] - x * c1[2]),
+        v[2] + k * (x * c1[1] - y * c1[0]),
     ]
+}
+
+/// `1 / x` with a floor that keeps a degenerate (all-cancelling) blend finite.
+#[inline(always)]
+pub(crate) fn recip(sq: f32) -> f32 {
+    1.0 / sq.max(1e-30)
 }
 
 /// `1 / sqrt(x)` with a floor that keeps degenerate inputs finite.

@@ -6,7 +6,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{inv_len, rotate, Blend, Chunk, Lanes};
+use super::kernel::{recip, rotate, Blend, Chunk, Lanes};
 use super::skinned_mesh::LANES;
 use crate::math::DualQuat;
 
@@ -27,10 +27,10 @@ impl Blend<W> for Qb {
     #[inline(always)]
     fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
         for l in 0..LANES {
-            let s = inv_len(b[0][l] * b[0][l] + b[1][l] * b[1][l] + b[2][l] * b[2][l] + b[3][l] * b[3][l]);
-            let q = [b[0][l] * s, b[1][l] * s, b[2][l] * s, b[3][l] * s];
-            let p = rotate(q, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
-            let n = rotate(q, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
+            let inv_sq = recip(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+            let p = rotate(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let n = rotate(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + b[4 + i][l];
                 out.n[i][l] = n[i];
