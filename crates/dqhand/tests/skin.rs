@@ -255,6 +255,12 @@ fn malformed_meshes_are_rejected_with_the_culprit_named() {
     assert!(err(one_vertex([0.0; 3], vec![0], vec![-1.0], ok_ib.clone())).contains("invalid weight"));
     assert!(err(one_vertex([0.0; 3], vec![0], vec![1.0], vec![Affine3A::ZERO])).contains("not invertible"));
     assert!(err(one_vertex([0.0; 3], vec![0; 9], vec![0.1; 9], ok_ib.clone())).contains("9 influences"));
+    let mut uv = one_vertex([0.0; 3], vec![0], vec![1.0], ok_ib.clone());
+    uv.uvs = vec![[0.5, f32::NAN]];
+    assert!(err(uv).contains("vertex 0 has a non-finite texture coordinate"));
+    let mut normal = one_vertex([0.0; 3], vec![0], vec![1.0], ok_ib.clone());
+    normal.normals = vec![[0.0, f32::INFINITY, 0.0]];
+    assert!(err(normal).contains("vertex 0 has a non-finite normal"));
     let mut tri = one_vertex([0.0; 3], vec![0], vec![1.0], ok_ib.clone());
     tri.indices = vec![0, 0, 3];
     assert!(err(tri).contains("triangle 0 uses vertex 3"));

@@ -109,6 +109,9 @@ impl SkinnedMesh {
         if let Some(v) = data.normals.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
             return bad(format!("vertex {v} has a non-finite normal {:?}", data.normals[v]));
         }
+        if let Some(v) = data.uvs.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return bad(format!("vertex {v} has a non-finite texture coordinate {:?}", data.uvs[v]));
+        }
         for (j, m) in data.inverse_bind.iter().enumerate() {
             let det = m.matrix3.determinant();
             if !m.is_finite() || det.abs() < 1e-12 {
