@@ -25,6 +25,9 @@ pub struct Args {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Time the portable kernel even where the AVX2 + FMA one would run.
+    #[arg(long)]
+    portable: bool,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -35,7 +38,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let (animation, poses) = animation(&model)?;
     let mesh = &model.mesh;
-    let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, mesh.inverse_bind().len())).collect();
+    let mut deformers: Vec<Deformer> = Method::ALL
+        .iter()
+        .map(|&m| Deformer::new(m, mesh.inverse_bind().len()))
+        .map(|d| if args.portable { d.portable() } else { d })
+        .collect();
     let mut out = Deformed::new(mesh);
     let mut samples = vec![Vec::with_capacity(args.frames); 3];
     // Warm-up: caches, branch predictors, CPU frequency.
@@ -56,7 +63,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let stats: Vec<(f64, f64, f64)> = samples.iter_mut().map(|s| (percentile(s, 0.5), percentile(s, 0.1), percentile(s, 0.9))).collect();
     let median = |m: Method| stats[m as usize].0;
-    let simd = if cfg!(target_arch = "x86_64") && std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") { "avx2+fma" } else { "portable" };
+    let simd = if dqhand::skin::simd_available() && !args.portable { "avx2+fma" } else { "portable" };
     let methods: serde_json::Map<String, serde_json::Value> = Method::ALL
         .iter()
         .map(|&m| {
