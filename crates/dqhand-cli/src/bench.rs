@@ -40,7 +40,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mesh = &model.mesh;
     let mut deformers: Vec<Deformer> = Method::ALL
         .iter()
-        .map(|&m| Deformer::new(m, mesh.inverse_bind().len()))
+        .map(|&m| Deformer::new(m, mesh))
         .map(|d| if args.portable { d.portable() } else { d })
         .collect();
     let mut out = Deformed::new(mesh);

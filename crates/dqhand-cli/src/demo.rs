@@ -23,7 +23,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     dqhand::io::write_skinned_glb(&model, &rigged)?;
     println!("{}", model.description);
     println!("rigged, skinned hand: {}", rigged.display());
-    let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, model.skeleton.len())).collect();
+    let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, &model.mesh)).collect();
     let mut out = Deformed::new(&model.mesh);
     println!("{:<10} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs");
     for (i, g) in GESTURES.iter().enumerate() {

@@ -39,7 +39,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let (skinning, warnings) = model.pose_skinning(&target, limits).map_err(|e| e.in_file(&origin))?;
     crate::warn_all(&warnings);
     let mut out = Deformed::new(&model.mesh);
-    Deformer::new(args.method, skinning.len()).deform(&model.mesh, &skinning, &mut out);
+    Deformer::new(args.method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
     dqhand::io::write_posed(&args.out, out.positions(), out.normals(), model.mesh.uvs(), model.mesh.indices())?;
     println!(
         "wrote {} ({} vertices, {} triangles, {})",

@@ -45,7 +45,7 @@ fn pose_file(value: Value) -> PoseFile {
 fn deform_with(model: &Model, target: &PoseTarget, limits: Limits, method: Method) -> (Vec<[f32; 3]>, Vec<String>) {
     let (skinning, warnings) = model.pose_skinning(target, limits).expect("pose the model");
     let mut out = Deformed::new(&model.mesh);
-    Deformer::new(method, skinning.len()).deform(&model.mesh, &skinning, &mut out);
+    Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
     (out.positions().to_vec(), warnings)
 }
 

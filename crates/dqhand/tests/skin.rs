@@ -14,7 +14,7 @@ use support::{rotation, vec3};
 
 fn deform(method: Method, mesh: &SkinnedMesh, skinning: &[Affine3A]) -> Deformed {
     let mut out = Deformed::new(mesh);
-    Deformer::new(method, skinning.len()).deform(mesh, skinning, &mut out);
+    Deformer::new(method, mesh).deform(mesh, skinning, &mut out);
     out
 }
 
@@ -220,8 +220,8 @@ fn the_portable_and_simd_kernels_agree() {
     for method in Method::ALL {
         let mut fast = Deformed::new(&model.mesh);
         let mut portable = Deformed::new(&model.mesh);
-        Deformer::new(method, skinning.len()).deform(&model.mesh, &skinning, &mut fast);
-        Deformer::new(method, skinning.len()).portable().deform(&model.mesh, &skinning, &mut portable);
+        Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut fast);
+        Deformer::new(method, &model.mesh).portable().deform(&model.mesh, &skinning, &mut portable);
         for (a, b) in fast.positions().iter().zip(portable.positions()).chain(fast.normals().iter().zip(portable.normals())) {
             assert_close!(*a, *b, 1e-5);
         }

@@ -90,11 +90,13 @@ pub struct Deformer {
 }
 
 impl Deformer {
-    /// A deformer for a skeleton of `joint_count` joints; all buffers are allocated here.
+    /// A deformer for `mesh` (and meshes with the same joints and influence pairs); all
+    /// buffers are allocated here.
     #[must_use]
-    pub fn new(method: Method, joint_count: usize) -> Self {
-        let (lbn, qn) = if method == Method::Lb { (joint_count, 0) } else { (0, joint_count) };
-        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![0.0; qn * qn], portable: false }
+    pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
+        let joints = mesh.inverse_bind().len();
+        let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
+        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], portable: false }
     }
 
     /// The same deformer on the portable kernel, even where the AVX2 + FMA one would run
@@ -113,14 +115,14 @@ impl Deformer {
     /// Deforms `mesh` by the skinning transforms into `out`.
     ///
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
-    /// and translation, or dual quaternion), with a joints × joints table of the signs that
-    /// align each rotation to each other one. Steps 2–6: every vertex is blended. Allocates
-    /// nothing.
+    /// and translation, or dual quaternion), and for the quaternion methods one sign per pair
+    /// of joints that share a vertex, aligning the other joint's rotation to the hemisphere
+    /// of the heaviest one. Steps 2–6: every vertex is blended. Allocates nothing.
     ///
     /// * `skinning` — #joints transforms `world · inverse_bind`, from [`skinning_transforms`].
     ///
     /// # Panics
-    /// If `skinning` or `out` do not match the sizes given to [`Self::new`] and [`Deformed::new`].
+    /// If `skinning`, `out` or the deformer were made for a mesh with other joints or pairs.
     pub fn deform(&mut self, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut Deformed) {
         assert_eq!(out.vertex_count, mesh.vertex_count(), "output buffers belong to another mesh");
         assert_eq!(skinning.len(), mesh.inverse_bind().len(), "one skinning transform per joint");
@@ -139,13 +141,11 @@ impl Deformer {
                 for (d, m) in self.quat.iter_mut().zip(skinning) {
                     *d = convert(m);
                 }
-                let j = self.quat.len();
-                for h in 0..j {
-                    for i in 0..j {
-                        let (a, b) = (&self.quat[h], &self.quat[i]);
-                        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-                        self.signs[h * j + i] = if dot < 0.0 { -1.0 } else { 1.0 };
-                    }
+                assert_eq!(self.signs.len(), mesh.pairs.len() + 1, "deformer made for another mesh");
+                for (sign, &(h, j)) in self.signs[1..].iter_mut().zip(&mesh.pairs) {
+                    let (a, b) = (&self.quat[usize::from(h)], &self.quat[usize::from(j)]);
+                    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+                    *sign = if dot < 0.0 { -1.0 } else { 1.0 };
                 }
                 let frame = Frame { params: &self.quat, signs: &self.signs, portable: self.portable };
                 if self.method == Method::Qb {

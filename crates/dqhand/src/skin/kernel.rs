@@ -31,7 +31,7 @@ pub(crate) trait Blend<const W: usize> {
 pub(crate) struct Frame<'a, const W: usize> {
     /// Blend parameters per joint, #joints.
     pub params: &'a [[f32; W]],
-    /// `signs[h * joints + j]`: ±1 aligning joint `j` to joint `h` (unused without `ALIGN`).
+    /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused without `ALIGN`).
     pub signs: &'a [f32],
     /// Use the portable kernel even where the AVX2 one would run.
     pub portable: bool,
@@ -100,20 +100,23 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     let padded = mesh.pos[0].len();
     assert!(positions.len() == padded && normals.len() == padded, "output buffers: padded vertex count");
     assert_eq!(mesh.k, K);
-    // Every packed joint index is below the mesh's joint count (checked when the mesh was
-    // built), so these two checks make every parameter and sign lookup in bounds.
+    // Every packed joint index is below the mesh's joint count and every sign index below
+    // its pair count + 1 (both by construction), so these two checks make every parameter
+    // and sign lookup in bounds.
     let joints = frame.params.len();
     assert_eq!(joints, mesh.inverse_bind().len(), "one parameter row per joint");
-    assert!(!B::ALIGN || frame.signs.len() == joints * joints, "sign table: joints²");
+    assert!(!B::ALIGN || frame.signs.len() == mesh.pairs.len() + 1, "one sign per joint pair");
     let lanes = |a: &[f32], base: usize| -> Lanes { a[base..base + LANES].try_into().unwrap() };
     let mut rest = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
     let mut out = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
     let mut b = [[0.0f32; LANES]; W];
     let (all_js, all_ws) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0);
+    let all_ps = mesh.slot_pairs.as_chunks::<K>().0;
     for (base, &kc) in (0..padded).step_by(LANES).zip(&mesh.chunk_influences) {
         let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
         let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
-        blend::<W, K, AVX>(frame, B::ALIGN, usize::from(kc), js, ws, &mut b);
+        let ps: &[[u32; K]; LANES] = all_ps[base..base + LANES].try_into().unwrap();
+        blend::<W, K, AVX>(frame, B::ALIGN, usize::from(kc), Slots { js, ws, ps }, &mut b);
         for c in 0..3 {
             rest.p[c] = lanes(&mesh.pos[c], base);
             rest.n[c] = lanes(&mesh.nrm[c], base);
@@ -126,27 +129,34 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     }
 }
 
+/// The influence slots of one chunk: joints, weights and sign indices per vertex.
+#[derive(Clone, Copy)]
+pub(crate) struct Slots<'a, const K: usize> {
+    js: &'a [[u16; K]; LANES],
+    ws: &'a [[f32; K]; LANES],
+    ps: &'a [[u32; K]; LANES],
+}
+
 /// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]` over the
 /// first `kc` influence slots (the chunk's largest influence count).
 ///
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, kc: usize, js: &[[u16; K]; LANES], ws: &[[f32; K]; LANES], b: &mut [Lanes; W]) {
+fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
         // joint indices are in bounds (see `chunks`).
-        unsafe { avx2::blend::<W, K>(frame, align, kc, js, ws, b) };
+        unsafe { avx2::blend::<W, K>(frame, align, kc, slots, b) };
         return;
     }
-    let joints = frame.params.len();
+    let Slots { js, ws, ps } = slots;
     let mut acc = [[0.0f32; W]; LANES];
     for (l, acc) in acc.iter_mut().enumerate() {
-        let h = usize::from(js[l][0]) * joints;
         for k in 0..kc.min(K) {
             let j = usize::from(js[l][k]);
-            let w = if align { ws[l][k] * frame.signs[h + j] } else { ws[l][k] };
+            let w = if align { ws[l][k] * frame.signs[ps[l][k] as usize] } else { ws[l][k] };
             let p = &frame.params[j];
             for c in 0..W {
                 acc[c] += w * p[c];
@@ -194,7 +204,7 @@ mod avx2 {
 
     use core::arch::x86_64::*;
 
-    use super::{Frame, Lanes, LANES};
+    use super::{Frame, Lanes, Slots, LANES};
 
     /// As the portable `blend`, for `W` = 8 or 16.
     #[target_feature(enable = "avx2,fma")]
@@ -202,12 +212,11 @@ mod avx2 {
         frame: &Frame<'_, W>,
         align: bool,
         kc: usize,
-        js: &[[u16; K]; LANES],
-        ws: &[[f32; K]; LANES],
+        slots: Slots<'_, K>,
         b: &mut [Lanes; W],
     ) {
         const { assert!(W == 8 || W == 16) };
-        let joints = frame.params.len();
+        let Slots { js, ws, ps } = slots;
         let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
         // Influence-major, lanes unrolled: the accumulators stay in registers.
         for k in 0..kc.min(K) {
@@ -215,7 +224,7 @@ mod avx2 {
                 let j = usize::from(js[l][k]);
                 let mut w = ws[l][k];
                 if align {
-                    w *= *frame.signs.get_unchecked(usize::from(js[l][0]) * joints + j);
+                    w *= *frame.signs.get_unchecked(ps[l][k] as usize);
                 }
                 let wv = _mm256_set1_ps(w);
                 let p = frame.params.get_unchecked(j).as_ptr();

@@ -8,14 +8,14 @@ use glam::Affine3A;
 
 use super::kernel::{recip, rotate, Blend, Chunk, Lanes};
 use super::skinned_mesh::LANES;
-use crate::math::DualQuat;
 
 /// Blend parameters: the rotation `(x, y, z, w)`, then the translation and a zero.
 pub(crate) const W: usize = 8;
 
 /// The rotation quaternion and translation of a skinning matrix's rigid part.
 pub(crate) fn params(m: &Affine3A) -> [f32; W] {
-    let (q, t) = DualQuat::from_mat4(&(*m).into()).to_rotation_translation();
+    let (_, q, t) = m.to_scale_rotation_translation();
+    let q = q.normalize();
     [q.x, q.y, q.z, q.w, t.x, t.y, t.z, 0.0]
 }
 

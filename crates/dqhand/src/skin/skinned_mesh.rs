@@ -57,6 +57,12 @@ pub struct SkinnedMesh {
     pub(crate) k: usize,
     pub(crate) joints: Vec<u16>,
     pub(crate) weights: Vec<f32>,
+    /// The distinct (heaviest joint, other joint) pairs that share a vertex, for the
+    /// quaternion methods' sign alignment: one sign per pair per frame.
+    pub(crate) pairs: Vec<(u16, u16)>,
+    /// Per influence slot, the index of its pair's sign: 0 for the heaviest joint itself
+    /// (always +1), else 1 + the index into `pairs`.
+    pub(crate) slot_pairs: Vec<u32>,
     /// Per chunk of [`LANES`] vertices, the most non-zero influences of any of its vertices:
     /// the blend loop stops there (weights are sorted, so the rest are zero).
     pub(crate) chunk_influences: Vec<u8>,
@@ -169,6 +175,21 @@ impl SkinnedMesh {
             weights[v * k] = 1.0;
         }
 
+        let mut pair_index = std::collections::HashMap::new();
+        let mut pairs = Vec::new();
+        let slot_pairs = joints
+            .chunks_exact(k)
+            .flat_map(|js| js.iter().map(move |&j| (js[0], j)))
+            .map(|(h, j)| {
+                if h == j {
+                    return 0;
+                }
+                *pair_index.entry((h, j)).or_insert_with(|| {
+                    pairs.push((h, j));
+                    pairs.len() as u32
+                })
+            })
+            .collect();
         let chunk_influences = slots
             .chunks(LANES)
             .map(|c| c.iter().map(Vec::len).max().unwrap_or(1) as u8)
@@ -195,6 +216,8 @@ impl SkinnedMesh {
             k,
             joints,
             weights,
+            pairs,
+            slot_pairs,
             chunk_influences,
             max_influences,
             uvs: data.uvs,
