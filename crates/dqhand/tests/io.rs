@@ -724,3 +724,79 @@ fn several_meshes_and_primitives_are_concatenated_in_file_order() {
     // Each primitive's indices are offset to its own vertices.
     assert_eq!(&model.mesh.indices()[12..18], &[8, 9, 10, 8, 10, 11]);
 }
+
+/// The minimal glTF with `edit` applied to its JSON; returns the path.
+fn edited_gltf(test: &str, edit: impl FnOnce(&mut Value)) -> PathBuf {
+    let path = faulty_gltf(test, Fault::None);
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    edit(&mut doc);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn a_mesh_without_hand_joints_poses_at_rest_from_an_empty_pose_file() {
+    let model = io::load_gltf(&faulty_gltf("rest-no-hand", Fault::None)).unwrap();
+    let out = dqb(&model, &PoseFile::default());
+    for v in 0..model.mesh.vertex_count() {
+        assert!(Vec3::from(out[v]).distance(model.mesh.position(v)) < 1e-6);
+    }
+}
+
+#[test]
+fn primitives_with_four_and_eight_influences_load_together() {
+    let path = edited_gltf("mixed-sets", |doc| {
+        let mut eight = doc["meshes"][0]["primitives"][0].clone();
+        let attributes = &mut eight["attributes"];
+        attributes["JOINTS_1"] = attributes["JOINTS_0"].clone();
+        attributes["WEIGHTS_1"] = attributes["WEIGHTS_0"].clone();
+        doc["meshes"][0]["primitives"].as_array_mut().unwrap().push(eight);
+    });
+    let model = io::load_gltf(&path).unwrap();
+    assert_eq!(model.mesh.vertex_count(), 8);
+    // The second primitive lists each influence twice: merged into one, the sum of 2
+    // normalised with a warning, the same binding as the first primitive's.
+    assert!(model.warnings.iter().any(|w| w.contains("normalised")), "{:?}", model.warnings);
+    for v in 0..4 {
+        assert_eq!(influences(&model, v + 4), influences(&model, v));
+    }
+}
+
+#[test]
+fn joints_1_without_weights_1_is_an_error() {
+    let path = edited_gltf("joints1-only", |doc| {
+        let attributes = &mut doc["meshes"][0]["primitives"][0]["attributes"];
+        attributes["JOINTS_1"] = attributes["JOINTS_0"].clone();
+    });
+    expect_load_error(&path, &["only one of JOINTS_1 and WEIGHTS_1"]);
+}
+
+#[test]
+fn a_zero_node_rotation_is_an_error_and_a_non_unit_one_is_normalised() {
+    let zero = edited_gltf("zero-rotation", |doc| doc["nodes"][1]["rotation"] = json!([0.0, 0.0, 0.0, 0.0]));
+    expect_load_error(&zero, &["\"tip\"", "not a rotation"]);
+    let scaled = edited_gltf("scaled-rotation", |doc| doc["nodes"][1]["rotation"] = json!([0.0, 0.0, 0.0, 2.0]));
+    let model = io::load_gltf(&scaled).unwrap();
+    assert!(model.warnings.iter().any(|w| w.contains("normalised") && w.contains("tip")), "{:?}", model.warnings);
+    let tip = model.skeleton.find("tip").unwrap();
+    assert!((model.skeleton.joints()[tip].rest.rotation.length() - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn duplicate_node_names_are_renamed_with_a_warning() {
+    let path = edited_gltf("duplicate-names", |doc| doc["nodes"][1]["name"] = json!("root"));
+    let model = io::load_gltf(&path).unwrap();
+    assert!(model.skeleton.find("root#1").is_some());
+    assert!(model.warnings.iter().any(|w| w.contains("root#1")), "{:?}", model.warnings);
+}
+
+#[test]
+fn unused_broken_accessors_do_not_block_loading() {
+    // An extra accessor nothing reads (as morph targets or animations would be), sparse and
+    // without a buffer view.
+    let path = edited_gltf("unused-accessor", |doc| {
+        let sparse = json!({ "componentType": 5126, "count": 1, "type": "SCALAR", "sparse": { "count": 1, "indices": { "bufferView": 0, "componentType": 5123 }, "values": { "bufferView": 0 } } });
+        doc["accessors"].as_array_mut().unwrap().push(sparse);
+    });
+    assert_eq!(io::load_gltf(&path).unwrap().mesh.vertex_count(), 4);
+}

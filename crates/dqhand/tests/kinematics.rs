@@ -188,3 +188,31 @@ fn malformed_skeletons_are_rejected() {
     assert!(err(vec![nan]).contains("non-finite"));
     assert!(HandRig::new(&finger([0.1; 3]), JointModel::Paper).unwrap_err().to_string().contains("wrist"));
 }
+
+#[test]
+fn a_flat_hand_missing_a_metacarpal_still_follows_the_wrist() {
+    // Every joint a sibling under the wrist (as WebXR stores them), without
+    // index-finger-metacarpal: the index proximal phalanx must hang from the wrist.
+    let model = build(&HandParams::default()).unwrap();
+    let world = model.skeleton.rest_world();
+    let keep: Vec<usize> = (0..model.skeleton.len()).filter(|&j| model.skeleton.joints()[j].name != "index-finger-metacarpal").collect();
+    let joints = keep
+        .iter()
+        .map(|&j| {
+            let name = model.skeleton.joints()[j].name.clone();
+            let (parent, rest) = if j == 0 { (None, world[0]) } else { (Some(0), world[0].inverse() * world[j]) };
+            Joint { name, parent, rest: Transform::from_affine(&rest) }
+        })
+        .collect();
+    let flat = Skeleton::new(joints).unwrap();
+    let rig = HandRig::new(&flat, JointModel::Paper).unwrap();
+    let tip = flat.find("index-finger-tip").unwrap();
+    let proximal = flat.find("index-finger-phalanx-proximal").unwrap();
+    assert_eq!(rig.skeleton().joints()[proximal].parent, flat.find("wrist"));
+    let lift = dqhand::math::DualQuat::from_translation(Vec3::Y * 0.5);
+    let mut b = PoseBuffers::new(rig.skeleton());
+    rig.locals(&Pose { wrist: Some(lift), angles: vec![0.0; 18] }, Limits::Anatomical, &mut b.locals);
+    forward_kinematics(rig.skeleton(), &b.locals, &mut b.world);
+    let rest_tip = flat.rest_world()[tip].translation;
+    assert_close!(Vec3::from(b.world[tip].translation), Vec3::from(rest_tip) + Vec3::Y * 0.5, 1e-5);
+}

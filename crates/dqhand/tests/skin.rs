@@ -280,3 +280,22 @@ fn eight_influences_are_kept() {
         assert_close!(deform(method, &mesh, &skinning).positions()[0], [1.0, 3.5, 0.0], 1e-5);
     }
 }
+
+#[test]
+fn huge_weights_are_normalised_without_overflow() {
+    let ib = vec![Affine3A::IDENTITY; 2];
+    let (mesh, warnings) = SkinnedMesh::new(one_vertex([1.0, 0.0, 0.0], vec![0, 1], vec![3e38, 3e38], ib)).unwrap();
+    assert_eq!(warnings.len(), 1);
+    assert_eq!(mesh.influences(0).collect::<Vec<_>>(), vec![(0, 0.5), (1, 0.5)]);
+}
+
+#[test]
+fn zero_length_normals_are_replaced_by_face_normals() {
+    let mut d = one_vertex([0.0; 3], vec![0], vec![1.0], vec![Affine3A::IDENTITY]);
+    d.positions = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    (d.joints, d.weights, d.indices) = (vec![0; 3], vec![1.0; 3], vec![0, 1, 2]);
+    d.normals = vec![[0.0; 3], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]];
+    let (mesh, warnings) = SkinnedMesh::new(d).unwrap();
+    assert!(warnings[0].contains("1 zero-length normals"), "{warnings:?}");
+    assert_eq!(mesh.normal(0), Vec3::Z);
+}

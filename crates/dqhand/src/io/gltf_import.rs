@@ -39,9 +39,6 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
     }
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(&gltf, path)?;
-    for accessor in gltf.accessors() {
-        check_accessor(&accessor, &buffers).map_err(bad)?;
-    }
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
 
     let skinned: Vec<gltf::Node<'_>> = gltf.nodes().filter(|n| n.mesh().is_some() && n.skin().is_some()).collect();
@@ -74,19 +71,35 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
     let node_to_joint: HashMap<usize, usize> =
         keep.iter().enumerate().filter(|(_, &k)| k).enumerate().map(|(j, (n, _))| (n, j)).collect();
     let mut joints = Vec::with_capacity(node_to_joint.len());
+    let mut names = std::collections::HashSet::new();
     for node in gltf.nodes().filter(|n| keep[n.index()]) {
         let (t, r, s) = node.transform().decomposed();
+        let mut name = node.name().map_or_else(|| format!("node{}", node.index()), str::to_owned);
+        if !names.insert(name.clone()) {
+            let renamed = format!("{name}#{}", node.index());
+            warnings.push(format!("node {} is also called {name:?}; it is called {renamed:?} here", node.index()));
+            name = renamed;
+            names.insert(name.clone());
+        }
+        let rotation = Quat::from_array(r);
+        let norm = rotation.length();
+        if !norm.is_finite() || norm < 1e-6 {
+            return Err(bad(format!("node {name:?} has rotation {r:?}, which is not a rotation")));
+        }
+        if (norm - 1.0).abs() > 1e-3 {
+            warnings.push(format!("node {name:?} has a rotation of norm {norm}; it was normalised"));
+        }
         joints.push(Joint {
-            name: node.name().map_or_else(|| format!("node{}", node.index()), str::to_owned),
+            name,
             parent: parent.get(&node.index()).and_then(|p| node_to_joint.get(p)).copied(),
-            rest: Transform { translation: Vec3::from(t), rotation: Quat::from_array(r), scale: Vec3::from(s) },
+            rest: Transform { translation: Vec3::from(t), rotation: rotation / norm, scale: Vec3::from(s) },
         });
     }
     let skeleton = Skeleton::new(joints)?;
 
     let skin_joints: Vec<usize> = skin.joints().map(|n| node_to_joint[&n.index()]).collect();
     let mut inverse_bind = vec![Affine3A::IDENTITY; skeleton.len()];
-    check_kind(skin.inverse_bind_matrices(), &format!("skin {} inverse bind matrix", skin.index()), Dimensions::Mat4, &[DataType::F32])?;
+    check_accessor(skin.inverse_bind_matrices(), &format!("skin {} inverse bind matrix", skin.index()), (Dimensions::Mat4, &[DataType::F32]), &buffers)?;
     if let Some(ibm) = skin.reader(get).read_inverse_bind_matrices() {
         let ibm: Vec<[[f32; 4]; 4]> = ibm.collect();
         if ibm.len() != skin_joints.len() {
@@ -113,34 +126,36 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
             if prim.mode() != gltf::mesh::Mode::Triangles {
                 return Err(bad(format!("mesh {:?} primitive {} uses mode {:?}; only triangles are supported", mesh.name().unwrap_or(""), prim.index(), prim.mode())));
             }
-            let has_second = prim.get(&gltf::Semantic::Joints(1)).is_some() && prim.get(&gltf::Semantic::Weights(1)).is_some();
-            stride = stride.max(if has_second { 8 } else { 4 });
+            stride = stride.max(4 * influence_sets(&prim, mesh.name().unwrap_or(""))?);
             primitives.push((mesh.name().unwrap_or("mesh").to_owned(), prim));
         }
     }
     for (name, prim) in &primitives {
         let where_ = format!("mesh {name:?} primitive {}", prim.index());
-        let (f32_only, uv_types, small_uint) = (&[DataType::F32][..], &[DataType::F32, DataType::U8, DataType::U16][..], &[DataType::U8, DataType::U16][..]);
+        let sets = influence_sets(prim, name)?;
+        let (vec3, uv, small_uint) = (&[DataType::F32][..], &[DataType::F32, DataType::U8, DataType::U16][..], &[DataType::U8, DataType::U16][..]);
         let mut kinds = vec![
-            (Semantic::Positions, "POSITION", Dimensions::Vec3, f32_only),
-            (Semantic::Normals, "NORMAL", Dimensions::Vec3, f32_only),
-            (Semantic::TexCoords(0), "TEXCOORD_0", Dimensions::Vec2, uv_types),
+            (Semantic::Positions, "POSITION", (Dimensions::Vec3, vec3)),
+            (Semantic::Normals, "NORMAL", (Dimensions::Vec3, vec3)),
+            (Semantic::TexCoords(0), "TEXCOORD_0", (Dimensions::Vec2, uv)),
         ];
-        for set in 0..stride as u32 / 4 {
-            kinds.push((Semantic::Joints(set), if set == 0 { "JOINTS_0" } else { "JOINTS_1" }, Dimensions::Vec4, small_uint));
-            kinds.push((Semantic::Weights(set), if set == 0 { "WEIGHTS_0" } else { "WEIGHTS_1" }, Dimensions::Vec4, uv_types));
+        for set in 0..sets as u32 {
+            let labels = [["JOINTS_0", "WEIGHTS_0"], ["JOINTS_1", "WEIGHTS_1"]][set as usize];
+            kinds.push((Semantic::Joints(set), labels[0], (Dimensions::Vec4, small_uint)));
+            kinds.push((Semantic::Weights(set), labels[1], (Dimensions::Vec4, uv)));
         }
-        for (semantic, label, dims, types) in kinds {
-            check_kind(prim.get(&semantic), &format!("{where_} {label}"), dims, types)?;
+        for (semantic, label, kind) in kinds {
+            check_accessor(prim.get(&semantic), &format!("{where_} {label}"), kind, &buffers)?;
         }
-        check_kind(prim.indices(), &format!("{where_} index"), Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32])?;
+        let index_types = &[DataType::U8, DataType::U16, DataType::U32][..];
+        check_accessor(prim.indices(), &format!("{where_} index"), (Dimensions::Scalar, index_types), &buffers)?;
         let reader = prim.reader(get);
         let positions: Vec<[f32; 3]> =
             reader.read_positions().ok_or_else(|| bad(format!("{where_} has no POSITION accessor")))?.collect();
         let n = positions.len();
         let base = data.positions.len() as u32;
         let mut influences = vec![(0u32, 0f32); n * stride];
-        for set in 0..stride / 4 {
+        for set in 0..sets {
             let js = reader.read_joints(set as u32).ok_or_else(|| bad(format!("{where_} has no JOINTS_{set} accessor")))?;
             let ws = reader.read_weights(set as u32).ok_or_else(|| bad(format!("{where_} has no WEIGHTS_{set} accessor")))?;
             let (js, ws): (Vec<[u16; 4]>, Vec<[f32; 4]>) = (js.into_u16().collect(), ws.into_f32().collect());
@@ -207,7 +222,7 @@ fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => {
-                gltf.blob.clone().ok_or_else(|| Error::Invalid("buffer 0 refers to a GLB binary chunk the file does not have".into()))?
+                gltf.blob.clone().ok_or_else(|| Error::Invalid(format!("buffer {} refers to a GLB binary chunk the file does not have", buffer.index())))?
             }
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let b64 = uri.split_once(";base64,").map(|s| s.1).ok_or_else(|| {
@@ -238,18 +253,36 @@ fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
     Ok(out)
 }
 
-/// Checks that an accessor's elements lie inside its buffer view and the view inside its
-/// buffer, so that reading it cannot go out of bounds.
-fn check_accessor(a: &gltf::Accessor<'_>, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
-    let i = a.index();
-    if a.sparse().is_some() {
-        return Err(format!("accessor {i} is sparse; sparse accessors are not supported"));
+/// How many JOINTS/WEIGHTS sets (of four influences) a primitive has: 1 or 2.
+fn influence_sets(prim: &gltf::Primitive<'_>, mesh: &str) -> Result<usize> {
+    let has = |s: Semantic| prim.get(&s).is_some();
+    match (has(Semantic::Joints(1)), has(Semantic::Weights(1))) {
+        (false, false) => Ok(1),
+        (true, true) => Ok(2),
+        _ => Err(Error::Invalid(format!("mesh {mesh:?} primitive {} has only one of JOINTS_1 and WEIGHTS_1", prim.index()))),
     }
-    let view = a.view().ok_or_else(|| format!("accessor {i} has no buffer view"))?;
+}
+
+/// Checks an accessor that is about to be read: the element type glTF prescribes for its use
+/// (the `gltf` crate's readers support no other), at least one element, no sparse storage,
+/// and elements inside its buffer view and the view inside its buffer, so that reading it
+/// cannot go out of bounds. `None` (an absent optional attribute) passes.
+fn check_accessor(a: Option<gltf::Accessor<'_>>, what: &str, kind: (Dimensions, &[DataType]), buffers: &[Vec<u8>]) -> Result<()> {
+    let Some(a) = a else { return Ok(()) };
+    let i = a.index();
+    let bad = |m: String| Err(Error::Invalid(format!("{what} accessor {i} {m}")));
+    let (dims, types) = kind;
+    if a.dimensions() != dims || !types.contains(&a.data_type()) {
+        return bad(format!("is {:?} {:?}; expected {dims:?} of {types:?}", a.dimensions(), a.data_type()));
+    }
+    if a.sparse().is_some() {
+        return bad("is sparse; sparse accessors are not supported".into());
+    }
+    let Some(view) = a.view() else { return bad("has no buffer view".into()) };
     let buffer = &buffers[view.buffer().index()];
     if view.offset().checked_add(view.length()).is_none_or(|end| end > buffer.len()) {
-        return Err(format!(
-            "buffer view {} (bytes {}..{}) reaches past the end of buffer {} ({} bytes)",
+        return bad(format!(
+            "uses buffer view {} (bytes {}..{}), which reaches past the end of buffer {} ({} bytes)",
             view.index(),
             view.offset(),
             view.offset().saturating_add(view.length()),
@@ -264,22 +297,8 @@ fn check_accessor(a: &gltf::Accessor<'_>, buffers: &[Vec<u8>]) -> std::result::R
         .and_then(|x| x.checked_add(a.offset()))
         .and_then(|x| x.checked_add(elem));
     match end {
-        None if a.count() == 0 => Err(format!("accessor {i} has no elements")),
+        None if a.count() == 0 => bad("has no elements".into()),
         Some(end) if end <= view.length() => Ok(()),
-        _ => Err(format!("accessor {i} ({} elements) reaches past the end of buffer view {}", a.count(), view.index())),
-    }
-}
-
-/// Checks that an accessor has the element type glTF prescribes for its use, since reading
-/// one of another type is not supported by the `gltf` crate's readers.
-fn check_kind(a: Option<gltf::Accessor<'_>>, what: &str, dims: Dimensions, types: &[DataType]) -> Result<()> {
-    match a {
-        Some(a) if a.dimensions() != dims || !types.contains(&a.data_type()) => Err(Error::Invalid(format!(
-            "{what} accessor {} is {:?} {:?}; expected {dims:?} of {types:?}",
-            a.index(),
-            a.dimensions(),
-            a.data_type()
-        ))),
-        _ => Ok(()),
+        _ => bad(format!("({} elements) reaches past the end of buffer view {}", a.count(), view.index())),
     }
 }

@@ -106,6 +106,10 @@ impl PoseFile {
                 .collect::<Result<_>>()
                 .map(PoseTarget::LocalRotations);
         }
+        if self.angles_deg.is_empty() && self.wrist.is_none() && self.model.is_none() {
+            // Nothing to pose: the rest pose as stored, which needs no hand joints.
+            return Ok(PoseTarget::LocalRotations(Vec::new()));
+        }
         let joint_model = match &self.model {
             Some(m) => m.parse().map_err(Error::Invalid)?,
             None if self.angles_deg.keys().all(|k| JointModel::Paper.dof_index(k).is_ok()) => JointModel::Paper,

@@ -34,17 +34,28 @@ pub struct HandRig {
     model: JointModel,
     dofs: Vec<RigDof>,
     wrist: usize,
+    /// Inverse rest world transform of the wrist's parent (fixed: only the wrist and below
+    /// move), which turns a world wrist pose into a local one.
+    wrist_parent_inverse: Affine3A,
 }
 
 impl HandRig {
     /// Resolves `model` on `skeleton`. A skeleton whose WebXR joints are stored as siblings
     /// (as WebXR and the generic-hand asset do) is first re-parented into the anatomical chain
-    /// wrist → metacarpal → phalanges, keeping every rest transform.
+    /// wrist → metacarpal → phalanges, keeping every rest transform; a joint whose anatomical
+    /// parent is missing hangs from the nearest ancestor in the chain that exists.
     ///
     /// # Errors
     /// [`Error::Invalid`] if a joint the model needs is missing.
     pub fn new(skeleton: &Skeleton, model: JointModel) -> Result<Self> {
-        let skeleton = skeleton.reparented(webxr::anatomical_parent)?;
+        let nearest_parent = |name: &str| {
+            let mut parent = webxr::anatomical_parent(name);
+            while let Some(p) = parent.filter(|p| skeleton.find(p).is_none()) {
+                parent = webxr::anatomical_parent(p);
+            }
+            parent
+        };
+        let skeleton = skeleton.reparented(nearest_parent)?;
         let wrist = skeleton.find("wrist").ok_or_else(|| missing("wrist"))?;
         let world = skeleton.rest_world();
         let pos = |name: &str| -> Option<Vec3> { skeleton.find(name).map(|i| world[i].translation.into()) };
@@ -65,12 +76,13 @@ impl HandRig {
                         b if b.starts_with("ring") || b.starts_with("pinky") => -radial,
                         _ => radial,
                     };
-                    Vec3::Y * abduction_sign(&skeleton, &world, joint, away)
+                    Vec3::Y * abduction_sign(&skeleton, &world, d.bone, away)
                 }
             };
             dofs.push(RigDof { joint, axis, min: d.min_deg.to_radians(), max: d.max_deg.to_radians() });
         }
-        Ok(Self { skeleton, model, dofs, wrist })
+        let wrist_parent_inverse = skeleton.joints()[wrist].parent.map_or(Affine3A::IDENTITY, |p| world[p].inverse());
+        Ok(Self { skeleton, model, dofs, wrist, wrist_parent_inverse })
     }
 
     /// The anatomical skeleton the rig poses (same joint indices as the input skeleton).
@@ -118,9 +130,7 @@ impl HandRig {
         }
         if let Some(w) = pose.wrist {
             let (rotation, translation) = w.to_rotation_translation();
-            let world = Affine3A::from_rotation_translation(rotation, translation);
-            let parent = self.skeleton.joints()[self.wrist].parent.map(|p| self.parent_world(p));
-            let local = parent.map_or(world, |p| p.inverse() * world);
+            let local = self.wrist_parent_inverse * Affine3A::from_rotation_translation(rotation, translation);
             locals[self.wrist] = Transform { scale: locals[self.wrist].scale, ..Transform::from_affine(&local) };
         }
         for (&a, d) in pose.angles.iter().zip(&self.dofs) {
@@ -132,24 +142,13 @@ impl HandRig {
             l.rotation = (l.rotation * Quat::from_axis_angle(d.axis, angle)).normalize();
         }
     }
-
-    /// Rest world transform of a joint above the wrist (fixed: only the wrist and below move).
-    fn parent_world(&self, joint: usize) -> Affine3A {
-        let joints = self.skeleton.joints();
-        let mut m = joints[joint].rest.to_affine();
-        let mut j = joint;
-        while let Some(p) = joints[j].parent {
-            m = joints[p].rest.to_affine() * m;
-            j = p;
-        }
-        m
-    }
 }
 
-/// +1 if turning `joint` about its +Y axis moves its child away along `away`, else −1.
-fn abduction_sign(skeleton: &Skeleton, world: &[Affine3A], joint: usize, away: Vec3) -> f32 {
-    let child = skeleton.joints().iter().position(|j| j.parent == Some(joint));
-    let Some(child) = child else { return 1.0 };
+/// +1 if turning `bone` about its +Y axis moves the next joint of its finger away along
+/// `away`, else −1.
+fn abduction_sign(skeleton: &Skeleton, world: &[Affine3A], bone: &str, away: Vec3) -> f32 {
+    let next = webxr::JOINT_NAMES.iter().position(|&n| n == bone).and_then(|i| webxr::JOINT_NAMES.get(i + 1));
+    let (Some(joint), Some(child)) = (skeleton.find(bone), next.and_then(|n| skeleton.find(n))) else { return 1.0 };
     let tip: Vec3 = world[child].translation.into();
     let turned = world[joint] * Affine3A::from_rotation_y(0.1) * world[joint].inverse();
     if (turned.transform_point3(tip) - tip).dot(away) >= 0.0 {

@@ -139,7 +139,7 @@ impl Skeleton {
         let world = self.rest_world();
         let mut joints = self.joints.clone();
         for (i, joint) in joints.iter_mut().enumerate() {
-            if let Some(p) = parent_of(&joint.name).and_then(|p| self.find(p)) {
+            if let Some(p) = parent_of(&joint.name).and_then(|p| self.find(p)).filter(|&p| joint.parent != Some(p)) {
                 joint.parent = Some(p);
                 joint.rest = Transform::from_affine(&(world[p].inverse() * world[i]));
             }

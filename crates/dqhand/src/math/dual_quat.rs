@@ -65,9 +65,8 @@ impl DualQuat {
         Self::from_rotation_translation(Quat::IDENTITY, translation)
     }
 
-    /// The rigid part of an affine matrix (rotation and translation; any scale is discarded).
-    ///
-    /// Use [`Self::rigidity_error`] first where a scaled matrix would be a mistake.
+    /// The rigid part of an affine matrix (rotation and translation; any scale is discarded,
+    /// which is why DQB and QB ignore scaled bones that LB follows).
     #[must_use]
     pub fn from_mat4(m: &Mat4) -> Self {
         let (_, rotation, translation) = m.to_scale_rotation_translation();

@@ -141,16 +141,22 @@ impl SkinnedMesh {
                 if j as usize >= joint_count {
                     return bad(format!("vertex {v} is bound to joint {j}, but the skin has only {joint_count} joints"));
                 }
-                inf.push((j as u16, w));
+                // A joint listed twice (as in JOINTS_0 and JOINTS_1) is one influence.
+                match inf.iter_mut().find(|i: &&mut (u16, f32)| u32::from(i.0) == j) {
+                    Some(i) => i.1 += w,
+                    None => inf.push((j as u16, w)),
+                }
             }
-            let sum: f32 = inf.iter().map(|i| i.1).sum();
+            // Summed in f64: f32 weights near f32::MAX would overflow to infinity.
+            let sum: f64 = inf.iter().map(|i| f64::from(i.1)).sum();
             if inf.is_empty() || sum <= 0.0 {
                 return bad(format!("vertex {v} has no positive weight"));
             }
             if (sum - 1.0).abs() > 1e-3 {
                 renormalised += 1;
             }
-            inf.iter_mut().for_each(|i| i.1 /= sum);
+            inf.iter_mut().for_each(|i| i.1 = (f64::from(i.1) / sum) as f32);
+            inf.retain(|i| i.1 > 0.0);
             inf.sort_by(|a, b| b.1.total_cmp(&a.1));
             slots.push(inf);
         }
@@ -197,7 +203,24 @@ impl SkinnedMesh {
         let normals = if data.normals.is_empty() {
             vertex_normals(&data.positions, &data.indices)
         } else {
-            data.normals.iter().map(|&m| Vec3::from(m).normalize_or(Vec3::Y).to_array()).collect()
+            let faces = vertex_normals(&data.positions, &data.indices);
+            let mut replaced = 0;
+            let normals = data
+                .normals
+                .iter()
+                .zip(&faces)
+                .map(|(&n, &f)| {
+                    Vec3::from(n).try_normalize().unwrap_or_else(|| {
+                        replaced += 1;
+                        Vec3::from(f)
+                    })
+                })
+                .map(|n| n.to_array())
+                .collect();
+            if replaced > 0 {
+                warnings.push(format!("{replaced} zero-length normals were replaced by the normals of the surrounding faces"));
+            }
+            normals
         };
         let column = |src: &[[f32; 3]], c: usize| {
             let mut col: Vec<f32> = src.iter().map(|p| p[c]).collect();
@@ -329,7 +352,11 @@ impl SkinnedMesh {
     /// Number of joints that influence at least one vertex (the paper's "bones").
     #[must_use]
     pub fn bone_count(&self) -> usize {
-        self.vertices_per_joint().iter().filter(|&&c| c > 0).count()
+        let mut used = vec![false; self.inverse_bind.len()];
+        for (&j, &w) in self.joints.iter().zip(&self.weights).take(self.vertex_count * self.k) {
+            used[usize::from(j)] |= w > 0.0;
+        }
+        used.iter().filter(|&&u| u).count()
     }
 }
 
