@@ -47,11 +47,7 @@ impl Error {
     #[must_use]
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         match self {
-            Error::Invalid(message) => Error::File { path: path.into(), message },
-            Error::UnknownName { kind, name, valid } => Error::File {
-                path: path.into(),
-                message: format!("unknown {kind} {name:?}; valid: {valid}"),
-            },
+            Error::Invalid(_) | Error::UnknownName { .. } => Error::File { path: path.into(), message: self.to_string() },
             other => other,
         }
     }
