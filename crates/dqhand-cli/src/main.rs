@@ -6,6 +6,7 @@
 mod bench;
 mod demo;
 mod info;
+mod metrics;
 mod skin;
 
 use clap::{Parser, Subcommand};
@@ -29,6 +30,9 @@ enum Command {
     Bench(bench::Args),
     /// Pose the built-in hand through the gesture library and write the meshes.
     Demo(demo::Args),
+    /// Realism metrics of LB, QB and DQB: volume, collapse and bulge, candy wrapper,
+    /// distortion and continuity over joint sweeps.
+    Metrics(metrics::Args),
 }
 
 fn main() {
@@ -38,6 +42,7 @@ fn main() {
         Command::Skin(a) => skin::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Demo(a) => demo::run(&a),
+        Command::Metrics(a) => metrics::run(&a),
     };
     if let Err(e) = result {
         eprintln!("dqhand: error: {e:#}");

@@ -70,7 +70,7 @@ const BUILTIN_VERTICES: usize = 8668;
 #[test]
 fn help_works_for_every_command() {
     let top = run_ok(&["--help"]);
-    for sub in ["info", "skin", "bench", "demo"] {
+    for sub in ["info", "skin", "bench", "demo", "metrics"] {
         assert!(top.contains(sub), "top-level help does not list {sub}:\n{top}");
         let help = run_ok(&[sub, "--help"]);
         assert!(help.contains("Usage"), "`dqhand {sub} --help`:\n{help}");
@@ -266,4 +266,47 @@ fn unknown_method_is_a_usage_error() {
 fn unknown_subcommand_is_a_usage_error() {
     assert_exit(&dqhand(&["frobnicate"]), 2);
     assert_exit(&dqhand::<&str>(&[]), 2);
+}
+
+#[test]
+fn metrics_json_and_csv_cover_every_sweep_and_method() {
+    let dir = temp_dir("metrics-csv");
+    let out = run_ok(&["metrics", "--json", "--csv", &path_arg(&dir)]);
+    let report: Value = serde_json::from_str(out.trim()).expect("one JSON object");
+    assert_eq!(report["closed"], json!(true));
+    let sweeps = report["sweeps"].as_object().unwrap();
+    for name in ["index-pip", "index-mcp", "fist", "index-pip-twist", "wrist-twist"] {
+        let s = &sweeps[name];
+        let n = s["values"].as_array().unwrap().len();
+        for m in ["lb", "qb", "dqb"] {
+            assert_eq!(s[m]["volume"].as_array().unwrap().len(), n, "{name} {m}");
+        }
+        let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 3 * n, "{name}.csv");
+    }
+}
+
+#[test]
+fn metrics_on_an_open_mesh_say_volume_is_undefined_and_report_the_rest() {
+    let Ok(hand) = std::env::var("DQHAND_WEBXR_HAND").or_else(|_| {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb");
+        if p.exists() { Ok(path_arg(&p)) } else { Err(()) }
+    }) else {
+        panic!("the WebXR generic hand is missing: run `make test` (it runs `npm ci` in third_party/)");
+    };
+    let result = dqhand(&["metrics", "--mesh", &hand, "--json"]);
+    assert_exit(&result, 0);
+    assert!(stderr(&result).contains("volume is undefined"), "{}", stderr(&result));
+    let report: Value = serde_json::from_str(stdout(&result).trim()).unwrap();
+    assert_eq!(report["closed"], json!(false));
+    assert!(report["sweeps"]["index-pip"]["dqb"]["volume"][0].is_null());
+    assert!(report["sweeps"]["index-pip"]["dqb"]["min_distance"][0].as_f64().unwrap() > 0.99);
+}
+
+#[test]
+fn readme_metrics_table_is_the_commands_output() {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md")).unwrap();
+    let begin = readme.find("<!-- metrics:begin -->\n").expect("README metrics marker") + "<!-- metrics:begin -->\n".len();
+    let end = readme.find("<!-- metrics:end -->").expect("README metrics end marker");
+    assert_eq!(&readme[begin..end], run_ok(&["metrics", "--markdown"]), "regenerate the README table with `dqhand metrics --markdown`");
 }

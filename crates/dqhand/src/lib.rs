@@ -18,6 +18,7 @@ pub mod hand;
 pub mod io;
 pub mod kinematics;
 pub mod math;
+pub mod metrics;
 pub mod model;
 pub mod skin;
 

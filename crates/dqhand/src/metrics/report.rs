@@ -1,0 +1,292 @@
+//! The realism report: LB, QB and DQB measured on the same sweeps of the same hand.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use glam::{Affine3A, Vec3};
+use serde_json::{json, Value};
+
+use super::{check_closed, edge_distortion, edges, enclosed_volume, JointRegion};
+use crate::gesture::gesture;
+use crate::kinematics::{forward_kinematics, HandRig, JointModel, Limits, Pose, Transform};
+use crate::model::Model;
+use crate::skin::{skinning_transforms, Deformed, Deformer, Method};
+use crate::{Error, Result};
+
+/// What one sweep moves.
+#[derive(Clone, Copy, Debug)]
+enum Motion {
+    /// One DOF of the `full` model, in degrees (limits off).
+    Dof(&'static str),
+    /// From the open hand to a gesture, in percent.
+    Gesture(&'static str),
+    /// The bones listed turned about the axis of the bone at the region's joint, through
+    /// that joint, in degrees.
+    Twist(&'static [&'static str]),
+}
+
+/// A named sweep: what moves, over which values, and the joint whose skin is measured.
+struct SweepSpec {
+    name: &'static str,
+    parameter: &'static str,
+    values: Vec<f32>,
+    motion: Motion,
+    joint: &'static str,
+    next: &'static str,
+}
+
+fn specs() -> Vec<SweepSpec> {
+    let range = |max: f32, step: f32| (0..=(max / step).round() as usize).map(|i| i as f32 * step).collect::<Vec<_>>();
+    let index = ["index-finger-phalanx-intermediate", "index-finger-phalanx-distal"];
+    vec![
+        SweepSpec { name: "index-pip", parameter: "degrees", values: range(110.0, 5.0), motion: Motion::Dof("index-finger-phalanx-intermediate.flex"), joint: index[0], next: index[1] },
+        SweepSpec { name: "index-mcp", parameter: "degrees", values: range(90.0, 5.0), motion: Motion::Dof("index-finger-phalanx-proximal.flex"), joint: "index-finger-phalanx-proximal", next: index[0] },
+        SweepSpec { name: "fist", parameter: "percent", values: range(100.0, 10.0), motion: Motion::Gesture("fist"), joint: "middle-finger-phalanx-intermediate", next: "middle-finger-phalanx-distal" },
+        SweepSpec { name: "index-pip-twist", parameter: "degrees", values: range(200.0, 10.0), motion: Motion::Twist(&["index-finger-phalanx-intermediate"]), joint: index[0], next: index[1] },
+        SweepSpec {
+            name: "wrist-twist",
+            parameter: "degrees",
+            values: range(200.0, 10.0),
+            motion: Motion::Twist(&["thumb-metacarpal", "index-finger-metacarpal", "middle-finger-metacarpal", "ring-finger-metacarpal", "pinky-finger-metacarpal"]),
+            joint: "middle-finger-metacarpal",
+            next: "middle-finger-phalanx-proximal",
+        },
+    ]
+}
+
+/// The measures of one frame under one method.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameMetrics {
+    /// Enclosed volume relative to rest; `None` if the mesh is not closed.
+    pub volume: Option<f32>,
+    /// Smallest distance-to-bones ratio in the joint region (< 1: collapse).
+    pub min_distance: f32,
+    /// Largest distance-to-bones ratio in the joint region (> 1: bulge).
+    pub max_distance: f32,
+    /// Smallest distance from the bone axis relative to the rest radius (candy wrapper).
+    pub section_radius: f32,
+    /// Mean relative edge-length change in the joint region.
+    pub distortion_mean: f32,
+    /// Largest relative edge-length change in the joint region.
+    pub distortion_max: f32,
+    /// Largest vertex displacement from the previous frame of the sweep (m).
+    pub jump: f32,
+}
+
+/// One sweep measured under the three methods.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    /// Sweep name (`index-pip`, …).
+    pub name: &'static str,
+    /// Unit of `values`.
+    pub parameter: &'static str,
+    /// The swept values.
+    pub values: Vec<f32>,
+    /// The joint whose skin is measured.
+    pub joint: &'static str,
+    /// Per method (in [`Method::ALL`] order), one entry per value.
+    pub frames: [Vec<FrameMetrics>; 3],
+}
+
+/// Everything `dqhand metrics` reports.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// Vertex count of the mesh.
+    pub vertices: usize,
+    /// `Ok` if the mesh is closed (volume defined), else why not.
+    pub closed: std::result::Result<(), String>,
+    /// The sweeps.
+    pub sweeps: Vec<Sweep>,
+}
+
+/// Measures LB, QB and DQB on every sweep.
+///
+/// # Errors
+/// [`Error::Invalid`] if the model lacks the WebXR hand joints the sweeps move.
+pub fn measure(model: &Model) -> Result<Report> {
+    let rig = HandRig::new(&model.skeleton, JointModel::Full)?;
+    let skeleton = rig.skeleton();
+    let mesh = &model.mesh;
+    let closed = check_closed(mesh.indices());
+    let rest_positions = mesh.positions();
+    let rest_volume = closed.is_ok().then(|| enclosed_volume(&rest_positions, mesh.indices()));
+    let rest_world = skeleton.rest_world();
+    let all_edges = edges(mesh.indices());
+    let mut deformers = Method::ALL.map(|m| Deformer::new(m, mesh));
+    let mut out = Deformed::new(mesh);
+    let mut world = rest_world.clone();
+    let mut skinning = vec![Affine3A::IDENTITY; skeleton.len()];
+    let mut locals = skeleton.rest_locals();
+    let mut sweeps = Vec::new();
+    for spec in specs() {
+        let region = JointRegion::new(skeleton, mesh, spec.joint, spec.next)?;
+        let in_region = {
+            let mut mark = vec![false; mesh.vertex_count()];
+            region.vertices.iter().for_each(|&v| mark[v] = true);
+            mark
+        };
+        let region_edges: Vec<[u32; 2]> = all_edges.iter().copied().filter(|e| e.iter().all(|&v| in_region[v as usize])).collect();
+        let mut frames: [Vec<FrameMetrics>; 3] = Default::default();
+        let mut previous: [Option<Vec<[f32; 3]>>; 3] = Default::default();
+        for &value in &spec.values {
+            pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
+            forward_kinematics(skeleton, &locals, &mut world);
+            skinning_transforms(&world, mesh.inverse_bind(), &mut skinning);
+            for (m, deformer) in deformers.iter_mut().enumerate() {
+                deformer.deform(mesh, &skinning, &mut out);
+                let posed = out.positions();
+                let (min_distance, max_distance) = region.distance_ratios(mesh, &rest_world, &world, posed);
+                let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
+                let jump = previous[m].as_ref().map_or(0.0, |p| {
+                    p.iter().zip(posed).map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b))).fold(0.0, f32::max)
+                });
+                frames[m].push(FrameMetrics {
+                    volume: rest_volume.map(|v0| (enclosed_volume(posed, mesh.indices()) / v0) as f32),
+                    min_distance,
+                    max_distance,
+                    section_radius: region.section_radius(&world, posed),
+                    distortion_mean,
+                    distortion_max,
+                    jump,
+                });
+                previous[m] = Some(posed.to_vec());
+            }
+        }
+        sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
+    }
+    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps })
+}
+
+/// Writes the local transforms of one sweep value.
+fn pose_sweep(rig: &HandRig, spec: &SweepSpec, value: f32, region: &JointRegion, rest_world: &[Affine3A], locals: &mut [Transform]) -> Result<()> {
+    let model = JointModel::Full;
+    let mut pose = Pose::rest(model.dof_count());
+    match spec.motion {
+        Motion::Dof(name) => pose.angles[model.dof_index(name)?] = value.to_radians(),
+        Motion::Gesture(name) => {
+            let g = gesture(name).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))?;
+            pose = pose.interpolate(&g.pose(model), value / 100.0);
+        }
+        Motion::Twist(_) => {}
+    }
+    rig.locals(&pose, Limits::Off, locals);
+    if let Motion::Twist(bones) = spec.motion {
+        // The axis of the bone J → C, through J, in world space at rest; each twisted bone's
+        // parent is at rest, so turning it in world space is turning it in its parent's frame.
+        let [_, j, c] = region.joints;
+        let (pj, pc) = (Vec3::from(rest_world[j].translation), Vec3::from(rest_world[c].translation));
+        let turn = Affine3A::from_translation(pj) * Affine3A::from_axis_angle((pc - pj).normalize(), value.to_radians()) * Affine3A::from_translation(-pj);
+        let skeleton = rig.skeleton();
+        for name in bones {
+            let b = skeleton.index_of(name)?;
+            let parent = skeleton.joints()[b].parent.map_or(Affine3A::IDENTITY, |p| rest_world[p]);
+            let local = parent.inverse() * turn * parent * locals[b].to_affine();
+            locals[b] = Transform { scale: locals[b].scale, ..Transform::from_affine(&local) };
+        }
+    }
+    Ok(())
+}
+
+impl Report {
+    /// The sweep called `name`.
+    #[must_use]
+    pub fn sweep(&self, name: &str) -> Option<&Sweep> {
+        self.sweeps.iter().find(|s| s.name == name)
+    }
+
+    /// Everything as one JSON object: per sweep, per method, one array per measure.
+    #[must_use]
+    pub fn to_json(&self) -> Value {
+        let sweeps: serde_json::Map<String, Value> = self
+            .sweeps
+            .iter()
+            .map(|s| {
+                let mut o = json!({ "parameter": s.parameter, "values": s.values, "joint": s.joint });
+                for (m, frames) in Method::ALL.iter().zip(&s.frames) {
+                    let col = |f: fn(&FrameMetrics) -> Value| Value::Array(frames.iter().map(f).collect());
+                    o[m.as_str()] = json!({
+                        "volume": col(|f| json!(f.volume)),
+                        "min_distance": col(|f| json!(f.min_distance)),
+                        "max_distance": col(|f| json!(f.max_distance)),
+                        "section_radius": col(|f| json!(f.section_radius)),
+                        "distortion_mean": col(|f| json!(f.distortion_mean)),
+                        "distortion_max": col(|f| json!(f.distortion_max)),
+                        "jump": col(|f| json!(f.jump)),
+                    });
+                }
+                (s.name.to_owned(), o)
+            })
+            .collect();
+        json!({
+            "vertices": self.vertices,
+            "closed": self.closed.is_ok(),
+            "volume_note": self.closed.as_ref().err().map(|why| format!("volume is undefined: the mesh is not closed ({why})")),
+            "sweeps": sweeps,
+            "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2] })).collect::<Vec<_>>(),
+        })
+    }
+
+    /// Writes one CSV per sweep into `dir`: value, method, then every measure.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if a file cannot be written.
+    pub fn write_csv(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
+        for s in &self.sweeps {
+            let mut text = format!("{},method,volume,min_distance,max_distance,section_radius,distortion_mean,distortion_max,jump_m\n", s.parameter);
+            for (m, frames) in Method::ALL.iter().zip(&s.frames) {
+                for (v, f) in s.values.iter().zip(frames) {
+                    let volume = f.volume.map_or(String::new(), |x| x.to_string());
+                    let _ = writeln!(
+                        text,
+                        "{v},{m},{volume},{},{},{},{},{},{}",
+                        f.min_distance, f.max_distance, f.section_radius, f.distortion_mean, f.distortion_max, f.jump
+                    );
+                }
+            }
+            let path = dir.join(format!("{}.csv", s.name));
+            std::fs::write(&path, text).map_err(Error::io(&path))?;
+        }
+        Ok(())
+    }
+
+    /// The headline numbers: `(measure, [LB, QB, DQB])`, `None` where undefined.
+    #[must_use]
+    pub fn headline(&self) -> Vec<(String, [Option<f32>; 3])> {
+        let at = |sweep: &str, value: f32, pick: fn(&FrameMetrics) -> Option<f32>| -> [Option<f32>; 3] {
+            let s = self.sweep(sweep);
+            let i = s.and_then(|s| s.values.iter().position(|&v| v == value));
+            [0, 1, 2].map(|m| s.zip(i).and_then(|(s, i)| pick(&s.frames[m][i])))
+        };
+        let worst = |sweep: &str, pick: fn(&FrameMetrics) -> f32| -> [Option<f32>; 3] {
+            let s = self.sweep(sweep);
+            [0, 1, 2].map(|m| s.map(|s| s.frames[m].iter().map(pick).fold(0.0, f32::max)))
+        };
+        vec![
+            ("volume at 90° index PIP flexion (rest = 1)".into(), at("index-pip", 90.0, |f| f.volume)),
+            ("skin-to-bone distance at 90° PIP, smallest (collapse < 1)".into(), at("index-pip", 90.0, |f| Some(f.min_distance))),
+            ("skin-to-bone distance at 90° PIP, largest (bulge > 1)".into(), at("index-pip", 90.0, |f| Some(f.max_distance))),
+            ("largest edge-length change at 90° PIP".into(), at("index-pip", 90.0, |f| Some(f.distortion_max))),
+            ("volume in a full fist".into(), at("fist", 100.0, |f| f.volume)),
+            ("section radius at 180° PIP twist (candy wrapper < 1)".into(), at("index-pip-twist", 180.0, |f| Some(f.section_radius))),
+            ("volume at 180° wrist twist".into(), at("wrist-twist", 180.0, |f| f.volume)),
+            ("section radius at 180° wrist twist".into(), at("wrist-twist", 180.0, |f| Some(f.section_radius))),
+            ("largest frame-to-frame jump, twist 0–200° in 10° steps (mm)".into(), {
+                let j = worst("index-pip-twist", |f| f.jump);
+                j.map(|x| x.map(|m| m * 1000.0))
+            }),
+        ]
+    }
+
+    /// The headline numbers as a markdown table.
+    #[must_use]
+    pub fn markdown(&self) -> String {
+        let mut s = String::from("| measure | LB | QB | DQB |\n|---|---|---|---|\n");
+        let cell = |v: Option<f32>| v.map_or_else(|| "undefined".to_owned(), |x| format!("{x:.3}"));
+        for (label, v) in self.headline() {
+            let _ = writeln!(s, "| {label} | {} | {} | {} |", cell(v[0]), cell(v[1]), cell(v[2]));
+        }
+        s
+    }
+}
+
