@@ -38,8 +38,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let w = report.headline().iter().map(|h| h.0.chars().count()).max().unwrap_or(0);
         println!("{:<w$}  {:>9} {:>9} {:>9}", "measure", "LB", "QB", "DQB");
         for (label, v) in report.headline() {
-            let cell = |x: Option<f32>| x.map_or_else(|| "undefined".into(), |x| format!("{x:.3}"));
-            println!("{label:<w$}  {:>9} {:>9} {:>9}", cell(v[0]), cell(v[1]), cell(v[2]));
+            let [lb, qb, dqb] = v.map(dqhand::metrics::format_value);
+            println!("{label:<w$}  {lb:>9} {qb:>9} {dqb:>9}");
         }
     }
     Ok(())

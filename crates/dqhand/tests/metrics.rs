@@ -58,6 +58,8 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
     assert!(qb > 2.0 && dqb < 1.3, "QB's rotation-centre artifact: QB {qb}, DQB {dqb}");
     let [lb, _, dqb] = row("volume in a full fist");
     assert!((dqb - 1.0).abs() < (lb - 1.0).abs() + 0.01, "fist volume: LB {lb}, DQB {dqb}");
+    let fist = report.intersections.iter().find(|(g, _)| *g == "fist").unwrap().1;
+    assert!(fist[1] > 2 * fist[2], "QB tears the fist's skin through itself: {fist:?}");
     // At rest every method reproduces the mesh: ratios 1, no distortion, no jump.
     for s in &report.sweeps {
         for m in 0..3 {
@@ -80,4 +82,21 @@ fn dqb_flips_past_180_degrees_of_twist_and_the_report_shows_it() {
     assert!(dqb[flip].jump > 3.0 * others, "jump at 170→180°: {}, largest elsewhere: {others}", dqb[flip].jump);
     // The radius itself is kept all the way.
     assert!(dqb.iter().all(|f| f.section_radius > 0.9), "{dqb:?}");
+}
+
+#[test]
+fn crossing_triangles_are_counted_once_and_neighbours_never() {
+    use dqhand::metrics::count_self_intersections;
+    // Two triangles piercing each other, and a third sharing a vertex with the first.
+    let p = [
+        [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+        [0.2, 0.2, -0.5], [0.2, 0.2, 0.5], [0.3, 0.3, 0.5],
+        [1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [1.0, 1.0, 0.0],
+    ];
+    let mut i = vec![0, 1, 2, 3, 4, 5, 1, 7, 8];
+    assert_eq!(count_self_intersections(&p, &i), 1);
+    i.truncate(6);
+    let (cp, ci) = cube();
+    assert_eq!(count_self_intersections(&cp, &ci), 0);
+    assert_eq!(count_self_intersections(&p, &i), 1);
 }

@@ -1,14 +1,17 @@
 //! Realism metrics: how LB, QB and DQB deform the same hand (the paper's claim, measured).
 //!
 //! Volume against rest, collapse and bulge near a bent joint, the candy wrapper of a twisted
-//! joint, edge-length distortion and the continuity of sweeps, each for the three methods.
+//! joint, edge-length distortion, the continuity of sweeps and self-intersections in gesture
+//! poses, each for the three methods.
 
 mod closed_surface;
 mod distortion;
 mod joint_region;
 mod report;
+mod self_intersection;
 
 pub use closed_surface::{check_closed, enclosed_volume};
 pub use distortion::{edge_distortion, edges};
 pub use joint_region::JointRegion;
-pub use report::{measure, FrameMetrics, Report, Sweep};
+pub use report::{format_value, measure, FrameMetrics, Report, Sweep};
+pub use self_intersection::count_self_intersections;

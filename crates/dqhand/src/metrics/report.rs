@@ -6,7 +6,7 @@ use std::path::Path;
 use glam::{Affine3A, Vec3};
 use serde_json::{json, Value};
 
-use super::{check_closed, edge_distortion, edges, enclosed_volume, JointRegion};
+use super::{check_closed, count_self_intersections, edge_distortion, edges, enclosed_volume, JointRegion};
 use crate::gesture::gesture;
 use crate::kinematics::{forward_kinematics, HandRig, JointModel, Limits, Pose, Transform};
 use crate::model::Model;
@@ -97,7 +97,14 @@ pub struct Report {
     pub closed: std::result::Result<(), String>,
     /// The sweeps.
     pub sweeps: Vec<Sweep>,
+    /// Intersecting triangle pairs of the rest mesh.
+    pub rest_intersections: usize,
+    /// Intersecting triangle pairs per gesture, per method (in [`Method::ALL`] order).
+    pub intersections: Vec<(&'static str, [usize; 3])>,
 }
+
+/// The gestures whose self-intersections are counted.
+const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs-up"];
 
 /// Measures LB, QB and DQB on every sweep.
 ///
@@ -154,7 +161,20 @@ pub fn measure(model: &Model) -> Result<Report> {
         }
         sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
     }
-    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps })
+    let mut intersections = Vec::new();
+    for name in INTERSECTION_GESTURES {
+        let g = gesture(name).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))?;
+        rig.locals(&g.pose(JointModel::Full), Limits::Anatomical, &mut locals);
+        forward_kinematics(skeleton, &locals, &mut world);
+        skinning_transforms(&world, mesh.inverse_bind(), &mut skinning);
+        let counts = deformers.each_mut().map(|d| {
+            d.deform(mesh, &skinning, &mut out);
+            count_self_intersections(out.positions(), mesh.indices())
+        });
+        intersections.push((name, counts));
+    }
+    let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
+    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections })
 }
 
 /// Writes the local transforms of one sweep value.
@@ -222,6 +242,10 @@ impl Report {
             "closed": self.closed.is_ok(),
             "volume_note": self.closed.as_ref().err().map(|why| format!("volume is undefined: the mesh is not closed ({why})")),
             "sweeps": sweeps,
+            "self_intersections": {
+                "rest": self.rest_intersections,
+                "gestures": self.intersections.iter().map(|(g, c)| json!({ "gesture": g, "lb": c[0], "qb": c[1], "dqb": c[2] })).collect::<Vec<_>>(),
+            },
             "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2] })).collect::<Vec<_>>(),
         })
     }
@@ -262,7 +286,7 @@ impl Report {
             let s = self.sweep(sweep);
             [0, 1, 2].map(|m| s.map(|s| s.frames[m].iter().map(pick).fold(0.0, f32::max)))
         };
-        vec![
+        let mut rows: Vec<(String, [Option<f32>; 3])> = vec![
             ("volume at 90° index PIP flexion (rest = 1)".into(), at("index-pip", 90.0, |f| f.volume)),
             ("skin-to-bone distance at 90° PIP, smallest (collapse < 1)".into(), at("index-pip", 90.0, |f| Some(f.min_distance))),
             ("skin-to-bone distance at 90° PIP, largest (bulge > 1)".into(), at("index-pip", 90.0, |f| Some(f.max_distance))),
@@ -275,18 +299,31 @@ impl Report {
                 let j = worst("index-pip-twist", |f| f.jump);
                 j.map(|x| x.map(|m| m * 1000.0))
             }),
-        ]
+        ];
+        rows.extend(self.intersections.iter().map(|(g, c)| {
+            (format!("intersecting triangle pairs, {g} (rest: {})", self.rest_intersections), c.map(|n| Some(n as f32)))
+        }));
+        rows
     }
 
     /// The headline numbers as a markdown table.
     #[must_use]
     pub fn markdown(&self) -> String {
         let mut s = String::from("| measure | LB | QB | DQB |\n|---|---|---|---|\n");
-        let cell = |v: Option<f32>| v.map_or_else(|| "undefined".to_owned(), |x| format!("{x:.3}"));
         for (label, v) in self.headline() {
-            let _ = writeln!(s, "| {label} | {} | {} | {} |", cell(v[0]), cell(v[1]), cell(v[2]));
+            let _ = writeln!(s, "| {label} | {} | {} | {} |", format_value(v[0]), format_value(v[1]), format_value(v[2]));
         }
         s
     }
 }
 
+
+/// A headline value as printed: `undefined`, a count, or three decimals.
+#[must_use]
+pub fn format_value(v: Option<f32>) -> String {
+    match v {
+        None => "undefined".to_owned(),
+        Some(x) if x.fract() == 0.0 && x >= 1.0 => format!("{x}"),
+        Some(x) => format!("{x:.3}"),
+    }
+}
