@@ -25,14 +25,15 @@ pub struct JointRegion {
 impl JointRegion {
     /// The region around `joint`, whose next joint along the chain is `next`.
     ///
+    /// * `rest_world` — #joints rest world transforms of `skeleton`.
+    ///
     /// # Errors
     /// [`Error::Invalid`] if a joint is missing or has no parent, or no vertex is near it.
-    pub fn new(skeleton: &Skeleton, mesh: &SkinnedMesh, joint: &str, next: &str) -> Result<Self> {
+    pub fn new(skeleton: &Skeleton, rest_world: &[Affine3A], mesh: &SkinnedMesh, joint: &str, next: &str) -> Result<Self> {
         let j = skeleton.index_of(joint)?;
         let c = skeleton.index_of(next)?;
         let a = skeleton.joints()[j].parent.ok_or_else(|| Error::Invalid(format!("joint {joint:?} has no parent bone")))?;
-        let rest = skeleton.rest_world();
-        let (pj, pc) = (Vec3::from(rest[j].translation), Vec3::from(rest[c].translation));
+        let (pj, pc) = (Vec3::from(rest_world[j].translation), Vec3::from(rest_world[c].translation));
         let (dir, length) = ((pc - pj).normalize_or_zero(), pc.distance(pj));
         let candidates: Vec<(usize, f32, f32)> = (0..mesh.vertex_count())
             .filter(|&v| mesh.influences(v).next().is_some_and(|(h, _)| h == a || h == j))

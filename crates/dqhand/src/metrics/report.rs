@@ -8,9 +8,9 @@ use serde_json::{json, Value};
 
 use super::{check_closed, count_self_intersections, edge_distortion, edges, enclosed_volume, JointRegion};
 use crate::gesture::gesture;
-use crate::kinematics::{forward_kinematics, HandRig, JointModel, Limits, Pose, Transform};
-use crate::model::Model;
-use crate::skin::{skinning_transforms, Deformed, Deformer, Method};
+use crate::kinematics::{HandRig, JointModel, Limits, Pose, Transform};
+use crate::model::{Model, PoseBuffers};
+use crate::skin::{Deformed, Deformer, Method};
 use crate::{Error, Result};
 
 /// What one sweep moves.
@@ -121,12 +121,10 @@ pub fn measure(model: &Model) -> Result<Report> {
     let all_edges = edges(mesh.indices());
     let mut deformers = Method::ALL.map(|m| Deformer::new(m, mesh));
     let mut out = Deformed::new(mesh);
-    let mut world = rest_world.clone();
-    let mut skinning = vec![Affine3A::IDENTITY; skeleton.len()];
-    let mut locals = skeleton.rest_locals();
+    let mut frame = PoseBuffers::new(skeleton);
     let mut sweeps = Vec::new();
     for spec in specs() {
-        let region = JointRegion::new(skeleton, mesh, spec.joint, spec.next)?;
+        let region = JointRegion::new(skeleton, &rest_world, mesh, spec.joint, spec.next)?;
         let in_region = {
             let mut mark = vec![false; mesh.vertex_count()];
             region.vertices.iter().for_each(|&v| mark[v] = true);
@@ -136,13 +134,12 @@ pub fn measure(model: &Model) -> Result<Report> {
         let mut frames: [Vec<FrameMetrics>; 3] = Default::default();
         let mut previous: [Option<Vec<[f32; 3]>>; 3] = Default::default();
         for &value in &spec.values {
-            pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
-            forward_kinematics(skeleton, &locals, &mut world);
-            skinning_transforms(&world, mesh.inverse_bind(), &mut skinning);
+            pose_sweep(&rig, &spec, value, &region, &rest_world, &mut frame.locals)?;
+            frame.evaluate(skeleton, mesh.inverse_bind());
             for (m, deformer) in deformers.iter_mut().enumerate() {
-                deformer.deform(mesh, &skinning, &mut out);
+                deformer.deform(mesh, &frame.skinning, &mut out);
                 let posed = out.positions();
-                let (min_distance, max_distance) = region.distance_ratios(mesh, &rest_world, &world, posed);
+                let (min_distance, max_distance) = region.distance_ratios(mesh, &rest_world, &frame.world, posed);
                 let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
                 let jump = previous[m].as_ref().map_or(0.0, |p| {
                     p.iter().zip(posed).map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b))).fold(0.0, f32::max)
@@ -151,7 +148,7 @@ pub fn measure(model: &Model) -> Result<Report> {
                     volume: rest_volume.map(|v0| (enclosed_volume(posed, mesh.indices()) / v0) as f32),
                     min_distance,
                     max_distance,
-                    section_radius: region.section_radius(&world, posed),
+                    section_radius: region.section_radius(&frame.world, posed),
                     distortion_mean,
                     distortion_max,
                     jump,
@@ -163,18 +160,21 @@ pub fn measure(model: &Model) -> Result<Report> {
     }
     let mut intersections = Vec::new();
     for name in INTERSECTION_GESTURES {
-        let g = gesture(name).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))?;
-        rig.locals(&g.pose(JointModel::Full), Limits::Anatomical, &mut locals);
-        forward_kinematics(skeleton, &locals, &mut world);
-        skinning_transforms(&world, mesh.inverse_bind(), &mut skinning);
+        rig.locals(&library_pose(name)?, Limits::Anatomical, &mut frame.locals);
+        let skinning = frame.evaluate(skeleton, mesh.inverse_bind());
         let counts = deformers.each_mut().map(|d| {
-            d.deform(mesh, &skinning, &mut out);
+            d.deform(mesh, skinning, &mut out);
             count_self_intersections(out.positions(), mesh.indices())
         });
         intersections.push((name, counts));
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
     Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections })
+}
+
+/// A gesture of the library as a `full`-model pose.
+fn library_pose(name: &str) -> Result<Pose> {
+    gesture(name).map(|g| g.pose(JointModel::Full)).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))
 }
 
 /// Writes the local transforms of one sweep value.
@@ -184,8 +184,7 @@ fn pose_sweep(rig: &HandRig, spec: &SweepSpec, value: f32, region: &JointRegion,
     match spec.motion {
         Motion::Dof(name) => pose.angles[model.dof_index(name)?] = value.to_radians(),
         Motion::Gesture(name) => {
-            let g = gesture(name).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))?;
-            pose = pose.interpolate(&g.pose(model), value / 100.0);
+            pose = pose.interpolate(&library_pose(name)?, value / 100.0);
         }
         Motion::Twist(_) => {}
     }
