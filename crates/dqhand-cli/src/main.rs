@@ -5,6 +5,7 @@
 
 mod bench;
 mod demo;
+mod hand;
 mod info;
 mod metrics;
 mod skin;
@@ -24,6 +25,8 @@ struct Cli {
 enum Command {
     /// Print meshes, vertex and triangle counts, the skeleton tree and influences per vertex.
     Info(info::Args),
+    /// Build the anatomical hand for given measurements and write it as a rigged glTF.
+    Hand(hand::Args),
     /// Pose a mesh with LB, QB or DQB and write it with normals (.ply, .obj or .glb).
     Skin(skin::Args),
     /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
@@ -39,6 +42,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
+        Command::Hand(a) => hand::run(&a),
         Command::Skin(a) => skin::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Demo(a) => demo::run(&a),

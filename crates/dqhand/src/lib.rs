@@ -5,7 +5,8 @@
 //! * [`math`] — dual quaternions and screws on top of glam;
 //! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
 //! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
-//! * [`hand`] — the built-in hand;
+//! * [`collision`] — collision proxies per bone (paper 4.2);
+//! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
 //! * [`model`] — a skeleton and its skinned mesh, posed frame by frame.
 //!
@@ -13,6 +14,7 @@
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names.
 
 mod error;
+pub mod collision;
 pub mod gesture;
 pub mod hand;
 pub mod io;

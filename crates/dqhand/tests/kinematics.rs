@@ -36,6 +36,9 @@ fn tip_in_finger_plane(world: &[Affine3A], tip: usize) -> (f32, f32) {
     (-p.y, -p.z)
 }
 
+/// The built-in hand, built once for the property test's many cases.
+static BUILT_IN: std::sync::LazyLock<dqhand::model::Model> = std::sync::LazyLock::new(|| build(&HandParams::default()).unwrap());
+
 proptest! {
     #[test]
     fn fingertip_matches_paper_equation_1(
@@ -58,7 +61,7 @@ proptest! {
 
     #[test]
     fn built_in_index_finger_matches_equation_1(t in (0.0f32..1.5, 0.0f32..1.9, 0.0f32..1.5)) {
-        let model = build(&HandParams::default()).unwrap();
+        let model = &*BUILT_IN;
         let rig = HandRig::new(&model.skeleton, JointModel::Paper).unwrap();
         let names = ["index-finger-phalanx-proximal", "index-finger-phalanx-intermediate", "index-finger-phalanx-distal", "index-finger-tip"];
         let idx: Vec<usize> = names.iter().map(|n| model.skeleton.find(n).unwrap()).collect();

@@ -1,14 +1,146 @@
-//! The built-in hand.
+//! The built-in anatomical hand: a parametric left or right hand from two measurements.
 //!
-//! For now a **procedural placeholder**: one tube per finger and an elliptic palm tube on the
-//! anatomical 20-bone skeleton, 8,668 vertices like the paper's Table 2 so that benchmarks
-//! run on the paper's workload. The parts are separate closed surfaces, not one watertight
-//! anatomical skin; the anatomical hand replaces this module in its own issue.
+//! The pipeline, one file each:
+//! * [`anthropometry`]: the 20-bone skeleton (25 WebXR joints with the tips) and the finger
+//!   breadths, as fractions of hand length and breadth from published anthropometry;
+//! * [`shape`]: the skin as an implicit surface: anatomical parts per bone (phalanges with
+//!   knuckles, pads and nails, metacarpals forming a palm that narrows to the wrist, thenar
+//!   and hypothenar eminences) blended by smooth minima;
+//! * [`tessellation`]: that surface meshed (surface nets), simplified to an exact vertex count
+//!   (meshoptimizer), relaxed and projected back onto the surface: one closed, 2-manifold
+//!   mesh, 8,668 vertices by default (the paper's Table 2);
+//! * [`weights`]: skin weights from each bone's parts, at most four per vertex.
 //!
-//! Proportions: segment lengths as fractions of hand length from Buchholz, Armstrong and
-//! Goldstein 1992 ("Anthropometric data for describing the kinematics of the human hand",
-//! Ergonomics 35:261), finger spacing and widths as fractions of hand breadth.
+//! UVs are a planar projection onto the palm plane (u across the hand, v along it), the same
+//! for the back and the palm: seamless, so glTF's vertex count is the mesh's.
 
-mod placeholder;
+mod anthropometry;
+mod shape;
+mod tessellation;
+mod weights;
 
-pub use placeholder::{build, HandParams, Side};
+use glam::{Affine3A, Vec3};
+
+use crate::kinematics::webxr;
+use crate::model::Model;
+use crate::skin::{MeshData, SkinnedMesh};
+use crate::{Error, Result};
+use anthropometry::Anatomy;
+use shape::HandShape;
+
+/// The paper's vertex count (its Table 2), the built-in hand's default density.
+pub const DEFAULT_VERTICES: usize = 8_668;
+/// Densities [`build`] accepts.
+pub const VERTEX_RANGE: core::ops::RangeInclusive<usize> = 1_000..=60_000;
+
+/// Which hand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Side {
+    /// Left hand: the thumb on +X when the palm faces down and the fingers point along −Z.
+    Left,
+    /// Right hand: the thumb on −X.
+    #[default]
+    Right,
+}
+
+impl Side {
+    /// `"left"` or `"right"`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+}
+
+/// What the user gives: two measurements, the side and the level of detail.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HandParams {
+    /// Wrist crease to middle fingertip (m); adult default 0.19.
+    pub length: f32,
+    /// Across the metacarpal heads (m); adult default 0.085.
+    pub breadth: f32,
+    /// Left or right.
+    pub side: Side,
+    /// Vertices of the mesh, in [`VERTEX_RANGE`]; default [`DEFAULT_VERTICES`].
+    pub vertices: usize,
+}
+
+impl Default for HandParams {
+    fn default() -> Self {
+        Self { length: 0.19, breadth: 0.085, side: Side::Right, vertices: DEFAULT_VERTICES }
+    }
+}
+
+impl HandParams {
+    /// Checks that the parameters describe a hand.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the parameter: a measurement that is not positive and finite,
+    /// a breadth outside 30–75 % of the length (hands measure 40–50 %), a vertex count
+    /// outside [`VERTEX_RANGE`].
+    pub fn validate(&self) -> Result<()> {
+        let Self { length: l, breadth: b, vertices, .. } = *self;
+        if !(l.is_finite() && l > 0.0) {
+            return Err(Error::Invalid(format!("hand length {l} m is not a positive length")));
+        }
+        if !(b.is_finite() && b > 0.0) {
+            return Err(Error::Invalid(format!("hand breadth {b} m is not a positive length")));
+        }
+        if !(0.3 * l..=0.75 * l).contains(&b) {
+            return Err(Error::Invalid(format!(
+                "hand breadth {b} m is {:.0} % of the length {l} m; hands measure 40–50 % (30–75 % accepted)",
+                100.0 * b / l
+            )));
+        }
+        if !VERTEX_RANGE.contains(&vertices) {
+            return Err(Error::Invalid(format!(
+                "{vertices} vertices is outside the supported density {}–{}",
+                VERTEX_RANGE.start(),
+                VERTEX_RANGE.end()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Builds the hand: skeleton, skin mesh with normals and UVs, skin weights.
+///
+/// # Errors
+/// [`Error::Invalid`] for parameters [`HandParams::validate`] rejects, or (not expected at
+/// supported densities) a surface that fails to mesh as a closed surface of that many vertices.
+pub fn build(params: &HandParams) -> Result<Model> {
+    params.validate()?;
+    let HandParams { length: l, breadth: b, side, vertices } = *params;
+    let radial = Vec3::X * if side == Side::Right { -1.0 } else { 1.0 };
+    let anatomy = Anatomy::new(l, b, radial);
+    let skeleton = anatomy.skeleton()?;
+    let shape = HandShape::new(&anatomy);
+    let surface = tessellation::tessellate(&shape, vertices)?;
+    let sigma: Vec<f32> = webxr::JOINT_NAMES.iter().map(|n| if n.contains("phalanx") { 0.016 * b } else { 0.04 * b }).collect();
+    let (joints, weights) = weights::skin_weights(&shape, &surface.positions, &sigma);
+    let uvs = surface
+        .positions
+        .iter()
+        .map(|p| [0.5 + radial.x * p[0] / (1.2 * b), -p[2] / (1.1 * l)])
+        .collect();
+    let data = MeshData {
+        positions: surface.positions,
+        normals: surface.normals,
+        uvs,
+        stride: weights::INFLUENCES,
+        joints,
+        weights,
+        indices: surface.indices,
+        parts: Vec::new(),
+        inverse_bind: anatomy.frames.iter().map(Affine3A::inverse).collect(),
+    };
+    let (mesh, warnings) = SkinnedMesh::new(data)?;
+    Ok(Model {
+        description: format!("anatomical {} hand, length {l} m, breadth {b} m, {vertices} vertices", side.name()),
+        skeleton,
+        mesh,
+        warnings,
+    })
+}

@@ -6,6 +6,7 @@ use std::path::Path;
 use serde_json::{json, Value};
 
 use super::{check_lengths, write_bytes};
+use crate::collision::ProxyShape;
 use crate::model::Model;
 use crate::Result;
 
@@ -103,7 +104,10 @@ fn skin_material() -> Value {
 /// Writes the model as a rigged, skinned GLB in its rest pose, which three.js and Blender load
 /// and animate: the joint hierarchy as nodes (rest TRS), one skin with the inverse bind
 /// matrices, one primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
-/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences).
+/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences). Each joint node with
+/// vertices of its own carries its collision proxy ([`crate::collision::fit_proxies`]) in the
+/// node's frame as `extras.dqhand_collision`: `{"capsule": {"start", "end", "radius"}}` or
+/// `{"convex_hull": {"points", "triangles"}}`.
 ///
 /// # Errors
 /// [`crate::Error::Io`] if the file cannot be written.
@@ -141,6 +145,7 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
     let ibm = glb.floats(&ibm, "MAT4", None);
 
     let joints = skeleton.joints();
+    let proxies = crate::collision::fit_proxies(model, crate::collision::PROXY_MARGIN);
     let mut nodes: Vec<Value> = joints
         .iter()
         .enumerate()
@@ -156,6 +161,9 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
             let children: Vec<usize> = (0..joints.len()).filter(|&c| joints[c].parent == Some(i)).collect();
             if !children.is_empty() {
                 node["children"] = json!(children);
+            }
+            if let Some(proxy) = proxies.iter().find(|p| p.joint == i) {
+                node["extras"] = json!({ "dqhand_collision": proxy_json(&proxy.shape) });
             }
             node
         })
@@ -173,6 +181,18 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
         "skins": [{ "name": "hand", "inverseBindMatrices": ibm, "joints": (0..joints.len()).collect::<Vec<_>>(), "skeleton": roots[0] }],
     });
     write_bytes(path, &glb.finish(doc))
+}
+
+fn proxy_json(shape: &ProxyShape) -> Value {
+    match shape {
+        ProxyShape::Capsule { start, end, radius } => {
+            json!({ "capsule": { "start": start.to_array(), "end": end.to_array(), "radius": radius } })
+        }
+        ProxyShape::ConvexHull { points, triangles } => {
+            let points: Vec<[f32; 3]> = points.iter().map(|p| p.to_array()).collect();
+            json!({ "convex_hull": { "points": points, "triangles": triangles } })
+        }
+    }
 }
 
 /// Writes a posed static mesh (positions, normals, texture coordinates if any) as GLB.

@@ -20,6 +20,10 @@ pub struct JointRegion {
     pub vertices: Vec<usize>,
     /// The skin radius at the joint in the rest pose (m).
     pub radius: f32,
+    /// The smallest distance of the region's vertices from the axis of `J → C` at rest (m):
+    /// the reference of [`Self::section_radius`] (less than `radius` where the section is
+    /// not round).
+    pub min_radius: f32,
 }
 
 impl JointRegion {
@@ -46,8 +50,10 @@ impl JointRegion {
         let mut radial: Vec<f32> = candidates.iter().filter(|c| (0.0..0.5 * length).contains(&c.1)).map(|c| c.2).collect();
         radial.sort_by(f32::total_cmp);
         let radius = *radial.get(radial.len() / 2).ok_or_else(|| Error::Invalid(format!("no skin around joint {joint:?}")))?;
-        let vertices = candidates.iter().filter(|c| c.1.abs() <= radius).map(|c| c.0).collect();
-        Ok(Self { joints: [a, j, c], vertices, radius })
+        let region: Vec<&(usize, f32, f32)> = candidates.iter().filter(|c| c.1.abs() <= radius).collect();
+        let min_radius = region.iter().map(|c| c.2).fold(f32::MAX, f32::min);
+        let vertices = region.iter().map(|c| c.0).collect();
+        Ok(Self { joints: [a, j, c], vertices, radius, min_radius })
     }
 
     /// Smallest and largest ratio, over the region, of a vertex's distance to the two bones
@@ -67,7 +73,7 @@ impl JointRegion {
     }
 
     /// The smallest distance of the region's vertices from the axis of the bone `J → C`
-    /// posed, relative to the rest radius: the candy-wrapper measure for a twisted joint.
+    /// posed, relative to the same at rest: the candy-wrapper measure for a twisted joint.
     #[must_use]
     pub fn section_radius(&self, world: &[Affine3A], positions: &[[f32; 3]]) -> f32 {
         let (pj, pc) = (Vec3::from(world[self.joints[1]].translation), Vec3::from(world[self.joints[2]].translation));
@@ -76,7 +82,7 @@ impl JointRegion {
             let d = Vec3::from(positions[v]) - pj;
             (d - d.dot(dir) * dir).length()
         });
-        min.fold(f32::MAX, f32::min) / self.radius
+        min.fold(f32::MAX, f32::min) / self.min_radius.max(1e-9)
     }
 }
 

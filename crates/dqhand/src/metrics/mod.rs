@@ -10,7 +10,7 @@ mod joint_region;
 mod report;
 mod self_intersection;
 
-pub use closed_surface::{check_closed, enclosed_volume};
+pub use closed_surface::{check_closed, enclosed_volume, winding_number};
 pub use distortion::{edge_distortion, edges};
 pub use joint_region::JointRegion;
 pub use report::{format_value, measure, FrameMetrics, Report, Sweep};
