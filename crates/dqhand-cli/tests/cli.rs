@@ -70,7 +70,7 @@ const BUILTIN_VERTICES: usize = 8668;
 #[test]
 fn help_works_for_every_command() {
     let top = run_ok(&["--help"]);
-    for sub in ["info", "skin", "bench", "demo", "metrics"] {
+    for sub in ["info", "hand", "skin", "bench", "demo", "metrics"] {
         assert!(top.contains(sub), "top-level help does not list {sub}:\n{top}");
         let help = run_ok(&[sub, "--help"]);
         assert!(help.contains("Usage"), "`dqhand {sub} --help`:\n{help}");
@@ -86,10 +86,10 @@ fn help_works_for_every_command() {
 // ---------------------------------------------------------------------------------------------
 
 #[test]
-fn info_builtin_describes_the_placeholder_hand() {
+fn info_builtin_describes_the_anatomical_hand() {
     let out = run_ok(&["info", "builtin"]);
     assert!(out.contains(&BUILTIN_VERTICES.to_string()), "no vertex count {BUILTIN_VERTICES}:\n{out}");
-    assert!(out.contains("placeholder"), "{out}");
+    assert!(out.contains("anatomical right hand"), "{out}");
     for joint in dqhand::kinematics::webxr::JOINT_NAMES {
         assert!(out.contains(joint), "joint {joint} not listed:\n{out}");
     }
@@ -102,6 +102,61 @@ fn info_reads_an_exported_glb() {
     dqhand::io::write_skinned_glb(&dqhand::hand::build(&Default::default()).unwrap(), &hand).unwrap();
     let out = run_ok(&["info", &path_arg(&hand)]);
     assert!(out.contains("hand.glb") && out.contains(&BUILTIN_VERTICES.to_string()), "{out}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// hand
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn hand_writes_a_rigged_hand_of_the_users_size_with_collision_proxies() {
+    let dir = temp_dir("hand");
+    let out = dir.join("left.glb");
+    let printed = run_ok(&["hand", "--length", "0.17", "--breadth", "0.075", "--side", "left", "--vertices", "2000", "--out", &path_arg(&out)]);
+    assert!(printed.contains("left hand") && printed.contains("2000 vertices"), "{printed}");
+    let model = dqhand::io::load_gltf(&out).unwrap();
+    assert_eq!(model.mesh.vertex_count(), 2000);
+    dqhand::metrics::check_closed(model.mesh.indices()).unwrap();
+    // A left hand has its thumb on +X; the hand is 0.17 m from the wrist crease to the tip.
+    let thumb_tip = model.skeleton.rest_world()[model.skeleton.find("thumb-tip").unwrap()].translation;
+    assert!(thumb_tip.x > 0.0, "{thumb_tip}");
+    let reach = (0..model.mesh.vertex_count()).map(|v| -model.mesh.position(v).z).fold(0.0, f32::max);
+    assert!((reach / 0.17 - 1.0).abs() < 0.04, "{reach}");
+    // Every bone with skin carries a proxy: capsules on the phalanges, hulls on the palm.
+    let doc: Value = serde_json::from_slice(&glb_json(&std::fs::read(&out).unwrap())).unwrap();
+    let proxy = |name: &str| {
+        let node = doc["nodes"].as_array().unwrap().iter().find(|n| n["name"] == name).unwrap();
+        node["extras"]["dqhand_collision"].clone()
+    };
+    let capsule = proxy("index-finger-phalanx-intermediate");
+    let radius = capsule["capsule"]["radius"].as_f64().unwrap();
+    assert!((0.005..0.015).contains(&radius), "{capsule}");
+    assert!(proxy("wrist")["convex_hull"]["points"].as_array().unwrap().len() >= 4);
+    assert!(proxy("index-finger-tip").is_null(), "tips have no skin of their own");
+}
+
+#[test]
+fn hand_refuses_implausible_measurements() {
+    let dir = temp_dir("hand-bad");
+    let out = path_arg(&dir.join("bad.glb"));
+    for (args, words) in [
+        (vec!["--length", "0"], "length"),
+        (vec!["--length=-0.2"], "length"),
+        (vec!["--breadth", "0.3"], "breadth"),
+        (vec!["--vertices", "0"], "vertices"),
+    ] {
+        let mut all = vec!["hand", "--out", &out];
+        all.extend(args.iter().copied());
+        let err = run_error(&all);
+        assert!(err.contains(words), "{args:?}: {err}");
+    }
+    assert!(!dir.join("bad.glb").exists(), "nothing written on error");
+}
+
+/// The JSON chunk of a GLB.
+fn glb_json(bytes: &[u8]) -> Vec<u8> {
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    bytes[20..20 + len].to_vec()
 }
 
 // ---------------------------------------------------------------------------------------------
