@@ -52,28 +52,26 @@ const PINKY_FIST: [(&str, f32); 3] = curl!("pinky-finger", 88.0, 95.0, 60.0);
 const CUP: [(&str, f32); 2] = [("ring-finger-metacarpal.flex", 8.0), ("pinky-finger-metacarpal.flex", 15.0)];
 /// The thumb folded over the middle phalanges of the curled fingers.
 const THUMB_OVER: [(&str, f32); 4] = [
-    ("thumb-metacarpal.abd", 35.0),
-    ("thumb-metacarpal.flex", 30.0),
-    ("thumb-phalanx-proximal.flex", 45.0),
-    ("thumb-phalanx-distal.flex", 30.0),
+    ("thumb-metacarpal.abd", 10.0),
+    ("thumb-metacarpal.flex", 10.0),
+    ("thumb-phalanx-proximal.flex", 30.0),
+    ("thumb-phalanx-distal.flex", 75.0),
 ];
 /// The thumb tucked against the side of the palm, as when counting on the fingers.
 const THUMB_IN: [(&str, f32); 4] = [
-    ("thumb-metacarpal.abd", 10.0),
-    ("thumb-metacarpal.flex", 45.0),
-    ("thumb-phalanx-proximal.flex", 50.0),
-    ("thumb-phalanx-distal.flex", 40.0),
+    ("thumb-metacarpal.abd", -10.0),
+    ("thumb-metacarpal.flex", 5.0),
+    ("thumb-phalanx-proximal.flex", 55.0),
+    ("thumb-phalanx-distal.flex", 70.0),
 ];
 const THUMB_OUT: [(&str, f32); 3] =
     [("thumb-metacarpal.abd", 20.0), ("thumb-metacarpal.flex", -15.0), ("thumb-phalanx-distal.flex", -10.0)];
 
 const OK_INDEX: [(&str, f32); 3] = curl!("index-finger", 45.0, 65.0, 35.0);
-const OK_THUMB: [(&str, f32); 4] = [
-    ("thumb-metacarpal.abd", 45.0),
-    ("thumb-metacarpal.flex", 25.0),
-    ("thumb-phalanx-proximal.flex", 20.0),
-    ("thumb-phalanx-distal.flex", 25.0),
-];
+/// The thumb pad on the index pad (angles from a grid search over the thumb's DOFs for the two
+/// tips 16 mm apart on the built-in hand; the same for `PINCH_THUMB`).
+const OK_THUMB: [(&str, f32); 3] =
+    [("thumb-metacarpal.flex", 30.0), ("thumb-phalanx-proximal.flex", -5.0), ("thumb-phalanx-distal.flex", 50.0)];
 const OK_OTHERS: [(&str, f32); 5] = [
     ("middle-finger-phalanx-proximal.flex", 15.0),
     ("middle-finger-phalanx-proximal.abd", -5.0),
@@ -82,12 +80,11 @@ const OK_OTHERS: [(&str, f32); 5] = [
     ("pinky-finger-phalanx-proximal.abd", 15.0),
 ];
 const PINCH_INDEX: [(&str, f32); 3] = curl!("index-finger", 40.0, 45.0, 20.0);
-const PINCH_THUMB: [(&str, f32); 5] = [
-    ("thumb-metacarpal.abd", 50.0),
-    ("thumb-metacarpal.flex", 20.0),
-    ("thumb-phalanx-proximal.flex", 15.0),
+const PINCH_THUMB: [(&str, f32); 4] = [
+    ("thumb-metacarpal.flex", 35.0),
+    ("thumb-phalanx-proximal.flex", -5.0),
     ("thumb-phalanx-proximal.abd", 5.0),
-    ("thumb-phalanx-distal.flex", 15.0),
+    ("thumb-phalanx-distal.flex", 10.0),
 ];
 const PINCH_OTHERS: [(&str, f32); 6] = [
     ("middle-finger-phalanx-proximal.flex", 30.0),

@@ -11,7 +11,8 @@
 //! * joint centres at mid-depth of the finger; the metacarpal heads spread across 65 % of the
 //!   hand breadth, their bases (CMC) converge to 40 % of that; the relaxed spread of the
 //!   fingers (index 9° radial … little 15° ulnar) leaves a gap between them at rest, the pose
-//!   a hand is modelled and rigged in.
+//!   a hand is modelled and rigged in; the thumb's dorsal axis points mostly radially (a relaxed
+//!   thumbnail faces sideways), so that its flexion carries it across the palm.
 
 use glam::{Affine3A, Mat3, Quat, Vec3};
 
@@ -72,7 +73,7 @@ impl Anatomy {
             let first = if f == 0 { 1 } else { 5 * f };
             let (base, dirs, up) = if f == 0 {
                 let dir = (radial * 0.55 - Vec3::Y * 0.2 - Vec3::Z * 0.8).normalize();
-                let up = (radial * 0.7 + Vec3::Y * 0.7).normalize();
+                let up = (radial * 0.85 + Vec3::Y * 0.5).normalize();
                 (radial * 0.2 * b - Vec3::Y * 0.14 * b - Vec3::Z * 0.06 * l, [dir, dir], up)
             } else {
                 let mcp_x = radial * MCP_ACROSS[f - 1] * b;

@@ -118,6 +118,7 @@ pub fn build(params: &HandParams) -> Result<Model> {
     let skeleton = anatomy.skeleton()?;
     let shape = HandShape::new(&anatomy);
     let surface = tessellation::tessellate(&shape, vertices)?;
+    // Falloff lengths: short across the finger joints, long on the palm.
     let sigma: Vec<f32> = webxr::JOINT_NAMES.iter().map(|n| if n.contains("phalanx") { 0.016 * b } else { 0.04 * b }).collect();
     let (joints, weights) = weights::skin_weights(&shape, &surface.positions, &sigma);
     let uvs = surface

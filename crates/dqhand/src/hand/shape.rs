@@ -229,7 +229,7 @@ impl HandShape {
             let (c, r) = p.bounding;
             [lo.min(c - r - pad), hi.max(c + r + pad)]
         });
-        Self { parts, web: 0.09 * b, between: 0.03 * b, bounds, finest_feature: 0.011 * b }
+        Self { parts, web: 0.09 * b, between: 0.045 * b, bounds, finest_feature: 0.011 * b }
     }
 
     /// Signed distance from `p` to the skin (negative inside).
