@@ -48,11 +48,10 @@ struct Part {
 }
 
 impl Solid {
-    /// Radius of a sphere around the solid, centred on its frame's origin (a round cone's
-    /// is centred on its axis' midpoint instead; see `HandShape::new`).
+    /// Radius of a sphere around the solid, centred on its frame's origin.
     fn extent(&self) -> f32 {
         match *self {
-            Solid::RoundCone { len, ra, rb } => 0.5 * len + ra.max(rb),
+            Solid::RoundCone { len, ra, rb } => len + ra.max(rb),
             Solid::Ellipsoid { radii } => radii.max_element(),
         }
     }
@@ -140,6 +139,7 @@ impl HandShape {
             let to_world = Affine3A::from_mat3_translation(glam::Mat3::from_cols(x, z.cross(x), z), a);
             Part {
                 to_local: to_world.inverse(),
+                // Tighter than `Solid::extent`: centred on the axis' midpoint.
                 bounding: (a.lerp(c, 0.5), 0.5 * a.distance(c) + ra.max(rb)),
                 squash,
                 solid: Solid::RoundCone { len: a.distance(c), ra, rb },
