@@ -10,6 +10,7 @@
 
 use glam::{Affine3A, Vec3};
 
+use crate::math::segment_distance;
 use crate::model::Model;
 
 /// How far proxies stand off the skin (m): enough that contact is detected before the skin
@@ -61,7 +62,7 @@ pub fn fit_proxies(model: &Model, margin: f32) -> Vec<Proxy> {
                     let end = to_local.transform_point3(world[c].translation.into());
                     let radius = vs
                         .iter()
-                        .map(|&v| distance_to_segment(to_local.transform_point3(mesh.position(v)), Vec3::ZERO, end))
+                        .map(|&v| segment_distance(to_local.transform_point3(mesh.position(v)), Vec3::ZERO, end))
                         .fold(0.0, f32::max);
                     ProxyShape::Capsule { start: Vec3::ZERO, end, radius: radius + margin }
                 }
@@ -72,7 +73,7 @@ pub fn fit_proxies(model: &Model, margin: f32) -> Vec<Proxy> {
                         // Fewer than four points, or all in a plane: a capsule around them.
                         Err(_) => {
                             let far = points.iter().copied().fold(Vec3::ZERO, |a, p| if p.length() > a.length() { p } else { a });
-                            let radius = points.iter().map(|&p| distance_to_segment(p, Vec3::ZERO, far)).fold(0.0, f32::max);
+                            let radius = points.iter().map(|&p| segment_distance(p, Vec3::ZERO, far)).fold(0.0, f32::max);
                             ProxyShape::Capsule { start: Vec3::ZERO, end: far, radius: radius + margin }
                         }
                     }
@@ -81,10 +82,4 @@ pub fn fit_proxies(model: &Model, margin: f32) -> Vec<Proxy> {
             Proxy { joint: j, shape }
         })
         .collect()
-}
-
-fn distance_to_segment(p: Vec3, a: Vec3, b: Vec3) -> f32 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 { ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
-    p.distance(a + ab * t)
 }

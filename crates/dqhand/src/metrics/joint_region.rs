@@ -4,6 +4,7 @@
 use glam::{Affine3A, Vec3};
 
 use crate::kinematics::Skeleton;
+use crate::math::segment_distance;
 use crate::skin::SkinnedMesh;
 use crate::{Error, Result};
 
@@ -84,11 +85,4 @@ impl JointRegion {
         });
         min.fold(f32::MAX, f32::min) / self.min_radius.max(1e-9)
     }
-}
-
-/// Distance from `x` to the segment `a`–`b`.
-fn segment_distance(x: Vec3, a: Vec3, b: Vec3) -> f32 {
-    let ab = b - a;
-    let t = ((x - a).dot(ab) / ab.length_squared().max(1e-18)).clamp(0.0, 1.0);
-    x.distance(a + t * ab)
 }
