@@ -1,35 +1,138 @@
-//! `dqhand demo`: the built-in hand posed through the gesture library with LB, QB and DQB.
+//! `dqhand demo`: the live viewer (a local server for the browser page), or with `--out` the
+//! gesture library posed with LB, QB and DQB and written as files.
 
-use std::path::PathBuf;
+use std::net::{IpAddr, SocketAddr, TcpListener};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
+use anyhow::{bail, Context};
 use dqhand::gesture::GESTURES;
 use dqhand::io::{PoseFile, PoseTarget};
 use dqhand::kinematics::{JointModel, Limits};
 use dqhand::skin::{Deformed, Deformer, Method};
 
+use crate::server;
+
 /// Arguments of `dqhand demo`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Directory for the posed meshes, the pose files and the rigged hand.
-    #[arg(long, default_value = "out/demo")]
-    out: PathBuf,
+    /// Address to listen on. The default serves this machine only; 0.0.0.0 shares the viewer
+    /// with the network (anyone who can reach it can watch and pose the hand).
+    #[arg(long, default_value = "127.0.0.1")]
+    host: IpAddr,
+    /// Port to listen on (0: any free port; the URL printed says which).
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// Do not open a browser.
+    #[arg(long)]
+    no_open: bool,
+    /// Frames per second streamed to each viewer.
+    #[arg(long, default_value_t = 120.0, value_parser = parse_fps)]
+    fps: f64,
+    /// Joint model of the sliders at start (`paper` 18 DOF or `full` 23 DOF).
+    #[arg(long, default_value = "full")]
+    joint_model: JointModel,
+    /// The hand: `builtin` or a skinned glTF with WebXR joint names.
+    #[arg(long, default_value = "builtin")]
+    model: String,
+    /// The built page (default: viewer/dist of this checkout).
+    #[arg(long)]
+    viewer: Option<PathBuf>,
+    /// Instead of serving, write the gesture library posed with LB, QB and DQB (GLB), its
+    /// pose files and the rigged hand into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+fn parse_fps(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(f) if (1.0..=1000.0).contains(&f) => Ok(f),
+        _ => Err(format!("{s:?} is not a frame rate from 1 to 1000")),
+    }
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if let Some(out) = &args.out {
+        return write_gestures(out);
+    }
+    let assets = viewer_dir(args.viewer.as_deref())?;
+    let model = dqhand::io::load_model(&args.model)?;
+    crate::warn_all(&model.warnings);
+    let address = SocketAddr::new(args.host, args.port);
+    let listener = TcpListener::bind(address).with_context(|| format!("cannot listen on {address} (try another --port)"))?;
+    let bound = listener.local_addr()?;
+    let url = format!("http://{}/", if bound.ip().is_unspecified() { SocketAddr::new([127, 0, 0, 1].into(), bound.port()) } else { bound });
+    println!("{}", model.description);
+    if bound.ip().is_loopback() {
+        println!("listening on {bound}, this machine only (--host 0.0.0.0 to share with the network)");
+    } else {
+        println!("listening on {bound}: anyone who can reach this machine can watch and pose the hand");
+    }
+    println!("viewer: {url}");
+    println!("press Ctrl-C to stop");
+    if !args.no_open {
+        open_browser(&url);
+    }
+    let shared = server::Shared { model: Arc::new(model), joint_model: args.joint_model, assets, fps: args.fps };
+    server::serve(listener, shared)?;
+    Ok(())
+}
+
+/// The built page: `--viewer`, else `viewer/dist` here or in this checkout.
+fn viewer_dir(given: Option<&Path>) -> anyhow::Result<PathBuf> {
+    let candidates: Vec<PathBuf> = match given {
+        Some(p) => vec![p.into()],
+        None => vec!["viewer/dist".into(), Path::new(env!("CARGO_MANIFEST_DIR")).join("../../viewer/dist")],
+    };
+    for c in &candidates {
+        if c.join("index.html").is_file() {
+            return c.canonicalize().with_context(|| c.display().to_string());
+        }
+    }
+    match given {
+        Some(p) => bail!("{}: no index.html (give the directory of the built viewer)", p.display()),
+        None => bail!("the viewer is not built (no viewer/dist/index.html): run `make viewer` or `make demo`"),
+    }
+}
+
+/// Opens `url` in the desktop's browser when there is a desktop; otherwise the printed URL
+/// is all there is.
+fn open_browser(url: &str) {
+    let has_display = cfg!(any(target_os = "macos", windows))
+        || std::env::var_os("DISPLAY").is_some()
+        || std::env::var_os("WAYLAND_DISPLAY").is_some();
+    if !has_display {
+        println!("(no display: open the URL in a browser)");
+        return;
+    }
+    let opener = if cfg!(target_os = "macos") { "open" } else if cfg!(windows) { "explorer" } else { "xdg-open" };
+    let spawned = std::process::Command::new(opener)
+        .arg(url)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+    if spawned.is_err() {
+        println!("(could not start {opener}: open the URL in a browser)");
+    }
+}
+
+/// `--out`: every gesture posed with each method, as GLB and pose files, and the rigged hand.
+fn write_gestures(out: &Path) -> anyhow::Result<()> {
     let model = dqhand::io::load_model("builtin")?;
-    std::fs::create_dir_all(&args.out).map_err(|e| anyhow::anyhow!("{}: {e}", args.out.display()))?;
-    let rigged = args.out.join("hand.glb");
+    std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
+    let rigged = out.join("hand.glb");
     dqhand::io::write_skinned_glb(&model, &rigged)?;
     println!("{}", model.description);
     println!("rigged, skinned hand: {}", rigged.display());
     let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, &model.mesh)).collect();
-    let mut out = Deformed::new(&model.mesh);
+    let mut posed = Deformed::new(&model.mesh);
     println!("{:<10} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs");
     for (i, g) in GESTURES.iter().enumerate() {
         let pose = g.pose(JointModel::Full);
         let stem = format!("{i:02}-{}", g.name);
-        let pose_path = args.out.join(format!("{stem}.pose.json"));
+        let pose_path = out.join(format!("{stem}.pose.json"));
         let file = PoseFile::from_pose(JointModel::Full, &pose);
         std::fs::write(&pose_path, serde_json::to_string_pretty(&file)?).map_err(|e| anyhow::anyhow!("{}: {e}", pose_path.display()))?;
         let target = PoseTarget::Angles { model: JointModel::Full, pose };
@@ -38,10 +141,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let mut times = Vec::new();
         for d in &mut deformers {
             let t = Instant::now();
-            d.deform(&model.mesh, &skinning, &mut out);
+            d.deform(&model.mesh, &skinning, &mut posed);
             times.push(t.elapsed().as_secs_f64() * 1e6);
-            let path = args.out.join(format!("{stem}.{}.glb", d.method()));
-            dqhand::io::write_posed(&path, out.positions(), out.normals(), model.mesh.uvs(), model.mesh.indices())?;
+            let path = out.join(format!("{stem}.{}.glb", d.method()));
+            dqhand::io::write_posed(&path, posed.positions(), posed.normals(), model.mesh.uvs(), model.mesh.indices())?;
         }
         println!("{:<10} {:>9.1} {:>9.1} {:>9.1}  {stem}.{{lb,qb,dqb}}.glb, {stem}.pose.json", g.name, times[0], times[1], times[2]);
     }

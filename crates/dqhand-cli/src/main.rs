@@ -8,6 +8,7 @@ mod demo;
 mod hand;
 mod info;
 mod metrics;
+mod server;
 mod skin;
 
 use clap::{Parser, Subcommand};
@@ -31,7 +32,8 @@ enum Command {
     Skin(skin::Args),
     /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
     Bench(bench::Args),
-    /// Pose the built-in hand through the gesture library and write the meshes.
+    /// The live viewer: a local server for the browser page that poses the hand and compares
+    /// LB, QB and DQB (with --out: write the gesture library as meshes instead).
     Demo(demo::Args),
     /// Realism metrics of LB, QB and DQB: volume, collapse and bulge, candy wrapper,
     /// distortion and continuity over joint sweeps.

@@ -8,7 +8,8 @@
 //! * [`collision`] — collision proxies per bone (paper 4.2);
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
-//! * [`model`] — a skeleton and its skinned mesh, posed frame by frame.
+//! * [`model`] — a skeleton and its skinned mesh, posed frame by frame;
+//! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!
 //! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names.
@@ -23,5 +24,6 @@ pub mod math;
 pub mod metrics;
 pub mod model;
 pub mod skin;
+pub mod stream;
 
 pub use error::{Error, Result};

@@ -25,12 +25,23 @@ impl Pose {
     /// If the poses have different angle counts.
     #[must_use]
     pub fn interpolate(&self, end: &Pose, t: f32) -> Pose {
-        assert_eq!(self.angles.len(), end.angles.len(), "poses of different joint models");
-        let angles = self.angles.iter().zip(&end.angles).map(|(a, b)| a + (b - a) * t).collect();
-        let wrist = match (self.wrist, end.wrist) {
+        let mut out = self.clone();
+        self.interpolate_into(end, t, &mut out);
+        out
+    }
+
+    /// [`Self::interpolate`] into `out`, allocating nothing (for per-frame playback).
+    ///
+    /// # Panics
+    /// If the three poses have different angle counts.
+    pub fn interpolate_into(&self, end: &Pose, t: f32, out: &mut Pose) {
+        assert!(self.angles.len() == end.angles.len() && out.angles.len() == end.angles.len(), "poses of different joint models");
+        for ((o, a), b) in out.angles.iter_mut().zip(&self.angles).zip(&end.angles) {
+            *o = a + (b - a) * t;
+        }
+        out.wrist = match (self.wrist, end.wrist) {
             (None, None) => None,
             (a, b) => Some(a.unwrap_or(DualQuat::IDENTITY).sclerp(b.unwrap_or(DualQuat::IDENTITY), t)),
         };
-        Pose { wrist, angles }
     }
 }

@@ -11,7 +11,7 @@ mod report;
 mod self_intersection;
 
 pub use closed_surface::{check_closed, enclosed_volume, winding_number};
-pub use distortion::{edge_distortion, edges};
+pub use distortion::{edge_distortion, edges, VertexDistortion};
 pub use joint_region::JointRegion;
 pub use report::{format_value, measure, FrameMetrics, Report, Sweep};
 pub use self_intersection::count_self_intersections;

@@ -1,0 +1,85 @@
+//! The viewer's local server: static files of the built page and the engine stream, both on
+//! one port. One thread per connection: a slow or vanished browser only ever holds up its own
+//! thread, never the engine of another viewer.
+
+mod assets;
+mod request;
+mod socket;
+
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use dqhand::kinematics::JointModel;
+use dqhand::model::Model;
+
+/// Connections served at once; more are answered 503 (each holds a thread).
+const MAX_CONNECTIONS: usize = 64;
+/// Time a client has to send its request line and headers.
+const REQUEST_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// What every connection shares.
+pub struct Shared {
+    /// The skinned hand every viewer poses (read-only; each viewer has its own pose).
+    pub model: Arc<Model>,
+    /// The joint model a new viewer starts with.
+    pub joint_model: JointModel,
+    /// The built page (`viewer/dist`), canonical.
+    pub assets: PathBuf,
+    /// Frames per second streamed to each viewer.
+    pub fps: f64,
+}
+
+/// Accepts connections forever, one thread each.
+pub fn serve(listener: TcpListener, shared: Shared) -> std::io::Result<()> {
+    let shared = Arc::new(shared);
+    let open = Arc::new(AtomicUsize::new(0));
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else { continue };
+        let (shared, open) = (Arc::clone(&shared), Arc::clone(&open));
+        if open.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
+            open.fetch_sub(1, Ordering::SeqCst);
+            let _ = request::respond(&stream, 503, "text/plain", b"too many connections\n", false);
+            continue;
+        }
+        std::thread::spawn(move || {
+            let peer = stream.peer_addr().ok();
+            if let Err(e) = connection(stream, &shared) {
+                log_error(peer, &e);
+            }
+            open.fetch_sub(1, Ordering::SeqCst);
+        });
+    }
+    Ok(())
+}
+
+fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
+    use std::io::ErrorKind::{BrokenPipe, ConnectionAborted, ConnectionReset, UnexpectedEof};
+    if !matches!(e.kind(), BrokenPipe | ConnectionReset | ConnectionAborted | UnexpectedEof) {
+        eprintln!("dqhand: {}: {e}", peer.map_or_else(|| "client".into(), |p| p.to_string()));
+    }
+}
+
+/// One connection: a request for a file, or the upgrade to the engine stream.
+fn connection(stream: TcpStream, shared: &Shared) -> std::io::Result<()> {
+    stream.set_read_timeout(Some(REQUEST_TIMEOUT))?;
+    stream.set_nodelay(true)?;
+    let request = match request::Request::read(&stream) {
+        Ok(r) => r,
+        Err(request::Refusal { status, message }) => {
+            return request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false);
+        }
+    };
+    if request.path == socket::PATH {
+        match request.websocket_accept() {
+            Ok(accept) => socket::run(stream, request, &accept, shared),
+            Err(request::Refusal { status, message }) => {
+                request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false)
+            }
+        }
+    } else {
+        assets::serve(&stream, &request, &shared.assets)
+    }
+}

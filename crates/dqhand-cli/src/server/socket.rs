@@ -1,0 +1,138 @@
+//! The engine stream of one viewer: hello and topology, then frames at the configured rate,
+//! with user edits read in between. Flow control keeps at most [`WINDOW`] frames unacknowledged,
+//! so a browser that falls behind gets fewer frames instead of a growing queue.
+
+use std::io::{ErrorKind, Write};
+use std::net::TcpStream;
+use std::time::{Duration, Instant};
+
+use dqhand::stream::{Applied, Command, Session};
+use tungstenite::protocol::{Role, WebSocketConfig};
+use tungstenite::{Message, WebSocket};
+
+use super::request::Request;
+use super::Shared;
+
+/// The path of the stream.
+pub const PATH: &str = "/stream";
+/// Largest command accepted from a page; larger ones are answered with an error.
+pub const MAX_COMMAND_BYTES: usize = 4 * 1024;
+/// Largest WebSocket message read at all; beyond it the connection is closed (after an
+/// error message), since the rest of the message would have to be read to go on.
+const MAX_WIRE_BYTES: usize = 64 * 1024;
+/// Frames sent but not yet acknowledged, at most.
+const WINDOW: u32 = 3;
+/// A send that cannot complete in this time (the client stopped reading) ends the connection.
+const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Completes the handshake and streams until the client leaves.
+pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Shared) -> std::io::Result<()> {
+    let response = format!(
+        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
+    );
+    stream.write_all(response.as_bytes())?;
+    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
+    let config = WebSocketConfig::default().max_message_size(Some(MAX_WIRE_BYTES)).max_frame_size(Some(MAX_WIRE_BYTES));
+    let mut ws = WebSocket::from_partially_read(stream, request.rest, Role::Server, Some(config));
+    let mut session = match Session::new(shared.model.clone(), shared.joint_model) {
+        Ok(s) => s,
+        Err(e) => return send_error(&mut ws, &e.to_string()).map_err(io),
+    };
+    ws.send(Message::text(session.hello(MAX_COMMAND_BYTES))).map_err(io)?;
+    ws.send(Message::binary(session.topology().encode())).map_err(io)?;
+
+    let period = Duration::from_secs_f64(1.0 / shared.fps);
+    let (mut sent, mut acked) = (0u32, 0u32);
+    let mut last_frame = Instant::now();
+    let mut next_frame = last_frame;
+    let mut rate = Rate::new();
+    let mut frame = Vec::new();
+    loop {
+        // Read edits until the next frame is due (or, with the window full, until an ack).
+        loop {
+            let now = Instant::now();
+            let window_open = sent.wrapping_sub(acked) < WINDOW;
+            if window_open && now >= next_frame {
+                break;
+            }
+            let wait = if window_open { next_frame - now } else { Duration::from_millis(50) };
+            ws.get_ref().set_read_timeout(Some(wait.max(Duration::from_millis(1))))?;
+            match ws.read() {
+                Ok(Message::Text(text)) => {
+                    if text.len() > MAX_COMMAND_BYTES {
+                        send_error(&mut ws, &format!("message of {} bytes refused (at most {MAX_COMMAND_BYTES})", text.len())).map_err(io)?;
+                        continue;
+                    }
+                    match Command::parse(&text) {
+                        Ok(Command::Ack { seq }) => acked = seq.wrapping_add(1),
+                        Ok(command) => match session.apply(&command) {
+                            Ok(Applied::Frame) => {}
+                            Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES))).map_err(io)?,
+                            Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
+                        },
+                        Err(e) => send_error(&mut ws, &e).map_err(io)?,
+                    }
+                }
+                Ok(Message::Binary(_)) => send_error(&mut ws, "binary messages are not commands; send JSON text").map_err(io)?,
+                Ok(Message::Close(_)) => return Ok(()),
+                Ok(_) => {}
+                Err(tungstenite::Error::Io(e)) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                Err(tungstenite::Error::Capacity(e)) => {
+                    let _ = send_error(&mut ws, &format!("message refused: {e}; closing"));
+                    let _ = ws.close(None);
+                    let _ = ws.flush();
+                    return Ok(());
+                }
+                Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => return Ok(()),
+                Err(e) => return Err(io(e)),
+            }
+        }
+        let now = Instant::now();
+        session.advance((now - last_frame).as_secs_f32().min(0.1));
+        last_frame = now;
+        session.render(rate.tick(now), &mut frame);
+        // tungstenite takes ownership of each message: one buffer per frame is the transport's
+        // cost (the engine's own buffers are reused).
+        ws.send(Message::binary(std::mem::take(&mut frame))).map_err(io)?;
+        sent = sent.wrapping_add(1);
+        next_frame += period;
+        if next_frame < now {
+            next_frame = now; // after a stall, resume the rate instead of bursting to catch up
+        }
+    }
+}
+
+fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungstenite::Result<()> {
+    ws.send(Message::text(serde_json::json!({ "type": "error", "message": message }).to_string()))
+}
+
+fn io(e: tungstenite::Error) -> std::io::Error {
+    match e {
+        tungstenite::Error::Io(e) => e,
+        e => std::io::Error::other(e),
+    }
+}
+
+/// Frames per second over the last second or so.
+struct Rate {
+    since: Instant,
+    count: u32,
+    fps: f32,
+}
+
+impl Rate {
+    fn new() -> Self {
+        Self { since: Instant::now(), count: 0, fps: 0.0 }
+    }
+
+    /// Counts a frame at `now`; returns the latest rate.
+    fn tick(&mut self, now: Instant) -> f32 {
+        self.count += 1;
+        let elapsed = (now - self.since).as_secs_f32();
+        if elapsed >= 1.0 {
+            self.fps = self.count as f32 / elapsed;
+            (self.since, self.count) = (now, 0);
+        }
+        self.fps
+    }
+}

@@ -1,0 +1,311 @@
+//! The binary wire format of the viewer stream, version 1: the mesh topology once, then one
+//! frame per engine step. Little-endian; every array starts on a 4-byte boundary, so the page
+//! reads it through `Float32Array` / `Uint32Array` views without copying.
+//!
+//! Topology (`DQHT`):
+//! ```text
+//! 0  u32 magic "DQHT"   4 u16 version   6 u16 reserved
+//! 8  u32 vertex count   12 u32 index count   16 u32 joint count
+//! 20 u32 indices[index count]   then i32 parent[joint count] (−1 for a root)
+//! ```
+//! Frame (`DQHF`):
+//! ```text
+//! 0  u32 magic "DQHF"   4 u16 version   6 u16 flags (bit 0: distortion arrays follow)
+//! 8  u32 sequence number   12 u32 vertex count   16 u32 joint count   20 u32 DOF count
+//! 24 u8 mesh count (1–3)   25 u8 method per mesh (0 LB, 1 QB, 2 DQB; 255 unused) ×3
+//! 28 f32 engine time of this frame (pose + skin + distortion), µs
+//! 32 f32 frames per second the engine is sending   36 f32 timeline time, s
+//! 40 f32 timeline duration, s (0: no timeline)     44 u32 state (bit 0: playing; bit 1: limits on)
+//! 48 f32 wrist translation xyz, rotation xyzw
+//! 76 f32 angles[DOF count] (radians)   then f32 joint positions[3 · joint count] (world)
+//!    then per mesh: f32 positions[3 · vertex count], f32 normals[3 · vertex count],
+//!                   (flag 0) f32 distortion[vertex count]
+//! ```
+
+use crate::skin::Method;
+use crate::{Error, Result};
+
+/// Version of the format written here; a reader refuses any other.
+pub const VERSION: u16 = 1;
+/// `"DQHF"` read as a little-endian `u32`.
+pub const FRAME_MAGIC: u32 = u32::from_le_bytes(*b"DQHF");
+/// `"DQHT"` read as a little-endian `u32`.
+pub const TOPOLOGY_MAGIC: u32 = u32::from_le_bytes(*b"DQHT");
+/// Bytes before the angles of a frame.
+pub const FRAME_HEADER_BYTES: usize = 76;
+/// Bytes before the indices of a topology message.
+pub const TOPOLOGY_HEADER_BYTES: usize = 20;
+/// Frame flag: a distortion array follows each mesh's normals.
+pub const FLAG_DISTORTION: u16 = 1;
+/// State bit: the timeline is playing.
+pub const STATE_PLAYING: u32 = 1;
+/// State bit: angles are clamped to the anatomical limits.
+pub const STATE_LIMITS: u32 = 2;
+
+/// The scalar fields of a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameHeader {
+    /// Increases by one per frame sent to a client.
+    pub sequence: u32,
+    /// Vertices per mesh.
+    pub vertex_count: u32,
+    /// Joints with a position.
+    pub joint_count: u32,
+    /// Angles in the pose.
+    pub dof_count: u32,
+    /// The method of each mesh, in order (1–3 of them).
+    pub methods: [Option<Method>; 3],
+    /// Whether each mesh carries a distortion array.
+    pub distortion: bool,
+    /// Engine time spent on this frame, µs.
+    pub engine_us: f32,
+    /// Frames per second the engine is sending to this client.
+    pub engine_fps: f32,
+    /// Timeline position, s.
+    pub time: f32,
+    /// Timeline length, s (0 when nothing is loaded).
+    pub duration: f32,
+    /// [`STATE_PLAYING`] | [`STATE_LIMITS`].
+    pub state: u32,
+    /// Wrist translation (m) and rotation `[x, y, z, w]`.
+    pub wrist: [f32; 7],
+}
+
+impl FrameHeader {
+    /// Meshes in the frame.
+    #[must_use]
+    pub fn mesh_count(&self) -> usize {
+        self.methods.iter().take_while(|m| m.is_some()).count()
+    }
+
+    /// Total size of the frame in bytes.
+    #[must_use]
+    pub fn byte_len(&self) -> usize {
+        let v = self.vertex_count as usize;
+        let per_mesh = 6 * v + if self.distortion { v } else { 0 };
+        FRAME_HEADER_BYTES + 4 * (self.dof_count as usize + 3 * self.joint_count as usize + self.mesh_count() * per_mesh)
+    }
+}
+
+fn method_code(m: Option<Method>) -> u8 {
+    m.map_or(255, |m| Method::ALL.iter().position(|&a| a == m).expect("a method") as u8)
+}
+
+/// Appends `values` as little-endian f32.
+fn put_f32s(out: &mut Vec<u8>, values: &[f32]) {
+    if cfg!(target_endian = "little") {
+        out.extend_from_slice(bytemuck::cast_slice(values));
+    } else {
+        values.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+    }
+}
+
+/// Builds a frame in a byte buffer: [`Self::begin`], then the pose, joints and meshes in the
+/// order of the format. Appending never reallocates once the buffer has held one frame.
+pub struct FrameWriter<'a> {
+    out: &'a mut Vec<u8>,
+    header: FrameHeader,
+}
+
+impl<'a> FrameWriter<'a> {
+    /// Clears `out` and writes the header.
+    pub fn begin(out: &'a mut Vec<u8>, header: FrameHeader) -> Self {
+        out.clear();
+        out.reserve(header.byte_len());
+        let h = &header;
+        out.extend_from_slice(&FRAME_MAGIC.to_le_bytes());
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&(if h.distortion { FLAG_DISTORTION } else { 0 }).to_le_bytes());
+        for v in [h.sequence, h.vertex_count, h.joint_count, h.dof_count] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out.push(h.mesh_count() as u8);
+        out.extend(h.methods.map(method_code));
+        put_f32s(out, &[h.engine_us, h.engine_fps, h.time, h.duration]);
+        out.extend_from_slice(&h.state.to_le_bytes());
+        put_f32s(out, &h.wrist);
+        Self { out, header }
+    }
+
+    /// Appends f32 values (angles, joint positions, a mesh's arrays).
+    pub fn floats(&mut self, values: &[f32]) -> &mut Self {
+        put_f32s(self.out, values);
+        self
+    }
+
+    /// Checks that the frame is complete.
+    ///
+    /// # Panics
+    /// If fewer or more values were written than the header announces.
+    pub fn finish(self) {
+        assert_eq!(self.out.len(), self.header.byte_len(), "frame content does not match its header");
+    }
+}
+
+/// A frame read back: the header and views of its arrays.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameView {
+    /// The scalar fields.
+    pub header: FrameHeader,
+    /// Radians, one per DOF.
+    pub angles: Vec<f32>,
+    /// World joint positions, xyz per joint.
+    pub joints: Vec<f32>,
+    /// Per mesh: positions, normals (xyz per vertex) and distortion (empty without the flag).
+    pub meshes: Vec<[Vec<f32>; 3]>,
+}
+
+fn bad(message: impl Into<String>) -> Error {
+    Error::Invalid(format!("stream message: {}", message.into()))
+}
+
+/// Little-endian reader over a message that reports truncation as an error.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end.ok_or_else(|| bad(format!("truncated at byte {} of {}", self.at, self.bytes.len())))?;
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+    fn u16(&mut self) -> Result<u16> {
+        Ok(u16::from_le_bytes(self.take(2)?.try_into().expect("2 bytes")))
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+    }
+    fn f32s(&mut self, n: usize) -> Result<Vec<f32>> {
+        let bytes = self.take(n.checked_mul(4).ok_or_else(|| bad("array too long"))?)?;
+        Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect())
+    }
+    fn start(&mut self, magic: u32, what: &str) -> Result<u16> {
+        if self.u32()? != magic {
+            return Err(bad(format!("not a {what} (wrong magic)")));
+        }
+        let version = self.u16()?;
+        if version != VERSION {
+            return Err(bad(format!("{what} version {version}, this reader knows {VERSION}")));
+        }
+        self.u16()
+    }
+    fn end(&self) -> Result<()> {
+        if self.at == self.bytes.len() {
+            Ok(())
+        } else {
+            Err(bad(format!("{} bytes after the end", self.bytes.len() - self.at)))
+        }
+    }
+}
+
+impl FrameView {
+    /// Parses a frame.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a wrong magic or version, an unknown method, or a length that
+    /// does not match the header.
+    pub fn parse(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader { bytes, at: 0 };
+        let flags = r.start(FRAME_MAGIC, "frame")?;
+        let (sequence, vertex_count, joint_count, dof_count) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
+        let codes = r.take(4)?;
+        let mesh_count = usize::from(codes[0]);
+        let mut methods = [None; 3];
+        for (i, (m, &c)) in methods.iter_mut().zip(&codes[1..]).enumerate() {
+            *m = match (i < mesh_count, Method::ALL.get(usize::from(c))) {
+                (true, Some(&m)) => Some(m),
+                (false, _) if c == 255 => None,
+                _ => return Err(bad(format!("mesh {i}: method code {c} with {mesh_count} meshes"))),
+            };
+        }
+        if mesh_count == 0 || mesh_count > 3 {
+            return Err(bad(format!("{mesh_count} meshes (1 to 3)")));
+        }
+        let s = r.f32s(4)?;
+        let state = r.u32()?;
+        let wrist: [f32; 7] = r.f32s(7)?.try_into().expect("7 values");
+        let header = FrameHeader {
+            sequence,
+            vertex_count,
+            joint_count,
+            dof_count,
+            methods,
+            distortion: flags & FLAG_DISTORTION != 0,
+            engine_us: s[0],
+            engine_fps: s[1],
+            time: s[2],
+            duration: s[3],
+            state,
+            wrist,
+        };
+        if header.byte_len() != bytes.len() {
+            return Err(bad(format!("{} bytes, the header announces {}", bytes.len(), header.byte_len())));
+        }
+        let angles = r.f32s(dof_count as usize)?;
+        let joints = r.f32s(3 * joint_count as usize)?;
+        let v = vertex_count as usize;
+        let mut meshes = Vec::with_capacity(mesh_count);
+        for _ in 0..mesh_count {
+            let d = if header.distortion { v } else { 0 };
+            meshes.push([r.f32s(3 * v)?, r.f32s(3 * v)?, r.f32s(d)?]);
+        }
+        r.end()?;
+        Ok(Self { header, angles, joints, meshes })
+    }
+}
+
+/// The mesh and skeleton structure sent once per connection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Topology {
+    /// Vertices of the mesh.
+    pub vertex_count: u32,
+    /// Triangle corners, three per triangle.
+    pub indices: Vec<u32>,
+    /// Parent of each joint (`None` for a root), for drawing the skeleton.
+    pub parents: Vec<Option<usize>>,
+}
+
+impl Topology {
+    /// Encodes the topology message.
+    #[must_use]
+    pub fn encode(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(TOPOLOGY_HEADER_BYTES + 4 * (self.indices.len() + self.parents.len()));
+        out.extend_from_slice(&TOPOLOGY_MAGIC.to_le_bytes());
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&0u16.to_le_bytes());
+        for n in [self.vertex_count, self.indices.len() as u32, self.parents.len() as u32] {
+            out.extend_from_slice(&n.to_le_bytes());
+        }
+        self.indices.iter().for_each(|i| out.extend_from_slice(&i.to_le_bytes()));
+        self.parents.iter().for_each(|p| out.extend_from_slice(&p.map_or(-1, |p| p as i32).to_le_bytes()));
+        out
+    }
+
+    /// Parses a topology message.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a wrong magic or version, a truncated message, an index out of
+    /// range or a parent that is not another joint.
+    pub fn parse(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader { bytes, at: 0 };
+        r.start(TOPOLOGY_MAGIC, "topology")?;
+        let (vertex_count, index_count, joint_count) = (r.u32()?, r.u32()? as usize, r.u32()? as usize);
+        let indices = (0..index_count).map(|_| r.u32()).collect::<Result<Vec<_>>>()?;
+        if let Some(i) = indices.iter().find(|&&i| i >= vertex_count) {
+            return Err(bad(format!("index {i} with {vertex_count} vertices")));
+        }
+        let parents = (0..joint_count)
+            .map(|j| match r.u32()? as i32 {
+                -1 => Ok(None),
+                p if p >= 0 && (p as usize) < joint_count && p as usize != j => Ok(Some(p as usize)),
+                p => Err(bad(format!("joint {j}: parent {p} is not another joint"))),
+            })
+            .collect::<Result<Vec<_>>>()?;
+        r.end()?;
+        Ok(Self { vertex_count, indices, parents })
+    }
+}

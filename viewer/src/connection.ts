@@ -1,0 +1,81 @@
+// The WebSocket to the engine: acknowledges every frame at once (the server's flow control),
+// and reconnects when the server goes away, replaying the page's settings to the new session.
+
+import {
+  binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand,
+  type Command, type Frame, type Hello, type Topology,
+} from './protocol';
+
+export interface ConnectionEvents {
+  hello(hello: Hello): void;
+  topology(topology: Topology): void;
+  frame(frame: Frame): void;
+  error(message: string): void;
+  status(connected: boolean): void;
+}
+
+const RETRY_MS = 500;
+
+export class Connection {
+  private socket: WebSocket | null = null;
+  /** Commands that set up the view, replayed after a reconnect, by kind. */
+  private settings = new Map<string, Command>();
+  connected = false;
+  framesReceived = 0;
+  bytesReceived = 0;
+
+  constructor(private readonly url: string, private readonly events: ConnectionEvents) {
+    this.open();
+  }
+
+  private open(): void {
+    const socket = new WebSocket(this.url);
+    socket.binaryType = 'arraybuffer';
+    this.socket = socket;
+    socket.onopen = () => {
+      this.connected = true;
+      this.events.status(true);
+      for (const c of this.settings.values()) socket.send(encodeCommand(c));
+    };
+    socket.onmessage = (event) => this.receive(event.data as string | ArrayBuffer);
+    socket.onclose = () => {
+      if (this.socket !== socket) return;
+      this.connected = false;
+      this.events.status(false);
+      setTimeout(() => this.open(), RETRY_MS);
+    };
+  }
+
+  private receive(data: string | ArrayBuffer): void {
+    try {
+      if (typeof data === 'string') {
+        const message = decodeText(data);
+        if (message.type === 'hello') this.events.hello(message);
+        else this.events.error(message.message);
+        return;
+      }
+      this.bytesReceived += data.byteLength;
+      const kind = binaryKind(data);
+      if (kind === 'topology') this.events.topology(decodeTopology(data));
+      else if (kind === 'frame') {
+        const frame = decodeFrame(data);
+        this.send({ type: 'ack', seq: frame.header.sequence });
+        this.framesReceived++;
+        this.events.frame(frame);
+      } else this.events.error(`unknown binary message of ${data.byteLength} bytes`);
+    } catch (e) {
+      this.events.error((e as Error).message);
+    }
+  }
+
+  /** Sends a command now (dropped while disconnected: the pose comes from the engine). */
+  send(command: Command): void {
+    if (this.socket?.readyState === WebSocket.OPEN) this.socket.send(encodeCommand(command));
+  }
+
+  /** Sends a setting and remembers it for the next session (view, heat map, limits, model). */
+  setting(command: Command): void {
+    this.settings.set(command.type, command);
+    this.send(command);
+  }
+}

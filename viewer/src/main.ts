@@ -1,0 +1,222 @@
+// The viewer page: connects to the engine, draws its frames and turns controls into commands.
+
+import './style.css';
+import { Connection } from './connection';
+import { type Command, type Frame, type Hello, type Method, METHODS } from './protocol';
+import { HandScene } from './scene';
+
+const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
+const params = new URLSearchParams(location.search);
+const figure = params.has('figure');
+document.body.classList.toggle('figure', figure);
+
+const scene = new HandScene($<HTMLCanvasElement>('view'));
+const errors: string[] = [];
+let hello: Hello | null = null;
+let frame: Frame | null = null;
+let dragging: HTMLInputElement | null = null;
+let pageFps = 0;
+
+const status = (text: string, kind: '' | 'ok' | 'error') => {
+  const s = $('status');
+  s.textContent = text;
+  s.className = kind;
+};
+
+const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/stream`, {
+  hello(h) {
+    hello = h;
+    $('model-line').textContent = `${h.description}, ${h.triangles.toLocaleString()} triangles`;
+    buildGestures(h);
+    buildSliders(h);
+    const select = $<HTMLSelectElement>('joint-model');
+    select.replaceChildren(...h.joint_models.map((m) => new Option(`${m} (${m === h.joint_model ? h.dofs.length + ' DOF' : '…'})`, m, false, m === h.joint_model)));
+    $<HTMLInputElement>('timeline').max = String(h.sequence.duration);
+  },
+  topology(t) {
+    scene.setTopology(t);
+  },
+  frame(f) {
+    frame = f;
+    scene.showFrame(f);
+  },
+  error(message) {
+    errors.push(message);
+    status(`engine: ${message}`, 'error');
+  },
+  status(connected) {
+    status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
+  },
+});
+
+// --- skinning view ---------------------------------------------------------------------------
+const selectedMethod = (): Method => (METHODS.find((m) => $<HTMLInputElement>(`method-${m}`).checked) ?? 'dqb');
+function sendView(): void {
+  const split = $<HTMLInputElement>('split').checked;
+  connection.setting({ type: 'view', methods: split ? [...METHODS] : [selectedMethod()] });
+}
+for (const m of METHODS) $(`method-${m}`).addEventListener('change', sendView);
+$('split').addEventListener('change', sendView);
+$('heatmap').addEventListener('change', () => {
+  const on = $<HTMLInputElement>('heatmap').checked;
+  $('legend').hidden = !on;
+  connection.setting({ type: 'heatmap', on });
+});
+$('wireframe').addEventListener('change', () => scene.setWireframe($<HTMLInputElement>('wireframe').checked));
+$('skeleton').addEventListener('change', () => (scene.showSkeleton = $<HTMLInputElement>('skeleton').checked));
+$('limits').addEventListener('change', () => {
+  connection.setting({ type: 'limits', on: $<HTMLInputElement>('limits').checked });
+  if (hello) buildSliders(hello);
+});
+$('joint-model').addEventListener('change', () => connection.setting({ type: 'joint_model', name: $<HTMLSelectElement>('joint-model').value }));
+$('rest').addEventListener('click', () => connection.send({ type: 'rest' }));
+
+// --- gestures and timeline -------------------------------------------------------------------
+function buildGestures(h: Hello): void {
+  $('gestures').replaceChildren(
+    ...h.gestures.map((name) => {
+      const b = document.createElement('button');
+      b.textContent = name;
+      b.dataset.gesture = name;
+      b.addEventListener('click', () => connection.send({ type: 'gesture', name }));
+      return b;
+    }),
+  );
+}
+$('play').addEventListener('click', () => connection.send({ type: frame?.header.playing ? 'pause' : 'play' }));
+$('timeline').addEventListener('input', () => connection.send({ type: 'seek', time: Number($<HTMLInputElement>('timeline').value) }));
+
+// --- joint sliders ---------------------------------------------------------------------------
+const FINGERS = ['thumb', 'index', 'middle', 'ring', 'pinky'];
+function slider(label: string, min: number, max: number, step: number, onInput: (v: number) => void, data: Record<string, string>) {
+  const row = document.createElement('label');
+  row.className = 'slider';
+  const input = document.createElement('input');
+  Object.assign(input, { type: 'range', min: String(min), max: String(max), step: String(step), value: '0' });
+  Object.assign(input.dataset, data);
+  const out = document.createElement('output');
+  out.textContent = '0';
+  input.addEventListener('pointerdown', () => (dragging = input));
+  input.addEventListener('pointerup', () => (dragging = null));
+  input.addEventListener('input', () => {
+    out.textContent = input.value;
+    onInput(Number(input.value));
+  });
+  row.append(label, input, out);
+  return row;
+}
+
+function buildSliders(h: Hello): void {
+  const limits = $<HTMLInputElement>('limits').checked;
+  const groups = FINGERS.map((finger) => {
+    const d = document.createElement('details');
+    d.open = finger === 'index';
+    const s = document.createElement('summary');
+    s.textContent = finger;
+    d.append(s);
+    for (const dof of h.dofs.filter((x) => x.name.startsWith(finger))) {
+      const name = dof.joint.replace(/^\S+ /, '') + ' ' + dof.name.split('.')[1];
+      const [min, max] = limits ? [dof.min_deg, dof.max_deg] : [-180, 180];
+      d.append(slider(name, min, max, 1, (deg) => connection.send({ type: 'angle', dof: dof.name, deg }), { dof: dof.name }));
+    }
+    return d;
+  });
+  $('sliders').replaceChildren(...groups);
+  if ($('wrist').childElementCount === 0) {
+    const wrist = [0, 0, 0, 0, 0, 0];
+    const send = () => connection.send({ type: 'wrist', translation: [wrist[0] / 100, wrist[1] / 100, wrist[2] / 100], rotation_deg: [wrist[3], wrist[4], wrist[5]] });
+    const axes = ['x cm', 'y cm', 'z cm', 'rot x°', 'rot y°', 'rot z°'];
+    $('wrist').append(...axes.map((a, i) => slider(a, i < 3 ? -15 : -180, i < 3 ? 15 : 180, i < 3 ? 0.5 : 1, (v) => ((wrist[i] = v), send()), { wrist: String(i) })));
+  }
+}
+
+/** Moves the sliders and the timeline to the engine's pose (except the one being dragged). */
+function syncControls(f: Frame): void {
+  if (!hello || f.angles.length !== hello.dofs.length) return;
+  hello.dofs.forEach((dof, i) => {
+    const input = document.querySelector<HTMLInputElement>(`input[data-dof="${dof.name}"]`);
+    if (!input || input === dragging) return;
+    const deg = Math.round((f.angles[i] * 180) / Math.PI);
+    if (input.value !== String(deg)) {
+      input.value = String(deg);
+      input.nextElementSibling!.textContent = String(deg);
+    }
+  });
+  const t = $<HTMLInputElement>('timeline');
+  if (t !== dragging) t.value = String(f.header.time);
+  $('time').textContent = `${f.header.time.toFixed(1)} / ${f.header.duration.toFixed(1)} s`;
+  $('play').textContent = f.header.playing ? 'Pause' : 'Play';
+}
+
+// --- render loop and statistics --------------------------------------------------------------
+let frames = 0;
+let since = performance.now();
+let engineUs = 0;
+function loop(now: number): void {
+  scene.render();
+  frames++;
+  if (now - since >= 1000) {
+    pageFps = (frames * 1000) / (now - since);
+    frames = 0;
+    since = now;
+  }
+  if (frame) {
+    engineUs = engineUs === 0 ? frame.header.engineUs : 0.9 * engineUs + 0.1 * frame.header.engineUs;
+    syncControls(frame);
+    const h = frame.header;
+    $('stats').textContent =
+      `page ${pageFps.toFixed(0)} fps   engine ${h.engineFps.toFixed(0)} fps\n` +
+      `engine ${(engineUs / 1000).toFixed(2)} ms/frame (${h.methods.join(' + ').toUpperCase()})\n` +
+      `${(frame.byteLength / 1024).toFixed(0)} KiB/frame, ${h.vertexCount.toLocaleString()} vertices`;
+    $('labels').replaceChildren(
+      ...(h.methods.length > 1 || figure
+        ? scene.labelPositions().map(({ method, x, y }) => {
+            const s = document.createElement('span');
+            s.textContent = (method ?? '').toUpperCase();
+            s.style.left = `${x}px`;
+            s.style.top = `${y}px`;
+            return s;
+          })
+        : []),
+    );
+  }
+  requestAnimationFrame(loop);
+}
+requestAnimationFrame(loop);
+
+// --- hooks for the browser tests and `make figures` ------------------------------------------
+declare global {
+  interface Window {
+    dqhand: unknown;
+  }
+}
+window.dqhand = {
+  state: () => ({
+    connected: connection.connected,
+    framesReceived: connection.framesReceived,
+    errors: [...errors],
+    jointModel: hello?.joint_model ?? null,
+    dofs: hello?.dofs.map((d) => d.name) ?? [],
+    joints: hello ? [...hello.joints] : [],
+    pageFps,
+    visible: scene.visibleMethods(),
+    frame: frame && {
+      sequence: frame.header.sequence,
+      methods: frame.header.methods,
+      anglesDeg: Array.from(frame.angles, (a) => (a * 180) / Math.PI),
+      joints: Array.from(frame.joints),
+      playing: frame.header.playing,
+      time: frame.header.time,
+      engineFps: frame.header.engineFps,
+      engineUs: frame.header.engineUs,
+      distortion: frame.header.distortion,
+    },
+  }),
+  send: (command: Command) => connection.send(command),
+  setting: (command: Command) => connection.setting(command),
+  /** Camera: 'default' | 'side', optionally close on a joint (by name) at a distance (m). */
+  view: (preset: 'default' | 'side', joint?: string, distance?: number) => {
+    const index = joint && hello ? hello.joints.indexOf(joint) : -1;
+    scene.setView(preset, index >= 0 ? scene.jointPosition(index) ?? undefined : undefined, distance);
+  },
+};

@@ -1,0 +1,203 @@
+// The stream's wire format, version 1 (crates/dqhand/src/stream/frame.rs is the reference):
+// a topology message once, then binary frames; JSON text for hello, errors and commands.
+// Arrays are 4-byte aligned, so they are read as typed-array views without copying.
+
+export const VERSION = 1;
+export const FRAME_MAGIC = 0x46485144; // "DQHF" little-endian
+export const TOPOLOGY_MAGIC = 0x54485144; // "DQHT"
+export const FRAME_HEADER_BYTES = 76;
+export const TOPOLOGY_HEADER_BYTES = 20;
+export const FLAG_DISTORTION = 1;
+export const STATE_PLAYING = 1;
+export const STATE_LIMITS = 2;
+export const METHODS = ['lb', 'qb', 'dqb'] as const;
+export type Method = (typeof METHODS)[number];
+
+export class ProtocolError extends Error {}
+
+export interface FrameHeader {
+  sequence: number;
+  vertexCount: number;
+  jointCount: number;
+  dofCount: number;
+  methods: Method[];
+  distortion: boolean;
+  engineUs: number;
+  engineFps: number;
+  time: number;
+  duration: number;
+  playing: boolean;
+  limits: boolean;
+  /** Translation xyz (m), rotation xyzw. */
+  wrist: Float32Array;
+}
+
+export interface MeshArrays {
+  method: Method;
+  positions: Float32Array;
+  normals: Float32Array;
+  /** Per-vertex mean edge-length change against rest; null unless the heat map is on. */
+  distortion: Float32Array | null;
+}
+
+export interface Frame {
+  header: FrameHeader;
+  /** Radians, one per DOF of the hello's joint model. */
+  angles: Float32Array;
+  /** World joint positions, xyz per joint. */
+  joints: Float32Array;
+  meshes: MeshArrays[];
+  byteLength: number;
+}
+
+export interface Topology {
+  vertexCount: number;
+  indices: Uint32Array;
+  /** Parent joint index, -1 for a root. */
+  parents: Int32Array;
+}
+
+export interface Dof {
+  name: string;
+  joint: string;
+  min_deg: number;
+  max_deg: number;
+}
+
+export interface Hello {
+  type: 'hello';
+  version: number;
+  description: string;
+  vertices: number;
+  triangles: number;
+  joints: string[];
+  joint_model: string;
+  joint_models: string[];
+  dofs: Dof[];
+  gestures: string[];
+  sequence: { name: string; duration: number };
+  methods: Method[];
+  gesture_seconds: number;
+  max_message_bytes: number;
+}
+
+export type ServerText = Hello | { type: 'error'; message: string };
+
+/** Which binary message this is, from its magic; null if neither. */
+export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
+  if (buffer.byteLength < 4) return null;
+  const magic = new DataView(buffer).getUint32(0, true);
+  return magic === FRAME_MAGIC ? 'frame' : magic === TOPOLOGY_MAGIC ? 'topology' : null;
+}
+
+function checkStart(view: DataView, magic: number, what: string): number {
+  if (view.byteLength < 8 || view.getUint32(0, true) !== magic) throw new ProtocolError(`not a ${what} (wrong magic)`);
+  const version = view.getUint16(4, true);
+  if (version !== VERSION) throw new ProtocolError(`${what} version ${version}, this page knows ${VERSION}`);
+  return view.getUint16(6, true);
+}
+
+/** Bytes a frame with this header occupies. */
+export function frameByteLength(h: Pick<FrameHeader, 'vertexCount' | 'jointCount' | 'dofCount' | 'methods' | 'distortion'>): number {
+  const perMesh = 6 * h.vertexCount + (h.distortion ? h.vertexCount : 0);
+  return FRAME_HEADER_BYTES + 4 * (h.dofCount + 3 * h.jointCount + h.methods.length * perMesh);
+}
+
+export function decodeFrame(buffer: ArrayBuffer): Frame {
+  const view = new DataView(buffer);
+  if (buffer.byteLength < FRAME_HEADER_BYTES) throw new ProtocolError(`frame of ${buffer.byteLength} bytes is truncated`);
+  const flags = checkStart(view, FRAME_MAGIC, 'frame');
+  const meshCount = view.getUint8(24);
+  if (meshCount < 1 || meshCount > 3) throw new ProtocolError(`${meshCount} meshes (1 to 3)`);
+  const methods: Method[] = [];
+  for (let i = 0; i < meshCount; i++) {
+    const code = view.getUint8(25 + i);
+    const m = METHODS[code];
+    if (m === undefined) throw new ProtocolError(`mesh ${i}: method code ${code}`);
+    methods.push(m);
+  }
+  const state = view.getUint32(44, true);
+  const header: FrameHeader = {
+    sequence: view.getUint32(8, true),
+    vertexCount: view.getUint32(12, true),
+    jointCount: view.getUint32(16, true),
+    dofCount: view.getUint32(20, true),
+    methods,
+    distortion: (flags & FLAG_DISTORTION) !== 0,
+    engineUs: view.getFloat32(28, true),
+    engineFps: view.getFloat32(32, true),
+    time: view.getFloat32(36, true),
+    duration: view.getFloat32(40, true),
+    playing: (state & STATE_PLAYING) !== 0,
+    limits: (state & STATE_LIMITS) !== 0,
+    wrist: new Float32Array(buffer, 48, 7),
+  };
+  const expected = frameByteLength(header);
+  if (expected !== buffer.byteLength) throw new ProtocolError(`frame of ${buffer.byteLength} bytes, its header announces ${expected}`);
+  let at = FRAME_HEADER_BYTES;
+  const floats = (n: number) => {
+    const a = new Float32Array(buffer, at, n);
+    at += 4 * n;
+    return a;
+  };
+  const angles = floats(header.dofCount);
+  const joints = floats(3 * header.jointCount);
+  const n = header.vertexCount;
+  const meshes = methods.map((method) => ({
+    method,
+    positions: floats(3 * n),
+    normals: floats(3 * n),
+    distortion: header.distortion ? floats(n) : null,
+  }));
+  return { header, angles, joints, meshes, byteLength: buffer.byteLength };
+}
+
+export function decodeTopology(buffer: ArrayBuffer): Topology {
+  const view = new DataView(buffer);
+  checkStart(view, TOPOLOGY_MAGIC, 'topology');
+  if (buffer.byteLength < TOPOLOGY_HEADER_BYTES) throw new ProtocolError('topology truncated');
+  const vertexCount = view.getUint32(8, true);
+  const indexCount = view.getUint32(12, true);
+  const jointCount = view.getUint32(16, true);
+  const expected = TOPOLOGY_HEADER_BYTES + 4 * (indexCount + jointCount);
+  if (expected !== buffer.byteLength) throw new ProtocolError(`topology of ${buffer.byteLength} bytes, its header announces ${expected}`);
+  const indices = new Uint32Array(buffer, TOPOLOGY_HEADER_BYTES, indexCount);
+  const parents = new Int32Array(buffer, TOPOLOGY_HEADER_BYTES + 4 * indexCount, jointCount);
+  for (const i of indices) if (i >= vertexCount) throw new ProtocolError(`index ${i} with ${vertexCount} vertices`);
+  parents.forEach((p, j) => {
+    if (p < -1 || p >= jointCount || p === j) throw new ProtocolError(`joint ${j}: parent ${p} is not another joint`);
+  });
+  return { vertexCount, indices, parents };
+}
+
+/** Parses a text message from the server. */
+export function decodeText(text: string): ServerText {
+  let value: unknown;
+  try {
+    value = JSON.parse(text);
+  } catch (e) {
+    throw new ProtocolError(`text message is not JSON: ${(e as Error).message}`);
+  }
+  const type = (value as { type?: unknown } | null)?.type;
+  if (type !== 'hello' && type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
+  return value as ServerText;
+}
+
+/** The commands the engine accepts (crates/dqhand/src/stream/command.rs). */
+export type Command =
+  | { type: 'ack'; seq: number }
+  | { type: 'view'; methods: Method[] }
+  | { type: 'joint_model'; name: string }
+  | { type: 'angle'; dof: string; deg: number }
+  | { type: 'wrist'; translation: [number, number, number]; rotation_deg: [number, number, number] }
+  | { type: 'gesture'; name: string; seconds?: number }
+  | { type: 'play' }
+  | { type: 'pause' }
+  | { type: 'seek'; time: number }
+  | { type: 'heatmap'; on: boolean }
+  | { type: 'limits'; on: boolean }
+  | { type: 'rest' };
+
+export function encodeCommand(command: Command): string {
+  return JSON.stringify(command);
+}

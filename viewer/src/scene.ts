@@ -1,0 +1,262 @@
+// The three.js scene: up to three hands side by side (one per skinning method), lit so that
+// creases and volume read, with optional heat map, wireframe and skeleton overlays. Geometry
+// comes from the engine; this file only draws it.
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import type { Frame, Method, Topology } from './protocol';
+
+const SKIN = new THREE.Color(0xe0a98f);
+/** Distortion that maps to the top of the heat scale (30 % mean edge-length change). */
+export const HEAT_MAX = 0.3;
+
+/** Heat colour of a distortion value: neutral blue-grey at 0, yellow at half, red at HEAT_MAX. */
+export function heatColor(value: number, out: THREE.Color): THREE.Color {
+  const t = Math.min(Math.max(value / HEAT_MAX, 0), 1);
+  if (t < 0.5) return out.setRGB(0.55 + 0.9 * t, 0.6 + 0.6 * t, 0.75 - 1.3 * t);
+  const s = (t - 0.5) * 2;
+  return out.setRGB(1.0, 0.9 - 0.8 * s, 0.1 - 0.05 * s);
+}
+
+/**
+ * The engine's frame (WebXR: fingers along −Z, back of the hand +Y) turned for viewing:
+ * fingers up, palm toward the default camera.
+ */
+const PRESENT = new THREE.Quaternion().setFromEuler(new THREE.Euler(Math.PI / 2, Math.PI, 0, 'YXZ'));
+
+class HandView {
+  /** Placed side by side in the scene. */
+  readonly group = new THREE.Group();
+  /** Engine coordinates inside. */
+  readonly oriented = new THREE.Group();
+  readonly mesh: THREE.Mesh<THREE.BufferGeometry, THREE.MeshPhysicalMaterial>;
+  readonly bones: THREE.LineSegments;
+  readonly jointDots: THREE.Points;
+  method: Method | null = null;
+
+  constructor(topology: Topology) {
+    const n = topology.vertexCount;
+    const geometry = new THREE.BufferGeometry();
+    geometry.setIndex(new THREE.BufferAttribute(topology.indices, 1));
+    for (const [name, size] of [['position', 3], ['normal', 3], ['color', 3]] as const) {
+      const attribute = new THREE.BufferAttribute(new Float32Array(n * size), size);
+      attribute.setUsage(THREE.DynamicDrawUsage);
+      geometry.setAttribute(name, attribute);
+    }
+    const material = new THREE.MeshPhysicalMaterial({
+      color: SKIN, roughness: 0.55, metalness: 0, sheen: 0.5, sheenRoughness: 0.5,
+      sheenColor: new THREE.Color(0xff8f7a), clearcoat: 0.08, clearcoatRoughness: 0.5,
+    });
+    this.mesh = new THREE.Mesh(geometry, material);
+    this.mesh.castShadow = true;
+    this.mesh.receiveShadow = true;
+    this.mesh.frustumCulled = false;
+    const pairs = Array.from(topology.parents).filter((p) => p >= 0).length;
+    const lines = new THREE.BufferGeometry();
+    lines.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pairs * 6), 3));
+    this.bones = new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ color: 0x1d6fe0, depthTest: false }));
+    const dots = new THREE.BufferGeometry();
+    dots.setAttribute('position', new THREE.BufferAttribute(new Float32Array(topology.parents.length * 3), 3));
+    this.jointDots = new THREE.Points(dots, new THREE.PointsMaterial({ color: 0x0b3d91, size: 6, sizeAttenuation: false, depthTest: false }));
+    for (const o of [this.bones, this.jointDots]) {
+      o.renderOrder = 10;
+      o.frustumCulled = false;
+    }
+    this.oriented.quaternion.copy(PRESENT);
+    this.oriented.add(this.mesh, this.bones, this.jointDots);
+    this.group.add(this.oriented);
+  }
+
+  update(frame: Frame, index: number, parents: Int32Array, heat: THREE.Color): void {
+    const arrays = frame.meshes[index];
+    this.method = arrays.method;
+    const g = this.mesh.geometry;
+    const position = g.getAttribute('position') as THREE.BufferAttribute;
+    const normal = g.getAttribute('normal') as THREE.BufferAttribute;
+    (position.array as Float32Array).set(arrays.positions);
+    (normal.array as Float32Array).set(arrays.normals);
+    position.needsUpdate = true;
+    normal.needsUpdate = true;
+    const material = this.mesh.material;
+    const heatOn = arrays.distortion !== null;
+    if (heatOn) {
+      const color = g.getAttribute('color') as THREE.BufferAttribute;
+      const c = color.array as Float32Array;
+      arrays.distortion!.forEach((d, v) => {
+        heatColor(d, heat);
+        c[3 * v] = heat.r;
+        c[3 * v + 1] = heat.g;
+        c[3 * v + 2] = heat.b;
+      });
+      color.needsUpdate = true;
+    }
+    if (material.vertexColors !== heatOn) {
+      material.vertexColors = heatOn;
+      material.color.set(heatOn ? 0xffffff : SKIN);
+      material.sheen = heatOn ? 0 : 0.5;
+      material.needsUpdate = true;
+    }
+    const lines = this.bones.geometry.getAttribute('position') as THREE.BufferAttribute;
+    const l = lines.array as Float32Array;
+    let k = 0;
+    parents.forEach((p, j) => {
+      if (p < 0) return;
+      l.set(frame.joints.subarray(3 * p, 3 * p + 3), k);
+      l.set(frame.joints.subarray(3 * j, 3 * j + 3), k + 3);
+      k += 6;
+    });
+    lines.needsUpdate = true;
+    const dots = this.jointDots.geometry.getAttribute('position') as THREE.BufferAttribute;
+    (dots.array as Float32Array).set(frame.joints);
+    dots.needsUpdate = true;
+  }
+}
+
+export class HandScene {
+  readonly renderer: THREE.WebGLRenderer;
+  readonly scene = new THREE.Scene();
+  readonly camera = new THREE.PerspectiveCamera(35, 1, 0.005, 20);
+  readonly controls: OrbitControls;
+  private readonly key: THREE.DirectionalLight;
+  private readonly ground: THREE.Mesh;
+  private views: HandView[] = [];
+  private parents: Int32Array = new Int32Array(0);
+  private spacing = 0.15;
+  private framed = false;
+  private shownCount = 0;
+  private readonly heat = new THREE.Color();
+  /** Centre and size of the hand at the first frame, for camera presets. */
+  readonly bounds = new THREE.Box3();
+  showSkeleton = false;
+  lastFrame: Frame | null = null;
+
+  constructor(readonly canvas: HTMLCanvasElement) {
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.shadowMap.enabled = true;
+    this.renderer.shadowMap.type = THREE.PCFShadowMap;
+    this.renderer.toneMapping = THREE.ACESFilmicToneMapping;
+    this.renderer.toneMappingExposure = 1.05;
+    this.scene.background = new THREE.Color(0xf2f1ee);
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.enableDamping = true;
+
+    this.scene.add(new THREE.HemisphereLight(0xfdfbf7, 0x9a8a80, 1.3));
+    this.key = new THREE.DirectionalLight(0xfff4e8, 2.4);
+    this.key.castShadow = true;
+    this.key.shadow.mapSize.set(2048, 2048);
+    this.key.shadow.radius = 6;
+    this.key.shadow.blurSamples = 16;
+    this.key.shadow.bias = -0.0004;
+    this.key.shadow.normalBias = 0.002;
+    this.scene.add(this.key, this.key.target);
+    const fill = new THREE.DirectionalLight(0xdde8ff, 0.7);
+    fill.position.set(-1, 0.4, -0.6);
+    this.scene.add(fill);
+    this.ground = new THREE.Mesh(new THREE.PlaneGeometry(4, 4), new THREE.ShadowMaterial({ opacity: 0.22 }));
+    this.ground.rotation.x = -Math.PI / 2;
+    this.ground.receiveShadow = true;
+    this.scene.add(this.ground);
+  }
+
+  setTopology(topology: Topology): void {
+    for (const v of this.views) {
+      this.scene.remove(v.group);
+      v.mesh.geometry.dispose();
+      v.mesh.material.dispose();
+    }
+    this.views = [0, 1, 2].map(() => new HandView(topology));
+    for (const v of this.views) this.scene.add(v.group);
+    this.parents = topology.parents;
+    this.framed = false;
+  }
+
+  /** Shows a frame: one hand per mesh in it, side by side. */
+  showFrame(frame: Frame): void {
+    if (this.views.length === 0 || frame.header.vertexCount !== this.views[0].mesh.geometry.getAttribute('position').count) return;
+    this.lastFrame = frame;
+    const count = frame.meshes.length;
+    this.views.forEach((view, i) => {
+      view.group.visible = i < count;
+      if (i >= count) return;
+      view.update(frame, i, this.parents, this.heat);
+      view.group.position.x = (i - (count - 1) / 2) * this.spacing;
+      view.bones.visible = view.jointDots.visible = this.showSkeleton;
+    });
+    if (!this.framed) {
+      this.framed = true;
+      const first = this.views[0];
+      first.mesh.geometry.computeBoundingBox();
+      this.bounds.copy(first.mesh.geometry.boundingBox!).applyMatrix4(new THREE.Matrix4().makeRotationFromQuaternion(PRESENT));
+      const size = this.bounds.getSize(new THREE.Vector3());
+      this.spacing = Math.max(size.x, 0.6 * size.z) * 1.2;
+      this.ground.position.y = this.bounds.min.y - 0.03;
+    }
+    if (count !== this.shownCount) {
+      this.shownCount = count;
+      this.setView('default');
+    }
+  }
+
+  /** Visible hands and their methods, left to right. */
+  visibleMethods(): (Method | null)[] {
+    return this.views.filter((v) => v.group.visible).map((v) => v.method);
+  }
+
+  setWireframe(on: boolean): void {
+    for (const v of this.views) v.mesh.material.wireframe = on;
+  }
+
+  /** Camera presets: the whole scene, or close on a point of the first hand. */
+  setView(preset: 'default' | 'side', focus?: THREE.Vector3, distance?: number): void {
+    const center = focus ?? this.bounds.getCenter(new THREE.Vector3());
+    const count = Math.max(1, this.visibleMethods().length);
+    const size = this.bounds.getSize(new THREE.Vector3()).length();
+    const d = distance ?? size * (1.5 + 0.55 * (count - 1));
+    const direction = preset === 'side' ? new THREE.Vector3(1, 0.2, 0.1) : new THREE.Vector3(0.3, 0.35, 1);
+    this.controls.target.copy(center);
+    this.camera.position.copy(center).addScaledVector(direction.normalize(), d);
+    this.key.position.copy(center).add(new THREE.Vector3(0.35, 1.0, 0.6));
+    this.key.target.position.copy(center);
+    const s = this.key.shadow.camera;
+    s.left = s.bottom = -0.4;
+    s.right = s.top = 0.4;
+    s.near = 0.1;
+    s.far = 3;
+    s.updateProjectionMatrix();
+    this.controls.update();
+  }
+
+  /** Where the first visible hand's joint `index` is in the world (for zoomed figures). */
+  jointPosition(index: number): THREE.Vector3 | null {
+    const f = this.lastFrame;
+    if (!f || 3 * index + 2 >= f.joints.length) return null;
+    const first = this.views.find((v) => v.group.visible) ?? this.views[0];
+    first.group.updateMatrixWorld();
+    return first.oriented.localToWorld(new THREE.Vector3(f.joints[3 * index], f.joints[3 * index + 1], f.joints[3 * index + 2]));
+  }
+
+  /** Screen position (CSS pixels) of each visible hand's centre, for the method labels. */
+  labelPositions(): { method: Method | null; x: number; y: number }[] {
+    const rect = this.canvas.getBoundingClientRect();
+    const top = new THREE.Vector3();
+    return this.views
+      .filter((v) => v.group.visible)
+      .map((v) => {
+        top.set(0, this.bounds.max.y + 0.02, 0).add(this.bounds.getCenter(new THREE.Vector3()).setY(0)).add(v.group.position);
+        top.project(this.camera);
+        return { method: v.method, x: ((top.x + 1) / 2) * rect.width, y: ((1 - top.y) / 2) * rect.height };
+      });
+  }
+
+  render(): void {
+    const { clientWidth: w, clientHeight: h } = this.canvas;
+    if (this.canvas.width !== Math.floor(w * this.renderer.getPixelRatio()) || this.canvas.height !== Math.floor(h * this.renderer.getPixelRatio())) {
+      this.renderer.setSize(w, h, false);
+      this.camera.aspect = w / Math.max(h, 1);
+      this.camera.updateProjectionMatrix();
+    }
+    this.controls.update();
+    this.renderer.render(this.scene, this.camera);
+  }
+}
