@@ -83,7 +83,11 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
                     let _ = ws.flush();
                     return Ok(());
                 }
-                Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => return Ok(()),
+                Err(
+                    tungstenite::Error::ConnectionClosed
+                    | tungstenite::Error::AlreadyClosed
+                    | tungstenite::Error::Protocol(tungstenite::error::ProtocolError::ResetWithoutClosingHandshake),
+                ) => return Ok(()),
                 Err(e) => return Err(io(e)),
             }
         }

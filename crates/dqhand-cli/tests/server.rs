@@ -1,0 +1,295 @@
+//! `dqhand demo` as a server: what it binds to, the files it serves (and refuses), and the
+//! engine stream under good and bad clients.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use dqhand::skin::Method;
+use dqhand::stream::{FrameView, Topology};
+use serde_json::Value;
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+/// A running `dqhand demo` on a free loopback port, killed when dropped.
+struct Server {
+    child: Child,
+    address: String,
+    banner: String,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A directory that stands in for the built page, and a secret beside it.
+fn site(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dqhand-server-{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("site/assets")).unwrap();
+    std::fs::write(dir.join("site/index.html"), "<!doctype html><title>viewer</title>").unwrap();
+    std::fs::write(dir.join("site/assets/app.js"), "console.log(1)").unwrap();
+    std::fs::write(dir.join("secret.txt"), "do not serve").unwrap();
+    dir
+}
+
+fn start(test: &str, extra: &[&str]) -> Server {
+    let dir = site(test);
+    let viewer = dir.join("site");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dqhand"))
+        .args(["demo", "--no-open", "--port", "0", "--viewer"])
+        .arg(&viewer)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut banner = String::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        banner.push_str(&line);
+        banner.push('\n');
+        if let Some(url) = line.strip_prefix("viewer: http://") {
+            let address = url.trim_end_matches('/').to_string();
+            std::thread::spawn(move || lines.for_each(drop));
+            return Server { child, address, banner };
+        }
+    }
+    panic!("no URL printed: {banner}");
+}
+
+/// Sends a raw request and returns the status code and body.
+fn http(address: &str, request: &str) -> (u16, String) {
+    let mut s = TcpStream::connect(address).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut response = String::new();
+    let _ = s.read_to_string(&mut response);
+    let status = response.split(' ').nth(1).and_then(|c| c.parse().ok()).unwrap_or(0);
+    let body = response.split_once("\r\n\r\n").map_or("", |(_, b)| b).to_string();
+    (status, body)
+}
+
+fn get(address: &str, path: &str) -> (u16, String) {
+    http(address, &format!("GET {path} HTTP/1.1\r\nHost: {address}\r\n\r\n"))
+}
+
+type Client = WebSocket<MaybeTlsStream<TcpStream>>;
+
+fn connect(server: &Server) -> Client {
+    let (mut ws, _) = tungstenite::connect(format!("ws://{}/stream", server.address)).unwrap();
+    if let MaybeTlsStream::Plain(s) = ws.get_mut() {
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    }
+    ws
+}
+
+fn text(ws: &mut Client) -> Value {
+    loop {
+        match ws.read().unwrap() {
+            Message::Text(t) => return serde_json::from_str(&t).unwrap(),
+            Message::Binary(_) => {}
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+}
+
+/// The next frame, acknowledged.
+fn next_frame(ws: &mut Client) -> FrameView {
+    loop {
+        if let Message::Binary(b) = ws.read().unwrap() {
+            if b.starts_with(b"DQHF") {
+                let f = FrameView::parse(&b).unwrap();
+                ws.send(Message::text(format!(r#"{{"type":"ack","seq":{}}}"#, f.header.sequence))).unwrap();
+                return f;
+            }
+        }
+    }
+}
+
+/// Reads until an error message arrives (acknowledging frames meanwhile).
+fn next_error(ws: &mut Client) -> String {
+    loop {
+        match ws.read().unwrap() {
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(&t).unwrap();
+                if v["type"] == "error" {
+                    return v["message"].as_str().unwrap().to_string();
+                }
+            }
+            Message::Binary(b) if b.starts_with(b"DQHF") => {
+                let seq = FrameView::parse(&b).unwrap().header.sequence;
+                ws.send(Message::text(format!(r#"{{"type":"ack","seq":{seq}}}"#))).unwrap();
+            }
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn binds_to_loopback_by_default_and_says_so() {
+    let server = start("banner", &[]);
+    assert!(server.address.starts_with("127.0.0.1:"), "{}", server.address);
+    assert!(server.banner.contains("this machine only"), "{}", server.banner);
+}
+
+#[test]
+fn serves_the_page_and_nothing_outside_it() {
+    let server = start("files", &[]);
+    let a = &server.address;
+    assert_eq!(get(a, "/"), (200, "<!doctype html><title>viewer</title>".into()));
+    assert_eq!(get(a, "/assets/app.js").0, 200);
+    assert_eq!(get(a, "/index.html?x=1").0, 200);
+    for path in ["/../secret.txt", "/assets/../../secret.txt", "/%2e%2e/secret.txt", "/..%2fsecret.txt", "/assets%5c..%5c..%5csecret.txt", "//etc/passwd", "/missing.js", "/%zz"] {
+        let (status, body) = get(a, path);
+        assert!(status == 404 || status == 400, "{path}: {status}");
+        assert!(!body.contains("do not serve"), "{path} leaked the file");
+    }
+    assert_eq!(http(a, &format!("POST / HTTP/1.1\r\nHost: {a}\r\nContent-Length: 0\r\n\r\n")).0, 405);
+    assert_eq!(http(a, "this is not http\r\n\r\n").0, 400);
+    let huge = format!("GET / HTTP/1.1\r\nHost: {a}\r\nX-Big: {}\r\n\r\n", "a".repeat(10_000));
+    assert_eq!(http(a, &huge).0, 431);
+    assert_eq!(get(a, "/stream").0, 426, "the stream path needs an upgrade");
+    let foreign = format!(
+        "GET /stream HTTP/1.1\r\nHost: {a}\r\nOrigin: http://evil.example\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+         Sec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+    );
+    assert_eq!(http(a, &foreign).0, 403, "another site's page may not drive the engine");
+    assert_eq!(get(a, "/").0, 200, "still serving");
+}
+
+#[test]
+fn streams_hello_topology_and_frames_and_applies_edits() {
+    let server = start("stream", &[]);
+    let mut ws = connect(&server);
+    let hello = text(&mut ws);
+    assert_eq!(hello["type"], "hello");
+    assert_eq!(hello["joint_model"], "full");
+    let vertices = hello["vertices"].as_u64().unwrap() as u32;
+    let Message::Binary(topology) = ws.read().unwrap() else { panic!("topology expected") };
+    let topology = Topology::parse(&topology).unwrap();
+    assert_eq!(topology.vertex_count, vertices);
+    let f = next_frame(&mut ws);
+    assert_eq!(f.header.vertex_count, vertices);
+    assert_eq!(f.header.methods, [Some(Method::Dqb), None, None]);
+    assert!(f.header.state & 1 != 0, "the default scene plays the gesture sequence");
+    ws.send(Message::text(r#"{"type":"view","methods":["lb","qb","dqb"]}"#)).unwrap();
+    ws.send(Message::text(r#"{"type":"angle","dof":"index-finger-phalanx-intermediate.flex","deg":90}"#)).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let f = next_frame(&mut ws);
+        if f.header.mesh_count() == 3 && (f.angles[9].to_degrees() - 90.0).abs() < 1e-3 {
+            assert_eq!(f.header.state & 1, 0, "an edit pauses the timeline");
+            break;
+        }
+        assert!(Instant::now() < deadline, "edits never showed in the frames");
+    }
+    ws.send(Message::text(r#"{"type":"joint_model","name":"paper"}"#)).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        if let Message::Text(t) = ws.read().unwrap() {
+            let v: Value = serde_json::from_str(&t).unwrap();
+            assert_eq!(v["type"], "hello");
+            assert_eq!(v["dofs"].as_array().unwrap().len(), 18);
+            break;
+        }
+        assert!(Instant::now() < deadline);
+    }
+}
+
+#[test]
+fn bad_messages_get_an_error_and_the_server_keeps_serving() {
+    let server = start("bad", &[]);
+    let mut watcher = connect(&server);
+    next_frame(&mut watcher);
+    let mut ws = connect(&server);
+    next_frame(&mut ws);
+    for (message, expect) in [
+        (Message::text("{not json"), "not a valid command"),
+        (Message::text(r#"{"type":"teleport"}"#), "unknown variant"),
+        (Message::text(r#"{"type":"angle","dof":"nose.flex","deg":3}"#), "unknown degree of freedom"),
+        (Message::binary(vec![1u8, 2, 3]), "binary messages are not commands"),
+        (Message::text(format!(r#"{{"type":"rest","pad":"{}"}}"#, "x".repeat(10_000))), "at most 4096"),
+    ] {
+        ws.send(message).unwrap();
+        let e = next_error(&mut ws);
+        assert!(e.contains(expect), "{e:?} should mention {expect:?}");
+    }
+    next_frame(&mut ws); // the same connection goes on
+    // Larger than any message the server reads: an error, then the connection is closed.
+    ws.send(Message::text("x".repeat(200_000))).unwrap();
+    let e = next_error(&mut ws);
+    assert!(e.contains("closing"), "{e}");
+    let closed = loop {
+        match ws.read() {
+            Ok(Message::Close(_)) | Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => break true,
+            Err(tungstenite::Error::Io(e)) => break !matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut),
+            Err(tungstenite::Error::Protocol(_)) => break true,
+            Ok(_) => {}
+            Err(e) => panic!("{e}"),
+        }
+    };
+    assert!(closed, "the connection is closed after an oversized message");
+    // The other viewer never noticed.
+    let before = next_frame(&mut watcher).header.sequence;
+    for _ in 0..10 {
+        next_frame(&mut watcher);
+    }
+    assert_eq!(next_frame(&mut watcher).header.sequence, before + 11);
+    assert_eq!(get(&server.address, "/").0, 200);
+}
+
+#[test]
+fn clients_that_vanish_or_stall_do_not_stall_the_others() {
+    let server = start("vanish", &["--fps", "200"]);
+    let mut watcher = connect(&server);
+    next_frame(&mut watcher);
+    // One client leaves in the middle of a frame, one never reads, one sends half a message.
+    {
+        let mut ws = connect(&server);
+        text(&mut ws);
+        if let MaybeTlsStream::Plain(s) = ws.get_mut() {
+            let mut partial = [0u8; 1000];
+            let _ = s.read(&mut partial);
+            s.shutdown(std::net::Shutdown::Both).unwrap();
+        }
+    }
+    let _stalled = connect(&server);
+    let mut half = TcpStream::connect(&server.address).unwrap();
+    let a = &server.address;
+    write!(half, "GET /stream HTTP/1.1\r\nHost: {a}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n").unwrap();
+    half.write_all(&[0x81, 0xfe, 0x10]).unwrap(); // a masked text frame header, cut short
+    drop(half);
+    let start = Instant::now();
+    let first = next_frame(&mut watcher).header.sequence;
+    let mut last = first;
+    while start.elapsed() < Duration::from_millis(1500) {
+        last = next_frame(&mut watcher).header.sequence;
+    }
+    let rate = f64::from(last - first) / start.elapsed().as_secs_f64();
+    assert!(rate > 20.0, "the watcher kept receiving frames ({rate:.0}/s)");
+}
+
+#[test]
+fn refuses_a_port_in_use_and_a_missing_viewer() {
+    let server = start("port", &[]);
+    let port = server.address.rsplit(':').next().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand"))
+        .args(["demo", "--no-open", "--port", port, "--viewer"])
+        .arg(site("port2").join("site"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&format!("cannot listen on 127.0.0.1:{port}")), "{err}");
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["demo", "--no-open", "--viewer", "/nonexistent/dist"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/dist: no index.html"));
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["demo", "--fps", "0"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
