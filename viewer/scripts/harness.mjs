@@ -1,0 +1,106 @@
+// Shared by the browser tests and `make figures`: start `dqhand demo` on a free loopback port,
+// launch Debian's Chromium headless through playwright-core (no browser download), read the
+// rendered canvas back.
+
+import { spawn } from 'node:child_process';
+import { existsSync } from 'node:fs';
+import path from 'node:path';
+import { createInterface } from 'node:readline';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+
+/** The dqhand binary: $DQHAND_BIN, else the release build, else the debug build. */
+export function dqhandBin() {
+  if (process.env.DQHAND_BIN) return process.env.DQHAND_BIN;
+  const release = path.join(root, 'target/release/dqhand');
+  return existsSync(release) ? release : path.join(root, 'target/debug/dqhand');
+}
+
+/** Starts the viewer server; resolves once it prints its URL. */
+export function startServer({ port = 0, args = [] } = {}) {
+  const child = spawn(dqhandBin(), ['demo', '--no-open', '--port', String(port), '--viewer', path.join(root, 'viewer/dist'), ...args], {
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  return new Promise((resolve, reject) => {
+    const lines = createInterface({ input: child.stdout });
+    const timer = setTimeout(() => reject(new Error('dqhand demo printed no URL in 120 s')), 120_000);
+    child.on('exit', (code) => reject(new Error(`dqhand demo exited with ${code}`)));
+    lines.on('line', (line) => {
+      const m = /^viewer: (http:\/\/[^/]+\/)/.exec(line);
+      if (!m) return;
+      clearTimeout(timer);
+      const url = m[1];
+      resolve({
+        url,
+        port: Number(new URL(url).port),
+        stop: () =>
+          new Promise((done) => {
+            child.once('exit', () => done());
+            child.kill();
+          }),
+      });
+    });
+  });
+}
+
+/** Headless Chromium with software WebGL (SwiftShader), as on a machine without a GPU. */
+export function launchBrowser() {
+  const executablePath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+  if (!existsSync(executablePath)) throw new Error(`${executablePath} not found: install Debian's chromium (make test does)`);
+  return chromium.launch({
+    executablePath,
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox'],
+  });
+}
+
+/** Waits until the page's state satisfies `predicate` (a function source over `s`). */
+export async function waitState(page, predicate, timeout = 60_000) {
+  await page.waitForFunction(`(() => { const s = window.dqhand && window.dqhand.state(); return !!s && (${predicate}); })()`, null, { timeout, polling: 100 });
+}
+
+/** Lets the page draw a few more frames (so the canvas shows the latest engine frame). */
+export async function settle(page, frames = 3) {
+  await page.evaluate(
+    (n) => new Promise((done) => { let k = 0; const tick = () => (++k >= n ? done() : requestAnimationFrame(tick)); requestAnimationFrame(tick); }),
+    frames,
+  );
+}
+
+/**
+ * The canvas, read back: for each of `columns` vertical strips, how many pixels differ from
+ * the background; and a coarse 64×40 grey thumbnail to compare two renders.
+ */
+export async function canvasStats(page, columns = 1) {
+  return page.evaluate((columns) => {
+    const c = document.getElementById('view');
+    const w = c.width, h = c.height;
+    const tmp = document.createElement('canvas');
+    tmp.width = w;
+    tmp.height = h;
+    const g = tmp.getContext('2d');
+    g.drawImage(c, 0, 0);
+    const d = g.getImageData(0, 0, w, h).data;
+    const bg = [d[0], d[1], d[2]];
+    const strips = new Array(columns).fill(0);
+    const thumb = new Array(64 * 40).fill(0);
+    const counts = new Array(64 * 40).fill(0);
+    for (let y = 0; y < h; y++) {
+      for (let x = 0; x < w; x++) {
+        const i = 4 * (y * w + x);
+        const diff = Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]);
+        if (diff > 40) strips[Math.min(columns - 1, Math.floor((x * columns) / w))]++;
+        const t = Math.floor((y * 40) / h) * 64 + Math.floor((x * 64) / w);
+        thumb[t] += (d[i] + d[i + 1] + d[i + 2]) / 3;
+        counts[t]++;
+      }
+    }
+    return { width: w, height: h, strips, thumb: thumb.map((v, i) => v / counts[i]) };
+  }, columns);
+}
+
+/** Mean absolute difference of two thumbnails, in grey levels. */
+export function thumbDifference(a, b) {
+  return a.thumb.reduce((sum, v, i) => sum + Math.abs(v - b.thumb[i]), 0) / a.thumb.length;
+}

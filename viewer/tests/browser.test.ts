@@ -1,0 +1,138 @@
+// The real page in headless Chromium against a real `dqhand demo`: it loads and draws, the
+// controls reach the engine and come back as the right change on screen, and it survives a
+// server restart.
+
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { Browser, Page } from 'playwright-core';
+import { canvasStats, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+
+type Server = Awaited<ReturnType<typeof startServer>>;
+let server: Server;
+let browser: Browser;
+let page: Page;
+
+interface State {
+  connected: boolean;
+  framesReceived: number;
+  dofs: string[];
+  joints: string[];
+  visible: string[];
+  frame: { methods: string[]; anglesDeg: number[]; joints: number[]; playing: boolean } | null;
+}
+const state = (): Promise<State> => page.evaluate(() => (window as unknown as { dqhand: { state(): State } }).dqhand.state());
+const send = (command: object) => page.evaluate((c) => (window as unknown as { dqhand: { send(c: object): void } }).dqhand.send(c), command);
+
+/** Index of a DOF in the frame's angles. */
+const dof = (s: State, name: string) => s.dofs.indexOf(name);
+const tip = (s: State, finger: string) => {
+  const j = s.joints.indexOf(`${finger}-tip`);
+  return s.frame!.joints.slice(3 * j, 3 * j + 3);
+};
+const distance = (a: number[], b: number[]) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+
+beforeAll(async () => {
+  server = await startServer();
+  browser = await launchBrowser();
+  page = await browser.newPage({ viewport: { width: 900, height: 520 } });
+  page.on('pageerror', (e) => console.error('page error:', e.message));
+  await page.goto(server.url);
+  await waitState(page, 's.connected && s.framesReceived > 3 && s.visible.length === 1');
+});
+
+afterAll(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+describe('the viewer page', () => {
+  test('loads, plays the gesture sequence and draws a hand on the canvas', async () => {
+    const s = await state();
+    expect(s.frame!.playing).toBe(true);
+    expect(s.dofs).toHaveLength(23);
+    await settle(page);
+    const stats = await canvasStats(page);
+    const covered = stats.strips[0] / (stats.width * stats.height);
+    expect(covered).toBeGreaterThan(0.02);
+    expect(covered).toBeLessThan(0.9);
+    expect(await page.locator('#stats').textContent()).toMatch(/engine \d+ fps/);
+  });
+
+  test('a gesture button reaches its pose', async () => {
+    await page.click('button[data-gesture="fist"]');
+    const s = await state();
+    const pip = dof(s, 'index-finger-phalanx-intermediate.flex');
+    const mcp = dof(s, 'index-finger-phalanx-proximal.flex');
+    await waitState(page, `Math.abs(s.frame.anglesDeg[${pip}] - 100) < 0.01 && Math.abs(s.frame.anglesDeg[${mcp}] - 85) < 0.01 && !s.frame.playing`);
+  });
+
+  test('a slider moves the right finger and only that finger', async () => {
+    await send({ type: 'rest' });
+    await waitState(page, 's.frame.anglesDeg.every((a) => Math.abs(a) < 1e-3)');
+    const before = await state();
+    const name = 'index-finger-phalanx-intermediate.flex';
+    await page.locator(`input[data-dof="${name}"]`).fill('90');
+    const i = dof(before, name);
+    await waitState(page, `Math.abs(s.frame.anglesDeg[${i}] - 90) < 0.01`);
+    const after = await state();
+    expect(distance(tip(before, 'index-finger'), tip(after, 'index-finger'))).toBeGreaterThan(0.02);
+    for (const f of ['thumb', 'middle-finger', 'ring-finger', 'pinky-finger']) {
+      expect(distance(tip(before, f), tip(after, f))).toBeLessThan(1e-5);
+    }
+  });
+
+  test('switching the method changes the rendered hand', async () => {
+    await page.click('button[data-gesture="fist"]');
+    await waitState(page, '!s.frame.playing && s.frame.methods[0] === "dqb"');
+    await page.waitForTimeout(1000); // the move to the gesture takes 0.6 s
+    await settle(page);
+    const dqb = await canvasStats(page);
+    await page.check('#method-qb');
+    await waitState(page, 's.visible.length === 1 && s.visible[0] === "qb"');
+    await settle(page);
+    const qb = await canvasStats(page);
+    await page.check('#method-dqb');
+    await waitState(page, 's.visible[0] === "dqb"');
+    await settle(page);
+    const again = await canvasStats(page);
+    expect(thumbDifference(dqb, again)).toBeLessThan(0.5); // the same method draws the same hand
+    expect(thumbDifference(dqb, qb)).toBeGreaterThan(2 * thumbDifference(dqb, again) + 0.5);
+  });
+
+  test('the split view shows three hands, LB, QB and DQB', async () => {
+    await page.check('#split');
+    await waitState(page, 's.visible.join() === "lb,qb,dqb" && s.frame.methods.length === 3');
+    await settle(page);
+    const stats = await canvasStats(page, 3);
+    const strip = (stats.width / 3) * stats.height;
+    for (const covered of stats.strips) expect(covered / strip).toBeGreaterThan(0.01);
+    expect(await page.locator('#labels span').allTextContents()).toEqual(['LB', 'QB', 'DQB']);
+  });
+
+  test('the heat map colours the distortion', async () => {
+    await page.check('#heatmap');
+    await waitState(page, 's.frame && s.frame.methods.length === 3');
+    await page.waitForFunction(() => (window as unknown as { dqhand: { state(): { frame: { distortion: boolean } } } }).dqhand.state().frame.distortion);
+    await settle(page);
+    const reds = await page.evaluate(() => {
+      const c = document.getElementById('view') as HTMLCanvasElement;
+      const g = Object.assign(document.createElement('canvas'), { width: c.width, height: c.height }).getContext('2d')!;
+      g.drawImage(c, 0, 0);
+      const d = g.getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 110 && d[i + 2] < 90) n++;
+      return n;
+    });
+    expect(reds).toBeGreaterThan(50); // a fist stretches the skin over the knuckles
+    await page.uncheck('#heatmap');
+  });
+
+  test('the page reconnects after the server restarts, with its settings', async () => {
+    const port = server.port;
+    await server.stop();
+    await waitState(page, '!s.connected');
+    expect(await page.locator('#status').textContent()).toMatch(/reconnecting/);
+    server = await startServer({ port });
+    const before = (await state()).framesReceived;
+    await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
+  });
+});
