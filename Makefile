@@ -1,18 +1,33 @@
 # dqhand — `make demo` sets up and runs the main job; `make test` sets up and runs every test.
-# Both install what a fresh machine lacks (the Rust toolchain is expected, Node for assets).
+# Both install what a fresh machine lacks (the Rust toolchain and Node.js are expected; Debian's
+# chromium is installed for the browser tests when running as root).
 
 CARGO ?= cargo
 NPM ?= npm
+CHROMIUM ?= /usr/bin/chromium
 WEBXR_HAND := third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb
 VALIDATOR := third_party/node_modules/gltf-validator/package.json
+VIEWER_DEPS := viewer/node_modules/.package-lock.json
+VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build assets bench clean
+.PHONY: demo test build viewer assets chromium figures bench clean
 
-demo: build
-	./target/release/dqhand demo --out out/demo
+# The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
+demo: build viewer
+	./target/release/dqhand demo
 
 build:
 	$(CARGO) build --release --locked -p dqhand-cli
+
+# The page (TypeScript + three.js, built by Vite into viewer/dist, which `dqhand demo` serves).
+viewer: $(VIEWER_DIST)
+
+$(VIEWER_DEPS): viewer/package.json viewer/package-lock.json
+	cd viewer && $(NPM) ci --no-audit --no-fund
+	touch $@
+
+$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*)
+	cd viewer && $(NPM) run build
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
 # nothing third-party is committed.
@@ -22,14 +37,27 @@ $(WEBXR_HAND) $(VALIDATOR) &: third_party/package.json third_party/package-lock.
 	cd third_party && $(NPM) ci --no-audit --no-fund
 	touch $(WEBXR_HAND) $(VALIDATOR)
 
-# Rust tests (unit, property, golden, CLI), then the Khronos glTF validator on what we write.
-test: assets
+# Debian's Chromium drives the browser tests and the figures (no browser download).
+chromium:
+	@test -x $(CHROMIUM) || { \
+	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; \
+	  else echo "make: $(CHROMIUM) missing: install Debian's chromium (sudo apt-get install chromium)" >&2; exit 1; fi; }
+
+# Rust tests (unit, property, golden, CLI, server), the Khronos glTF validator on what we write,
+# then the page: protocol unit tests and browser tests against a real `dqhand demo`.
+test: assets viewer chromium
 	$(CARGO) test --locked --workspace
 	node --test tests/
+	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
+
+# docs/figures/*.png: the paper's Figures 5-7 on our hand, rendered by the real page.
+figures: build viewer chromium
+	cd viewer && DQHAND_BIN=$(CURDIR)/target/release/dqhand CHROMIUM=$(CHROMIUM) node scripts/figures.mjs
 
 bench: build
 	./target/release/dqhand bench
+	./target/release/dqhand bench --stream 3
 
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist

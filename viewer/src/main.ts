@@ -214,8 +214,8 @@ window.dqhand = {
   }),
   send: (command: Command) => connection.send(command),
   setting: (command: Command) => connection.setting(command),
-  /** Camera: 'default' | 'side', optionally close on a joint (by name) at a distance (m). */
-  view: (preset: 'default' | 'side', joint?: string, distance?: number) => {
+  /** Camera: 'default', 'side' or a direction, optionally close on a joint (by name) at a distance (m). */
+  view: (preset: 'default' | 'side' | [number, number, number], joint?: string, distance?: number) => {
     const index = joint && hello ? hello.joints.indexOf(joint) : -1;
     scene.setView(preset, index >= 0 ? scene.jointPosition(index) ?? undefined : undefined, distance);
   },

@@ -207,13 +207,18 @@ export class HandScene {
     for (const v of this.views) v.mesh.material.wireframe = on;
   }
 
-  /** Camera presets: the whole scene, or close on a point of the first hand. */
-  setView(preset: 'default' | 'side', focus?: THREE.Vector3, distance?: number): void {
+  /**
+   * Camera: from the front (`default`), from the index finger's side (`side`) or along a
+   * given direction, at the whole scene or close on a point.
+   */
+  setView(preset: 'default' | 'side' | [number, number, number], focus?: THREE.Vector3, distance?: number): void {
     const center = focus ?? this.bounds.getCenter(new THREE.Vector3());
     const count = Math.max(1, this.visibleMethods().length);
     const size = this.bounds.getSize(new THREE.Vector3()).length();
     const d = distance ?? size * (1.5 + 0.55 * (count - 1));
-    const direction = preset === 'side' ? new THREE.Vector3(1, 0.2, 0.1) : new THREE.Vector3(0.3, 0.35, 1);
+    const direction = Array.isArray(preset)
+      ? new THREE.Vector3(...preset)
+      : preset === 'side' ? new THREE.Vector3(1, 0.15, 0.2) : new THREE.Vector3(0.3, 0.35, 1);
     this.controls.target.copy(center);
     this.camera.position.copy(center).addScaledVector(direction.normalize(), d);
     this.key.position.copy(center).add(new THREE.Vector3(0.35, 1.0, 0.6));

@@ -28,6 +28,10 @@ pub struct Args {
     /// Time the portable kernel even where the AVX2 + FMA one would run.
     #[arg(long)]
     portable: bool,
+    /// Instead, measure the viewer stream end to end for this many seconds per run: split
+    /// view over a loopback WebSocket, at 120 fps and as fast as it goes.
+    #[arg(long, value_name = "SECONDS")]
+    stream: Option<f64>,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -35,6 +39,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = dqhand::io::load_model(&args.mesh)?;
     if !args.json {
         crate::warn_all(&model.warnings);
+    }
+    if let Some(seconds) = args.stream {
+        anyhow::ensure!(seconds > 0.0 && seconds <= 600.0, "--stream takes 0 to 600 seconds");
+        return crate::bench_stream::run(model, seconds, args.json);
     }
     let (animation, poses) = animation(&model)?;
     let mesh = &model.mesh;

@@ -45,7 +45,7 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-fn parse_fps(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_fps(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(f) if (1.0..=1000.0).contains(&f) => Ok(f),
         _ => Err(format!("{s:?} is not a frame rate from 1 to 1000")),
@@ -74,7 +74,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !args.no_open {
         open_browser(&url);
     }
-    let shared = server::Shared { model: Arc::new(model), joint_model: args.joint_model, assets, fps: args.fps };
+    let shared = server::Shared { model: Arc::new(model), joint_model: args.joint_model, assets: Some(assets), fps: args.fps };
     server::serve(listener, shared)?;
     Ok(())
 }

@@ -4,6 +4,7 @@
 //! one-line error on stderr otherwise (clap exits with 2 on bad usage).
 
 mod bench;
+mod bench_stream;
 mod demo;
 mod hand;
 mod info;

@@ -61,6 +61,8 @@ fn start(test: &str, extra: &[&str]) -> Server {
             return Server { child, address, banner };
         }
     }
+    let _ = child.kill();
+    let _ = child.wait();
     panic!("no URL printed: {banner}");
 }
 

@@ -26,8 +26,8 @@ pub struct Shared {
     pub model: Arc<Model>,
     /// The joint model a new viewer starts with.
     pub joint_model: JointModel,
-    /// The built page (`viewer/dist`), canonical.
-    pub assets: PathBuf,
+    /// The built page (`viewer/dist`), canonical; `None` serves the stream only.
+    pub assets: Option<PathBuf>,
     /// Frames per second streamed to each viewer.
     pub fps: f64,
 }
@@ -79,7 +79,9 @@ fn connection(stream: TcpStream, shared: &Shared) -> std::io::Result<()> {
                 request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false)
             }
         }
+    } else if let Some(root) = &shared.assets {
+        assets::serve(&stream, &request, root)
     } else {
-        assets::serve(&stream, &request, &shared.assets)
+        request::respond(&stream, 404, "text/plain", b"not found\n", false)
     }
 }
