@@ -104,3 +104,17 @@ export async function canvasStats(page, columns = 1) {
 export function thumbDifference(a, b) {
   return a.thumb.reduce((sum, v, i) => sum + Math.abs(v - b.thumb[i]), 0) / a.thumb.length;
 }
+
+/** Pixels of the canvas whose red, green and blue lie in the given [min, max] ranges. */
+export async function countColour(page, { r = [0, 255], g = [0, 255], b = [0, 255] }) {
+  return page.evaluate(({ r, g, b }) => {
+    const c = document.getElementById('view');
+    const ctx = Object.assign(document.createElement('canvas'), { width: c.width, height: c.height }).getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, 0, c.width, c.height).data;
+    const inside = (v, [lo, hi]) => v >= lo && v <= hi;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (inside(d[i], r) && inside(d[i + 1], g) && inside(d[i + 2], b)) n++;
+    return n;
+  }, { r, g, b });
+}

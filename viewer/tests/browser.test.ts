@@ -4,7 +4,7 @@
 
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
-import { canvasStats, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 let server: Server;
@@ -113,17 +113,28 @@ describe('the viewer page', () => {
     await waitState(page, 's.frame && s.frame.methods.length === 3');
     await page.waitForFunction(() => (window as unknown as { dqhand: { state(): { frame: { distortion: boolean } } } }).dqhand.state().frame.distortion);
     await settle(page);
-    const reds = await page.evaluate(() => {
-      const c = document.getElementById('view') as HTMLCanvasElement;
-      const g = Object.assign(document.createElement('canvas'), { width: c.width, height: c.height }).getContext('2d')!;
-      g.drawImage(c, 0, 0);
-      const d = g.getImageData(0, 0, c.width, c.height).data;
-      let n = 0;
-      for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 110 && d[i + 2] < 90) n++;
-      return n;
-    });
+    const reds = await countColour(page, { r: [181, 255], g: [0, 109], b: [0, 89] });
     expect(reds).toBeGreaterThan(50); // a fist stretches the skin over the knuckles
     await page.uncheck('#heatmap');
+  });
+
+  test('wireframe and skeleton overlays change what is drawn', async () => {
+    await page.uncheck('#split'); // one hand: software WebGL draws wireframes slowly
+    await waitState(page, 's.visible.length === 1');
+    await settle(page);
+    const plain = await canvasStats(page);
+    await page.check('#wireframe');
+    await settle(page);
+    const wire = await canvasStats(page);
+    expect(thumbDifference(plain, wire)).toBeGreaterThan(1);
+    await page.uncheck('#wireframe');
+    await page.check('#skeleton');
+    await settle(page);
+    const blue = await countColour(page, { r: [0, 89], b: [151, 255] });
+    expect(blue).toBeGreaterThan(100); // the bones, drawn over the skin
+    await page.uncheck('#skeleton');
+    await page.check('#split');
+    await waitState(page, 's.visible.length === 3');
   });
 
   test('the page reconnects after the server restarts, with its settings', async () => {

@@ -126,7 +126,8 @@ fn next_error(ws: &mut Client) -> String {
             }
             Message::Binary(b) if b.starts_with(b"DQHF") => {
                 let seq = FrameView::parse(&b).unwrap().header.sequence;
-                ws.send(Message::text(format!(r#"{{"type":"ack","seq":{seq}}}"#))).unwrap();
+                // The server may already be closing (after an oversized message).
+                let _ = ws.send(Message::text(format!(r#"{{"type":"ack","seq":{seq}}}"#)));
             }
             _ => {}
         }

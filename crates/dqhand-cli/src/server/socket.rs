@@ -81,6 +81,7 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
                     let _ = send_error(&mut ws, &format!("message refused: {e}; closing"));
                     let _ = ws.close(None);
                     let _ = ws.flush();
+                    linger(ws.get_mut());
                     return Ok(());
                 }
                 Err(
@@ -102,6 +103,24 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
         next_frame += period;
         if next_frame < now {
             next_frame = now; // after a stall, resume the rate instead of bursting to catch up
+        }
+    }
+}
+
+/// Closes our side and reads (and drops) what the client is still sending, for up to a
+/// second, before the socket goes: closing with unread data makes the kernel reset the
+/// connection, and the client would lose the error message sent just before.
+fn linger(stream: &mut TcpStream) {
+    let _ = stream.shutdown(std::net::Shutdown::Write);
+    let deadline = Instant::now() + Duration::from_secs(1);
+    let mut sink = [0u8; 16 * 1024];
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(100)));
+    while Instant::now() < deadline {
+        match std::io::Read::read(stream, &mut sink) {
+            Ok(0) => return,
+            Ok(_) => {}
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(_) => return,
         }
     }
 }
