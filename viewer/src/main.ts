@@ -106,6 +106,9 @@ function slider(label: string, min: number, max: number, step: number, onInput: 
   return row;
 }
 
+/** The slider of each DOF, in the hello's order (found once per rebuild, not per frame). */
+let dofInputs: (HTMLInputElement | null)[] = [];
+
 function buildSliders(h: Hello): void {
   const limits = $<HTMLInputElement>('limits').checked;
   const groups = FINGERS.map((finger) => {
@@ -122,6 +125,7 @@ function buildSliders(h: Hello): void {
     return d;
   });
   $('sliders').replaceChildren(...groups);
+  dofInputs = h.dofs.map((d) => $('sliders').querySelector<HTMLInputElement>(`input[data-dof="${d.name}"]`));
   if ($('wrist').childElementCount === 0) {
     const wrist = [0, 0, 0, 0, 0, 0];
     const send = () => connection.send({ type: 'wrist', translation: [wrist[0] / 100, wrist[1] / 100, wrist[2] / 100], rotation_deg: [wrist[3], wrist[4], wrist[5]] });
@@ -133,8 +137,7 @@ function buildSliders(h: Hello): void {
 /** Moves the sliders and the timeline to the engine's pose (except the one being dragged). */
 function syncControls(f: Frame): void {
   if (!hello || f.angles.length !== hello.dofs.length) return;
-  hello.dofs.forEach((dof, i) => {
-    const input = document.querySelector<HTMLInputElement>(`input[data-dof="${dof.name}"]`);
+  dofInputs.forEach((input, i) => {
     if (!input || input === dragging) return;
     const deg = Math.round((f.angles[i] * 180) / Math.PI);
     if (input.value !== String(deg)) {
@@ -168,17 +171,16 @@ function loop(now: number): void {
       `page ${pageFps.toFixed(0)} fps   engine ${h.engineFps.toFixed(0)} fps\n` +
       `engine ${(engineUs / 1000).toFixed(2)} ms/frame (${h.methods.join(' + ').toUpperCase()})\n` +
       `${(frame.byteLength / 1024).toFixed(0)} KiB/frame, ${h.vertexCount.toLocaleString()} vertices`;
-    $('labels').replaceChildren(
-      ...(h.methods.length > 1 || figure
-        ? scene.labelPositions().map(({ method, x, y }) => {
-            const s = document.createElement('span');
-            s.textContent = (method ?? '').toUpperCase();
-            s.style.left = `${x}px`;
-            s.style.top = `${y}px`;
-            return s;
-          })
-        : []),
-    );
+    const labels = h.methods.length > 1 || figure ? scene.labelPositions() : [];
+    const spans = $('labels');
+    while (spans.childElementCount < labels.length) spans.append(document.createElement('span'));
+    while (spans.childElementCount > labels.length) spans.lastElementChild!.remove();
+    labels.forEach(({ method, x, y }, i) => {
+      const span = spans.children[i] as HTMLElement;
+      span.textContent = (method ?? '').toUpperCase();
+      span.style.left = `${x}px`;
+      span.style.top = `${y}px`;
+    });
   }
   requestAnimationFrame(loop);
 }
