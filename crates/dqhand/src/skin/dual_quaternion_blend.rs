@@ -25,7 +25,7 @@ pub(crate) fn params(m: &Affine3A) -> [f32; W] {
 pub(crate) struct Dqb;
 
 impl Blend<W> for Dqb {
-    const ALIGN: bool = true;
+    const SIGNED: usize = W;
 
     #[inline(always)]
     fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {

@@ -20,9 +20,12 @@ pub(crate) struct Chunk {
 
 /// What differs between LB, QB and DQB.
 pub(crate) trait Blend<const W: usize> {
-    /// Whether influences are sign-aligned to the heaviest one before blending (quaternion
-    /// methods: `q` and `−q` are the same rotation but blend differently).
-    const ALIGN: bool;
+    /// How many leading parameters are sign-aligned to the heaviest influence before
+    /// blending: the quaternion parts, since `q` and `−q` are the same rotation but blend
+    /// differently. QB aligns its rotation (4) but not its translation, which is blended as
+    /// is; DQB aligns the whole dual quaternion (8), whose dual part changes sign with the
+    /// real part; LB aligns nothing (0).
+    const SIGNED: usize;
     /// Finishes a chunk from the blended parameters `b[component][lane]`.
     fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk);
 }
@@ -31,7 +34,7 @@ pub(crate) trait Blend<const W: usize> {
 pub(crate) struct Frame<'a, const W: usize> {
     /// Blend parameters per joint, #joints.
     pub params: &'a [[f32; W]],
-    /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused without `ALIGN`).
+    /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused when `SIGNED` is 0).
     pub signs: &'a [f32],
     /// Use the portable kernel even where the AVX2 one would run.
     pub portable: bool,
@@ -105,7 +108,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
     // and sign lookup in bounds.
     let joints = frame.params.len();
     assert_eq!(joints, mesh.inverse_bind().len(), "one parameter row per joint");
-    assert!(!B::ALIGN || frame.signs.len() == mesh.pairs.len() + 1, "one sign per joint pair");
+    assert!(B::SIGNED == 0 || frame.signs.len() == mesh.pairs.len() + 1, "one sign per joint pair");
     let lanes = |a: &[f32], base: usize| -> Lanes { a[base..base + LANES].try_into().unwrap() };
     let mut rest = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
     let mut out = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
@@ -116,7 +119,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
         let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
         let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
         let ps: &[[u32; K]; LANES] = all_ps[base..base + LANES].try_into().unwrap();
-        blend::<W, K, AVX>(frame, B::ALIGN, usize::from(kc), Slots { js, ws, ps }, &mut b);
+        blend::<W, K, AVX>(frame, B::SIGNED, usize::from(kc), Slots { js, ws, ps }, &mut b);
         for c in 0..3 {
             rest.p[c] = lanes(&mesh.pos[c], base);
             rest.n[c] = lanes(&mesh.nrm[c], base);
@@ -138,17 +141,18 @@ pub(crate) struct Slots<'a, const K: usize> {
 }
 
 /// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]` over the
-/// first `kc` influence slots (the chunk's largest influence count).
+/// first `kc` influence slots (the chunk's largest influence count), the sign `sₗₖ` applied
+/// to the first `signed` components only (1 for the rest).
 ///
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, align: bool, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
+fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, signed: usize, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
         // joint indices are in bounds (see `chunks`).
-        unsafe { avx2::blend::<W, K>(frame, align, kc, slots, b) };
+        unsafe { avx2::blend::<W, K>(frame, signed, kc, slots, b) };
         return;
     }
     let Slots { js, ws, ps } = slots;
@@ -156,10 +160,11 @@ fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, 
     for (l, acc) in acc.iter_mut().enumerate() {
         for k in 0..kc.min(K) {
             let j = usize::from(js[l][k]);
-            let w = if align { ws[l][k] * frame.signs[ps[l][k] as usize] } else { ws[l][k] };
+            let w = ws[l][k];
+            let sw = if signed > 0 { w * frame.signs[ps[l][k] as usize] } else { w };
             let p = &frame.params[j];
             for c in 0..W {
-                acc[c] += w * p[c];
+                acc[c] += if c < signed { sw } else { w } * p[c];
             }
         }
     }
@@ -210,7 +215,7 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn blend<const W: usize, const K: usize>(
         frame: &Frame<'_, W>,
-        align: bool,
+        signed: usize,
         kc: usize,
         slots: Slots<'_, K>,
         b: &mut [Lanes; W],
@@ -218,17 +223,26 @@ mod avx2 {
         const { assert!(W == 8 || W == 16) };
         let Slots { js, ws, ps } = slots;
         let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
+        // Per block of eight parameters, which take the signed weight: all, none, or the
+        // first few (QB's rotation), picked by a lane mask.
+        let first = |blk: usize| _mm256_set1_epi32((signed as i32 - 8 * blk as i32).clamp(0, 8));
+        let mask = |blk: usize| _mm256_castsi256_ps(_mm256_cmpgt_epi32(first(blk), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+        let masks = [mask(0), mask(1)];
         // Influence-major, lanes unrolled: the accumulators stay in registers.
         for k in 0..kc.min(K) {
             for l in 0..LANES {
                 let j = usize::from(js[l][k]);
-                let mut w = ws[l][k];
-                if align {
-                    w *= *frame.signs.get_unchecked(ps[l][k] as usize);
-                }
-                let wv = _mm256_set1_ps(w);
+                let w = _mm256_set1_ps(ws[l][k]);
+                let sw = if signed > 0 { _mm256_mul_ps(w, _mm256_set1_ps(*frame.signs.get_unchecked(ps[l][k] as usize))) } else { w };
                 let p = frame.params.get_unchecked(j).as_ptr();
                 for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
+                    let wv = if signed >= 8 * (blk + 1) {
+                        sw
+                    } else if signed <= 8 * blk {
+                        w
+                    } else {
+                        _mm256_blendv_ps(w, sw, masks[blk])
+                    };
                     r[l] = _mm256_fmadd_ps(wv, _mm256_loadu_ps(p.add(8 * blk)), r[l]);
                 }
             }

@@ -20,7 +20,7 @@ pub(crate) fn params(m: &Affine3A) -> [f32; W] {
 pub(crate) struct Lb;
 
 impl Blend<W> for Lb {
-    const ALIGN: bool = false;
+    const SIGNED: usize = 0;
 
     /// Positions by the blended matrix; normals by its cofactor matrix (the inverse transpose
     /// up to the determinant), whose rows are cross products of the other two rows.

@@ -22,7 +22,7 @@ pub(crate) fn params(m: &Affine3A) -> [f32; W] {
 pub(crate) struct Qb;
 
 impl Blend<W> for Qb {
-    const ALIGN: bool = true;
+    const SIGNED: usize = 4;
 
     #[inline(always)]
     fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
