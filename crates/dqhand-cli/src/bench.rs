@@ -2,15 +2,19 @@
 //!
 //! The three methods are timed interleaved, frame by frame, in one run (the order rotating
 //! each frame), so that machine noise hits them alike; the report is the median per frame
-//! and the ratios of medians. The pose sequence (forward kinematics) is computed before
-//! timing: what is timed is `Deformer::deform`, per-bone conversion included.
+//! and the ratios of medians. Each frame the engine's kinematics stage poses the hand
+//! untimed; what is timed is its skin stage (`Engine::skin`), per-bone conversion included.
 
 use std::time::Instant;
 
-use dqhand::kinematics::{HandRig, JointModel, Limits};
-use dqhand::model::{Model, PoseBuffers};
-use dqhand::skin::{Deformed, Deformer, Method};
-use glam::{Affine3A, Quat};
+use std::sync::Arc;
+
+use dqhand::engine::{Engine, ModelSource};
+use dqhand::gesture::Sequence;
+use dqhand::kinematics::{JointModel, Pose};
+use dqhand::model::Model;
+use dqhand::skin::Method;
+use glam::Quat;
 use serde_json::json;
 
 /// Arguments of `dqhand bench`.
@@ -18,7 +22,7 @@ use serde_json::json;
 pub struct Args {
     /// A .glb or .gltf file, or `builtin` for the built-in hand.
     #[arg(long, default_value = "builtin")]
-    mesh: String,
+    mesh: ModelSource,
     /// Frames timed per method.
     #[arg(long, default_value_t = 2000)]
     frames: usize,
@@ -36,7 +40,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.frames > 0, "--frames must be at least 1");
-    let model = dqhand::io::load_model(&args.mesh)?;
+    let model = args.mesh.load()?;
     if !args.json {
         crate::warn_all(&model.warnings);
     }
@@ -44,43 +48,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         anyhow::ensure!(seconds > 0.0 && seconds <= 600.0, "--stream takes 0 to 600 seconds");
         return crate::bench_stream::run(model, seconds, args.json);
     }
-    let (animation, poses) = animation(&model)?;
-    let mesh = &model.mesh;
-    let mut deformers: Vec<Deformer> = Method::ALL
-        .iter()
-        .map(|&m| Deformer::new(m, mesh))
-        .map(|d| if args.portable { d.portable() } else { d })
-        .collect();
-    let mut out = Deformed::new(mesh);
+    let model = Arc::new(model);
+    let mut animation = Animation::new(model.clone());
+    if args.portable {
+        animation.engine.use_portable_kernel();
+    }
     let mut samples = vec![Vec::with_capacity(args.frames); 3];
     // Warm-up: caches, branch predictors, CPU frequency.
-    for f in 0..poses.len().min(100) {
-        for d in &mut deformers {
-            d.deform(mesh, &poses[f], &mut out);
+    for f in 0..100 {
+        animation.pose(f);
+        for m in Method::ALL {
+            animation.engine.skin(m);
         }
     }
     for f in 0..args.frames {
-        let skinning = &poses[f % poses.len()];
+        animation.pose(f);
         for k in 0..3 {
-            let m = (f + k) % 3;
+            let m = Method::ALL[(f + k) % 3];
             let t = Instant::now();
-            deformers[m].deform(mesh, skinning, &mut out);
-            samples[m].push(t.elapsed().as_secs_f64() * 1e6);
+            let out = animation.engine.skin(m);
+            samples[m.index()].push(t.elapsed().as_secs_f64() * 1e6);
             std::hint::black_box(out.positions());
         }
     }
+    let mesh = &model.mesh;
+    let animation = animation.name;
     let stats: Vec<(f64, f64, f64)> = samples.iter_mut().map(|s| (percentile(s, 0.5), percentile(s, 0.1), percentile(s, 0.9))).collect();
-    let median = |m: Method| stats[m as usize].0;
+    let median = |m: Method| stats[m.index()].0;
     let simd = if dqhand::skin::simd_available() && !args.portable { "avx2+fma" } else { "portable" };
     let methods: serde_json::Map<String, serde_json::Value> = Method::ALL
         .iter()
         .map(|&m| {
-            let (med, p10, p90) = stats[m as usize];
+            let (med, p10, p90) = stats[m.index()];
             (m.as_str().to_owned(), json!({ "us_per_frame": med, "fps": 1e6 / med, "p10_us": p10, "p90_us": p90 }))
         })
         .collect();
     let report = json!({
-        "mesh": args.mesh,
+        "mesh": args.mesh.to_string(),
         "vertices": mesh.vertex_count(),
         "triangles": mesh.triangle_count(),
         "bones": mesh.bone_count(),
@@ -109,7 +113,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
         println!("{:<6} {:>12} {:>12} {:>12} {:>14}", "method", "median µs", "p10 µs", "p90 µs", "frames/s");
         for m in Method::ALL {
-            let (med, p10, p90) = stats[m as usize];
+            let (med, p10, p90) = stats[m.index()];
             println!("{:<6} {med:>12.1} {p10:>12.1} {p90:>12.1} {:>14.0}", m.as_str().to_uppercase(), 1e6 / med);
         }
         println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", median(Method::Dqb) / median(Method::Lb), median(Method::Dqb) / median(Method::Qb));
@@ -117,33 +121,50 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The poses to time: the gesture tour for a hand with WebXR joints, else every joint
-/// swinging ±30° about its own X axis.
-fn animation(model: &Model) -> anyhow::Result<(&'static str, Vec<Vec<Affine3A>>)> {
-    let ib = model.mesh.inverse_bind();
-    if let Ok(rig) = HandRig::new(&model.skeleton, JointModel::Full) {
-        let mut buffers = PoseBuffers::new(rig.skeleton());
-        let frames = dqhand::gesture::tour(JointModel::Full, 20)
-            .iter()
-            .map(|pose| {
-                rig.locals(pose, Limits::Anatomical, &mut buffers.locals);
-                buffers.evaluate(rig.skeleton(), ib).to_vec()
-            })
-            .collect();
-        return Ok(("the gesture tour", frames));
+/// The poses to time, frame by frame: the bundled gesture sequence (the viewer's timeline)
+/// sampled at 60 frames per second for a hand with WebXR joints, else every joint swinging
+/// ±30° about its own X axis over 240 frames.
+struct Animation {
+    engine: Engine,
+    name: &'static str,
+    sequence: Option<(Sequence, Pose)>,
+    rest: Vec<dqhand::kinematics::Transform>,
+    locals: Vec<dqhand::kinematics::Transform>,
+}
+
+impl Animation {
+    fn new(model: Arc<Model>) -> Self {
+        let rest = model.skeleton.rest_locals();
+        match Engine::with_joint_model(model.clone(), JointModel::Full) {
+            Ok(engine) => Self {
+                engine,
+                name: "the gesture sequence",
+                sequence: Some((Sequence::gestures(JointModel::Full), Pose::rest(JointModel::Full.dof_count()))),
+                locals: rest.clone(),
+                rest,
+            },
+            Err(_) => Self { engine: Engine::new(model), name: "joint swings", sequence: None, locals: rest.clone(), rest },
+        }
     }
-    let mut buffers = PoseBuffers::new(&model.skeleton);
-    let rest = model.skeleton.rest_locals();
-    let frames = (0..240)
-        .map(|f| {
-            let a = (f as f32 / 240.0 * std::f32::consts::TAU).sin() * 30f32.to_radians();
-            for (l, r) in buffers.locals.iter_mut().zip(&rest) {
-                l.rotation = r.rotation * Quat::from_rotation_x(a);
+
+    /// Poses frame `f` (the kinematics stage, untimed).
+    fn pose(&mut self, f: usize) {
+        match &mut self.sequence {
+            Some((sequence, pose)) => {
+                let rest_wrist = self.engine.rig().expect("a joint model").rest_wrist();
+                let time = (f as f32 / 60.0) % sequence.duration();
+                sequence.sample(time, rest_wrist, pose);
+                self.engine.pose(pose);
             }
-            buffers.evaluate(&model.skeleton, ib).to_vec()
-        })
-        .collect();
-    Ok(("joint swings", frames))
+            None => {
+                let a = (f as f32 / 240.0 * std::f32::consts::TAU).sin() * 30f32.to_radians();
+                for (l, r) in self.locals.iter_mut().zip(&self.rest) {
+                    l.rotation = r.rotation * Quat::from_rotation_x(a);
+                }
+                self.engine.pose_locals(&self.locals);
+            }
+        }
+    }
 }
 
 fn percentile(s: &mut [f64], q: f64) -> f64 {

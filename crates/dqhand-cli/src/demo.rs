@@ -7,10 +7,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context};
+use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::GESTURES;
-use dqhand::io::{PoseFile, PoseTarget};
-use dqhand::kinematics::{JointModel, Limits};
-use dqhand::skin::{Deformed, Deformer, Method};
+use dqhand::io::PoseFile;
+use dqhand::kinematics::JointModel;
+use dqhand::skin::Method;
 
 use crate::server;
 
@@ -35,7 +36,7 @@ pub struct Args {
     joint_model: JointModel,
     /// The hand: `builtin` or a skinned glTF with WebXR joint names.
     #[arg(long, default_value = "builtin")]
-    model: String,
+    model: ModelSource,
     /// The built page (default: viewer/dist of this checkout).
     #[arg(long)]
     viewer: Option<PathBuf>,
@@ -57,7 +58,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return write_gestures(out);
     }
     let assets = viewer_dir(args.viewer.as_deref())?;
-    let model = dqhand::io::load_model(&args.model)?;
+    let model = args.model.load()?;
     crate::warn_all(&model.warnings);
     let address = SocketAddr::new(args.host, args.port);
     let listener = TcpListener::bind(address).with_context(|| format!("cannot listen on {address} (try another --port)"))?;
@@ -120,14 +121,13 @@ fn open_browser(url: &str) {
 
 /// `--out`: every gesture posed with each method, as GLB and pose files, and the rigged hand.
 fn write_gestures(out: &Path) -> anyhow::Result<()> {
-    let model = dqhand::io::load_model("builtin")?;
+    let model = Arc::new(ModelSource::Builtin(dqhand::hand::HandParams::default()).load()?);
     std::fs::create_dir_all(out).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
     let rigged = out.join("hand.glb");
     dqhand::io::write_skinned_glb(&model, &rigged)?;
     println!("{}", model.description);
     println!("rigged, skinned hand: {}", rigged.display());
-    let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, &model.mesh)).collect();
-    let mut posed = Deformed::new(&model.mesh);
+    let mut engine = Engine::with_joint_model(model.clone(), JointModel::Full)?;
     println!("{:<10} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs");
     for (i, g) in GESTURES.iter().enumerate() {
         let pose = g.pose(JointModel::Full);
@@ -135,15 +135,13 @@ fn write_gestures(out: &Path) -> anyhow::Result<()> {
         let pose_path = out.join(format!("{stem}.pose.json"));
         let file = PoseFile::from_pose(JointModel::Full, &pose);
         std::fs::write(&pose_path, serde_json::to_string_pretty(&file)?).map_err(|e| anyhow::anyhow!("{}: {e}", pose_path.display()))?;
-        let target = PoseTarget::Angles { model: JointModel::Full, pose };
-        let (skinning, warnings) = model.pose_skinning(&target, Limits::Anatomical)?;
-        crate::warn_all(&warnings);
+        engine.pose(&pose);
         let mut times = Vec::new();
-        for d in &mut deformers {
+        for m in Method::ALL {
             let t = Instant::now();
-            d.deform(&model.mesh, &skinning, &mut posed);
+            let posed = engine.skin(m);
             times.push(t.elapsed().as_secs_f64() * 1e6);
-            let path = out.join(format!("{stem}.{}.glb", d.method()));
+            let path = out.join(format!("{stem}.{m}.glb"));
             dqhand::io::write_posed(&path, posed.positions(), posed.normals(), model.mesh.uvs(), model.mesh.indices())?;
         }
         println!("{:<10} {:>9.1} {:>9.1} {:>9.1}  {stem}.{{lb,qb,dqb}}.glb, {stem}.pose.json", g.name, times[0], times[1], times[2]);

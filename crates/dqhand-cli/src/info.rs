@@ -1,5 +1,6 @@
 //! `dqhand info`: what a skinned file (or the built-in hand) contains.
 
+use dqhand::engine::ModelSource;
 use dqhand::kinematics::{webxr, JointModel};
 use dqhand::model::Model;
 
@@ -8,13 +9,13 @@ use dqhand::model::Model;
 pub struct Args {
     /// A .glb or .gltf file, or `builtin` for the built-in hand.
     #[arg(default_value = "builtin")]
-    file: String,
+    file: ModelSource,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let model = dqhand::io::load_model(&args.file)?;
+    let model = args.file.load()?;
     crate::warn_all(&model.warnings);
-    print!("{}", describe(&args.file, &model));
+    print!("{}", describe(&args.file.to_string(), &model));
     Ok(())
 }
 

@@ -1,13 +1,16 @@
 //! `dqhand metrics`: the realism metrics of LB, QB and DQB on one hand.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+
+use dqhand::engine::ModelSource;
 
 /// Arguments of `dqhand metrics`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A .glb or .gltf file with the WebXR hand joints, or `builtin`.
     #[arg(long, default_value = "builtin")]
-    mesh: String,
+    mesh: ModelSource,
     /// Print everything as one JSON object.
     #[arg(long, conflicts_with = "markdown")]
     json: bool,
@@ -20,9 +23,9 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let model = dqhand::io::load_model(&args.mesh)?;
+    let model = args.mesh.load()?;
     crate::warn_all(&model.warnings);
-    let report = dqhand::metrics::measure(&model).map_err(|e| e.in_file(&args.mesh))?;
+    let report = dqhand::metrics::measure(Arc::new(model)).map_err(|e| e.in_file(args.mesh.to_string()))?;
     if let Err(why) = &report.closed {
         eprintln!("dqhand: warning: {}: volume is undefined: the mesh is not closed ({why}); the other metrics follow", args.mesh);
     }

@@ -2,16 +2,19 @@
 
 use std::path::PathBuf;
 
+use std::sync::Arc;
+
+use dqhand::engine::{Engine, ModelSource};
 use dqhand::io::PoseFile;
 use dqhand::kinematics::Limits;
-use dqhand::skin::{Deformed, Deformer, Method};
+use dqhand::skin::Method;
 
 /// Arguments of `dqhand skin`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A .glb or .gltf file, or `builtin` for the built-in hand.
     #[arg(long, default_value = "builtin")]
-    mesh: String,
+    mesh: ModelSource,
     /// Pose file (JSON, see the README); the rest pose if omitted.
     #[arg(long)]
     pose: Option<PathBuf>,
@@ -27,19 +30,19 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let model = dqhand::io::load_model(&args.mesh)?;
+    let model = args.mesh.load()?;
     crate::warn_all(&model.warnings);
     let pose = match &args.pose {
         Some(p) => PoseFile::load(p)?,
         None => PoseFile::default(),
     };
     let origin = args.pose.clone().unwrap_or_else(|| "rest pose".into());
-    let target = pose.resolve(&model).map_err(|e| e.in_file(&origin))?;
-    let limits = if args.no_limits { Limits::Off } else { Limits::Anatomical };
-    let (skinning, warnings) = model.pose_skinning(&target, limits).map_err(|e| e.in_file(&origin))?;
-    crate::warn_all(&warnings);
-    let mut out = Deformed::new(&model.mesh);
-    Deformer::new(args.method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
+    let target = pose.resolve(&model.skeleton).map_err(|e| e.in_file(&origin))?;
+    let model = Arc::new(model);
+    let mut engine = Engine::for_target(model.clone(), &target).map_err(|e| e.in_file(&origin))?;
+    engine.set_limits(if args.no_limits { Limits::Off } else { Limits::Anatomical });
+    crate::warn_all(&engine.pose_target(&target));
+    let out = engine.skin(args.method);
     dqhand::io::write_posed(&args.out, out.positions(), out.normals(), model.mesh.uvs(), model.mesh.indices())?;
     println!(
         "wrote {} ({} vertices, {} triangles, {})",

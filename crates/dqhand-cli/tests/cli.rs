@@ -116,7 +116,7 @@ fn hand_writes_a_rigged_hand_of_the_users_size_with_collision_proxies() {
     assert!(printed.contains("left hand") && printed.contains("2000 vertices"), "{printed}");
     let model = dqhand::io::load_gltf(&out).unwrap();
     assert_eq!(model.mesh.vertex_count(), 2000);
-    dqhand::metrics::check_closed(model.mesh.indices()).unwrap();
+    dqhand::geometry::check_closed(model.mesh.indices()).unwrap();
     // A left hand has its thumb on +X; the hand is 0.17 m from the wrist crease to the tip.
     let thumb_tip = model.skeleton.rest_world()[model.skeleton.find("thumb-tip").unwrap()].translation;
     assert!(thumb_tip.x > 0.0, "{thumb_tip}");

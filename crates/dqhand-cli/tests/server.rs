@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use dqhand::skin::Method;
+use dqhand::skin::MethodSet;
 use dqhand::stream::{FrameView, Topology};
 use serde_json::Value;
 use tungstenite::stream::MaybeTlsStream;
@@ -166,6 +166,27 @@ fn serves_the_page_and_nothing_outside_it() {
     assert_eq!(get(a, "/").0, 200, "still serving");
 }
 
+/// Issue 9 bug 8: DNS rebinding. A page of evil.example whose name was re-pointed at
+/// 127.0.0.1 sends `Host: evil.example` and a matching `Origin`; on loopback, refused.
+#[test]
+fn on_loopback_a_host_that_is_not_this_machine_is_refused() {
+    let server = start("host", &[]);
+    let a = &server.address;
+    let port = a.rsplit_once(':').unwrap().1;
+    let rebound = format!(
+        "GET /stream HTTP/1.1\r\nHost: evil.example:{port}\r\nOrigin: http://evil.example:{port}\r\nUpgrade: websocket\r\n\
+         Connection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+    );
+    let (status, body) = http(a, &rebound);
+    assert_eq!(status, 403, "{body}");
+    assert!(body.contains("evil.example"), "{body}");
+    assert_eq!(http(a, &format!("GET / HTTP/1.1\r\nHost: evil.example:{port}\r\n\r\n")).0, 403, "files too");
+    assert_eq!(http(a, "GET / HTTP/1.1\r\n\r\n").0, 400, "no Host at all");
+    for host in [format!("localhost:{port}"), format!("127.0.0.1:{port}")] {
+        assert_eq!(http(a, &format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n")).0, 200, "{host}");
+    }
+}
+
 #[test]
 fn streams_hello_topology_and_frames_and_applies_edits() {
     let server = start("stream", &[]);
@@ -179,7 +200,7 @@ fn streams_hello_topology_and_frames_and_applies_edits() {
     assert_eq!(topology.vertex_count, vertices);
     let f = next_frame(&mut ws);
     assert_eq!(f.header.vertex_count, vertices);
-    assert_eq!(f.header.methods, [Some(Method::Dqb), None, None]);
+    assert_eq!(f.header.methods, MethodSet::DQB);
     assert!(f.header.state & 1 != 0, "the default scene plays the gesture sequence");
     ws.send(Message::text(r#"{"type":"view","methods":["lb","qb","dqb"]}"#)).unwrap();
     ws.send(Message::text(r#"{"type":"angle","dof":"index-finger-phalanx-intermediate.flex","deg":90}"#)).unwrap();

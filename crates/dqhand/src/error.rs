@@ -1,8 +1,9 @@
-//! Typed errors of the library: each names the bad input and what is wrong with it.
+//! Typed errors of the library: one variant per kind of failure, so callers can branch on
+//! it; every message is lowercase and starts with the bad input (file, joint, vertex, value).
 
 use std::path::PathBuf;
 
-/// What went wrong, with the input (file, joint, vertex) it concerns.
+/// What went wrong, with the input (file, joint, vertex, value) it concerns.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -14,18 +15,64 @@ pub enum Error {
         /// The operating system's reason (part of the message, so not also a `source`).
         reason: std::io::Error,
     },
-    /// A file was read but its content is malformed or unsupported.
-    #[error("{}: {message}", path.display())]
+    /// Something read from a file is wrong: the file, then what ([`Error::in_file`]).
+    #[error("{}: {problem}", path.display())]
     File {
         /// The file.
         path: PathBuf,
-        /// What is wrong in it, lowercase, quoting the bad value.
-        message: String,
+        /// What is wrong in it; match on it to tell the kinds apart.
+        problem: Box<Error>,
     },
-    /// A skeleton, mesh or pose is inconsistent (no file involved).
+    /// A glTF file is malformed or uses something this reader does not support.
     #[error("{0}")]
-    Invalid(String),
-    /// A name (joint, DOF, node) is not known; lists the valid ones.
+    Gltf(String),
+    /// A file name's extension names no format that can be written (`.ply`, `.obj`, `.glb`).
+    #[error("{}: unknown output format; use .ply, .obj or .glb", .0.display())]
+    OutputFormat(PathBuf),
+    /// A skeleton is not a tree of uniquely named joints with finite transforms.
+    #[error("{0}")]
+    Skeleton(String),
+    /// Skinned mesh data are inconsistent (lengths, indices, weights, non-finite values).
+    #[error("{0}")]
+    Mesh(String),
+    /// A joint a joint model or measure needs is not in the skeleton.
+    #[error("skeleton has no joint {joint:?}; {needed_for}")]
+    MissingJoint {
+        /// The joint's name.
+        joint: String,
+        /// What needs it, as the end of the message.
+        needed_for: &'static str,
+    },
+    /// A joint's frame does not follow the WebXR convention the joint model poses with.
+    #[error("joint {joint:?}: {problem}; joint angles need WebXR joint frames (−Z along the bone toward the tip, +Y on the back of the hand)")]
+    JointFrame {
+        /// The joint's name.
+        joint: String,
+        /// How its frame differs.
+        problem: String,
+    },
+    /// A pose (angles, wrist, local rotations) has an unusable value.
+    #[error("{0}")]
+    Pose(String),
+    /// A pose sequence is malformed (no keyframes, times going backwards, wrong joint model).
+    #[error("{0}")]
+    Sequence(String),
+    /// The parameters of the built-in hand describe no hand.
+    #[error("{0}")]
+    HandParameter(String),
+    /// The built-in hand's surface could not be meshed as asked.
+    #[error("{0}")]
+    Tessellation(String),
+    /// No skin lies around a joint whose region is measured.
+    #[error("joint {0:?}: no skin around it to measure")]
+    NoSkin(String),
+    /// A viewer command has a value out of range or a repeated method.
+    #[error("{0}")]
+    Command(String),
+    /// A message of the viewer stream's binary format is malformed.
+    #[error("stream message: {0}")]
+    Frame(String),
+    /// A name (joint, DOF, node, method, joint model, gesture) is not known; lists the valid ones.
     #[error("unknown {kind} {name:?}; valid: {valid}")]
     UnknownName {
         /// What kind of name: "joint", "degree of freedom", "node".
@@ -43,11 +90,21 @@ impl Error {
         move |reason| Error::Io { path: path.into(), reason }
     }
 
-    /// Attaches a file path to an `Invalid` error so that the message names the input.
+    /// Attaches a file path so that the message names the input. Errors that already name
+    /// a file are returned as they are.
     #[must_use]
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         match self {
-            Error::Invalid(_) | Error::UnknownName { .. } => Error::File { path: path.into(), message: self.to_string() },
+            Error::Io { .. } | Error::File { .. } | Error::OutputFormat(_) => self,
+            other => Error::File { path: path.into(), problem: Box::new(other) },
+        }
+    }
+
+    /// The error itself, or for [`Error::File`] the problem in the file.
+    #[must_use]
+    pub fn problem(&self) -> &Error {
+        match self {
+            Error::File { problem, .. } => problem.problem(),
             other => other,
         }
     }

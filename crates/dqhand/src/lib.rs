@@ -1,14 +1,19 @@
 //! dqhand: a dual quaternion virtual hand (Chen, Zhu, Wan, Feng, "Dual quaternion based
 //! virtual hand interaction modeling", Sci China Inf Sci 56:032103, 2013).
 //!
-//! Layers, as in the paper's Figure 1:
+//! Modules from the bottom up, each importing only those above it in this list (the
+//! paper's Figure 1, layer by layer; ARCHITECTURE.md draws it):
 //! * [`math`] — dual quaternions and screws on top of glam;
+//! * [`geometry`] — mesh helpers: normals, edges, closed surfaces, volume, winding number;
 //! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
 //! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
+//! * [`model`] — a skeleton and the mesh bound to it;
 //! * [`collision`] — collision proxies per bone (paper 4.2);
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
-//! * [`model`] — a skeleton and its skinned mesh, posed frame by frame;
+//! * [`gesture`] — the gesture library and pose sequences;
+//! * [`engine`] — one step of Figure 1: pose → kinematics → skin (→ collision → interaction);
+//! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
 //! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!
 //! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
@@ -16,6 +21,8 @@
 
 mod error;
 pub mod collision;
+pub mod engine;
+pub mod geometry;
 pub mod gesture;
 pub mod hand;
 pub mod io;

@@ -5,7 +5,8 @@ use std::collections::HashSet;
 
 use dqhand::hand::{build, HandParams, Side, DEFAULT_VERTICES};
 use dqhand::kinematics::webxr;
-use dqhand::metrics::{check_closed, count_self_intersections, edges, enclosed_volume, winding_number};
+use dqhand::geometry::{check_closed, edges, enclosed_volume, winding_number};
+use dqhand::metrics::count_self_intersections;
 use dqhand::model::Model;
 use glam::{Vec3, Vec3Swizzles};
 

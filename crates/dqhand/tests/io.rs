@@ -1,10 +1,12 @@
 //! Files: glTF export and re-import of the built-in hand, the WebXR generic hand, the PLY, OBJ
 //! and GLB writers, malformed glTF input, and pose files.
 
+mod support;
+
 use std::path::{Path, PathBuf};
 
-use dqhand::io::{self, PoseFile, PoseTarget};
-use dqhand::kinematics::{webxr, Limits};
+use dqhand::io::{self, PoseFile};
+use dqhand::kinematics::{webxr, Limits, PoseTarget};
 use dqhand::model::Model;
 use dqhand::skin::{Deformed, Deformer, Method};
 use dqhand::Error;
@@ -43,7 +45,7 @@ fn pose_file(value: Value) -> PoseFile {
 /// Poses `model` with `target` and deforms it with `method`; returns positions and the
 /// clamping warnings.
 fn deform_with(model: &Model, target: &PoseTarget, limits: Limits, method: Method) -> (Vec<[f32; 3]>, Vec<String>) {
-    let (skinning, warnings) = model.pose_skinning(target, limits).expect("pose the model");
+    let (skinning, warnings) = support::pose_skinning(model, target, limits).expect("pose the model");
     let mut out = Deformed::new(&model.mesh);
     Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
     (out.positions().to_vec(), warnings)
@@ -51,7 +53,7 @@ fn deform_with(model: &Model, target: &PoseTarget, limits: Limits, method: Metho
 
 /// DQB positions of `model` posed by `pose` (anatomical limits).
 fn dqb(model: &Model, pose: &PoseFile) -> Vec<[f32; 3]> {
-    let target = pose.resolve(model).expect("resolve the pose");
+    let target = pose.resolve(&model.skeleton).expect("resolve the pose");
     deform_with(model, &target, Limits::Anatomical, Method::Dqb).0
 }
 
@@ -466,7 +468,7 @@ fn webxr_hand_local_rotations_pose_a_node() {
     let rest_rotation = model.skeleton.joints()[model.skeleton.find(joint).unwrap()].rest.rotation;
     let turned = rest_rotation * Quat::from_rotation_x(-1.0);
     let pose = pose_file(json!({ "local_rotations": { joint: turned.to_array() } }));
-    let target = pose.resolve(&model).expect("resolve node names");
+    let target = pose.resolve(&model.skeleton).expect("resolve node names");
     assert!(matches!(&target, PoseTarget::LocalRotations(r) if r.len() == 1));
     let rest = dqb(&model, &PoseFile::default());
     let posed = deform_with(&model, &target, Limits::Anatomical, Method::Dqb).0;
@@ -480,7 +482,7 @@ fn webxr_hand_local_rotations_pose_a_node() {
 fn webxr_hand_unknown_node_lists_valid_names() {
     let model = webxr_hand();
     let pose = pose_file(json!({ "local_rotations": { "index-knuckle": [0.0, 0.0, 0.0, 1.0] } }));
-    match pose.resolve(&model) {
+    match pose.resolve(&model.skeleton) {
         Err(Error::UnknownName { kind, name, valid }) => {
             assert_eq!(kind, "node");
             assert_eq!(name, "index-knuckle");
@@ -633,7 +635,7 @@ fn unnormalised_weights_load_with_a_warning() {
 #[test]
 fn pose_file_unknown_dof_lists_valid_names() {
     let pose = pose_file(json!({ "angles_deg": { "index-finger-knuckle.flex": 30 } }));
-    match pose.resolve(&builtin()) {
+    match pose.resolve(&builtin().skeleton) {
         Err(e @ Error::UnknownName { .. }) => {
             let message = e.to_string();
             for part in ["degree of freedom", "index-finger-knuckle.flex", "index-finger-phalanx-intermediate.flex", "thumb-metacarpal.abd"] {
@@ -666,7 +668,7 @@ fn pose_file_mixing_angles_and_local_rotations_is_an_error() {
         "angles_deg": { "index-finger-phalanx-proximal.flex": 30 },
         "local_rotations": { "wrist": [0.0, 0.0, 0.0, 1.0] },
     }));
-    let message = pose.resolve(&builtin()).expect_err("mixed pose").to_string();
+    let message = pose.resolve(&builtin().skeleton).expect_err("mixed pose").to_string();
     assert!(message.contains("local_rotations") && message.contains("angles_deg"), "{message}");
 }
 
@@ -682,7 +684,7 @@ fn pose_file_round_trips_through_json() {
 fn angle_beyond_limits_is_clamped_only_with_anatomical_limits() {
     let model = builtin();
     let dof = "index-finger-phalanx-intermediate.flex"; // 0..110 degrees
-    let target = |deg: f32| pose_file(json!({ "angles_deg": { dof: deg } })).resolve(&model).expect("resolve");
+    let target = |deg: f32| pose_file(json!({ "angles_deg": { dof: deg } })).resolve(&model.skeleton).expect("resolve");
     let run = |deg: f32, limits: Limits| deform_with(&model, &target(deg), limits, Method::Dqb);
 
     let (clamped, warnings) = run(150.0, Limits::Anatomical);
@@ -799,4 +801,39 @@ fn unused_broken_accessors_do_not_block_loading() {
         doc["accessors"].as_array_mut().unwrap().push(sparse);
     });
     assert_eq!(io::load_gltf(&path).unwrap().mesh.vertex_count(), 4);
+}
+
+/// Issue 9 bug 2: a glTF whose nodes are stored in another pose than the one the mesh was
+/// bound in (common in exported assets). Collision proxies and the metrics' joint regions
+/// relate vertices to joints through the inverse bind matrices, not the node pose, so they
+/// come out as for the hand stored in its bind pose.
+#[test]
+fn proxies_and_joint_regions_are_fitted_in_bind_space_when_the_node_pose_differs() {
+    use dqhand::collision::{fit_proxies, ProxyShape, PROXY_MARGIN};
+    use dqhand::metrics::JointRegion;
+    let dir = temp_dir("bind-pose");
+    let (model, _) = exported_builtin(&dir);
+    let mut turned = model.clone();
+    let pip = turned.skeleton.find("index-finger-phalanx-intermediate").unwrap();
+    let mut joints = turned.skeleton.joints().to_vec();
+    joints[pip].rest.rotation = joints[pip].rest.rotation * Quat::from_rotation_x(0.6);
+    turned.skeleton = dqhand::kinematics::Skeleton::new(joints).unwrap();
+    let path = dir.join("turned.glb");
+    io::write_skinned_glb(&turned, &path).unwrap();
+    let loaded = io::load_gltf(&path).unwrap();
+    assert_ne!(loaded.skeleton.rest_world()[pip], model.skeleton.rest_world()[pip], "the node pose differs");
+    let radius = |m: &Model, joint: usize| match fit_proxies(m, PROXY_MARGIN).into_iter().find(|p| p.joint == joint).unwrap().shape {
+        ProxyShape::Capsule { radius, .. } => radius,
+        other => panic!("expected a capsule, got {other:?}"),
+    };
+    for name in ["index-finger-phalanx-proximal", "index-finger-phalanx-intermediate", "index-finger-phalanx-distal"] {
+        let j = model.skeleton.find(name).unwrap();
+        assert_close!(radius(&loaded, j), radius(&model, j), 1e-4);
+    }
+    let region = |m: &Model| {
+        JointRegion::new(&m.skeleton, &m.bind_world(), &m.mesh, "index-finger-phalanx-intermediate", "index-finger-phalanx-distal").unwrap()
+    };
+    let (a, b) = (region(&loaded), region(&model));
+    assert_eq!(a.vertices, b.vertices);
+    assert_close!(a.radius, b.radius, 1e-5);
 }

@@ -4,7 +4,6 @@ mod support;
 
 use dqhand::hand::{build, HandParams, Side};
 use dqhand::kinematics::{forward_kinematics, HandRig, Joint, JointModel, Limits, Motion, Pose, Skeleton, Transform};
-use dqhand::model::PoseBuffers;
 use dqhand::Error;
 use glam::{Affine3A, Quat, Vec3};
 use proptest::prelude::*;
@@ -71,11 +70,9 @@ proptest! {
         for (i, n) in names[..3].iter().enumerate() {
             pose.angles[JointModel::Paper.dof_index(&format!("{n}.flex")).unwrap()] = [t.0, t.1, t.2][i];
         }
-        let mut buffers = PoseBuffers::new(rig.skeleton());
-        rig.locals(&pose, Limits::Off, &mut buffers.locals);
-        buffers.evaluate(rig.skeleton(), model.mesh.inverse_bind());
+        let world = support::world_of(&rig, &pose, Limits::Off);
         // The tip in the MCP's rest frame, which is where eq. (1) is written.
-        let tip = rest[idx[0]].inverse().transform_point3(buffers.world[idx[3]].translation.into());
+        let tip = rest[idx[0]].inverse().transform_point3(world[idx[3]].translation.into());
         let (ex, ey) = equation_1(l, [t.0, t.1, t.2]);
         assert_close!(-tip.y, ex, 1e-5);
         assert_close!(-tip.z, ey, 1e-5);
@@ -133,10 +130,8 @@ fn flexion_curls_toward_the_palm_and_abduction_spreads_on_both_sides() {
         let model = build(&HandParams { side, ..HandParams::default() }).unwrap();
         let rig = HandRig::new(&model.skeleton, JointModel::Full).unwrap();
         let tips = |pose: &Pose| {
-            let mut b = PoseBuffers::new(rig.skeleton());
-            rig.locals(pose, Limits::Anatomical, &mut b.locals);
-            b.evaluate(rig.skeleton(), model.mesh.inverse_bind());
-            let at = |n: &str| Vec3::from(b.world[model.skeleton.find(n).unwrap()].translation);
+            let world = support::world_of(&rig, pose, Limits::Anatomical);
+            let at = |n: &str| Vec3::from(world[model.skeleton.find(n).unwrap()].translation);
             (at("index-finger-tip"), at("middle-finger-tip"), at("pinky-finger-tip"), at("ring-finger-tip"))
         };
         let rest = tips(&Pose::rest(23));
@@ -158,11 +153,9 @@ fn wrist_pose_places_the_hand() {
     let model = build(&HandParams::default()).unwrap();
     let rig = HandRig::new(&model.skeleton, JointModel::Paper).unwrap();
     let wrist = dqhand::math::DualQuat::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.1, 1.2, -0.3));
-    let mut b = PoseBuffers::new(rig.skeleton());
-    rig.locals(&Pose { wrist: Some(wrist), angles: vec![0.0; 18] }, Limits::Anatomical, &mut b.locals);
-    b.evaluate(rig.skeleton(), model.mesh.inverse_bind());
+    let world = support::world_of(&rig, &Pose { wrist: Some(wrist), angles: vec![0.0; 18] }, Limits::Anatomical);
     let rest = model.skeleton.rest_world();
-    for (j, w) in b.world.iter().enumerate() {
+    for (j, w) in world.iter().enumerate() {
         assert_close!(Vec3::from(w.translation), wrist.transform_point3(rest[j].translation.into()), 1e-5);
     }
 }
@@ -213,9 +206,69 @@ fn a_flat_hand_missing_a_metacarpal_still_follows_the_wrist() {
     let proximal = flat.find("index-finger-phalanx-proximal").unwrap();
     assert_eq!(rig.skeleton().joints()[proximal].parent, flat.find("wrist"));
     let lift = dqhand::math::DualQuat::from_translation(Vec3::Y * 0.5);
-    let mut b = PoseBuffers::new(rig.skeleton());
-    rig.locals(&Pose { wrist: Some(lift), angles: vec![0.0; 18] }, Limits::Anatomical, &mut b.locals);
-    forward_kinematics(rig.skeleton(), &b.locals, &mut b.world);
+    let world = support::world_of(&rig, &Pose { wrist: Some(lift), angles: vec![0.0; 18] }, Limits::Anatomical);
     let rest_tip = flat.rest_world()[tip].translation;
-    assert_close!(Vec3::from(b.world[tip].translation), Vec3::from(rest_tip) + Vec3::Y * 0.5, 1e-5);
+    assert_close!(Vec3::from(world[tip].translation), Vec3::from(rest_tip) + Vec3::Y * 0.5, 1e-5);
+}
+
+/// The built-in hand's skeleton with every joint's world frame turned by `turn` (children
+/// keep their world positions), as another tool's convention would store it.
+fn reframed(skeleton: &Skeleton, turn: Quat, shift: Vec3) -> Skeleton {
+    let world: Vec<Affine3A> = skeleton
+        .rest_world()
+        .iter()
+        .map(|w| Affine3A::from_translation(shift) * *w * Affine3A::from_quat(turn))
+        .collect();
+    let joints = skeleton
+        .joints()
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let parent = j.parent.map_or(Affine3A::IDENTITY, |p| world[p]);
+            Joint { rest: Transform::from_affine(&(parent.inverse() * world[i])), ..j.clone() }
+        })
+        .collect();
+    Skeleton::new(joints).unwrap()
+}
+
+/// Issue 9 bug 6: flexion turns about −X, right only in WebXR joint frames. A rig whose
+/// bones run along +Y (Blender's convention) is refused, naming a joint, instead of flexing
+/// sideways.
+#[test]
+fn a_rig_in_another_bone_axis_convention_is_refused() {
+    let model = build(&HandParams::default()).unwrap();
+    let blender = reframed(&model.skeleton, Quat::from_rotation_x(std::f32::consts::FRAC_PI_2), Vec3::ZERO);
+    for joint_model in JointModel::ALL {
+        match HandRig::new(&blender, joint_model) {
+            Err(Error::JointFrame { joint, problem }) => assert!(problem.contains("90°"), "{joint}: {problem}"),
+            other => panic!("expected a joint frame error, got {other:?}"),
+        }
+    }
+    let message = HandRig::new(&blender, JointModel::Paper).unwrap_err().to_string();
+    assert!(message.contains("WebXR joint frames"), "{message}");
+    // The WebXR convention itself, anywhere in space, is accepted.
+    HandRig::new(&reframed(&model.skeleton, Quat::IDENTITY, Vec3::new(0.3, 1.2, -0.4)), JointModel::Full).unwrap();
+}
+
+/// Issue 9 bug 3: a missing wrist means the rest wrist when posing, so interpolating from no
+/// wrist to the rest wrist must not move a hand whose rest wrist is away from the origin.
+#[test]
+fn interpolating_from_no_wrist_to_the_rest_wrist_keeps_the_hand_still() {
+    let model = build(&HandParams::default()).unwrap();
+    let moved = reframed(&model.skeleton, Quat::IDENTITY, Vec3::new(0.3, 1.2, -0.4));
+    let rig = HandRig::new(&moved, JointModel::Full).unwrap();
+    let rest_wrist = rig.rest_wrist();
+    assert_close!(rest_wrist.translation(), Vec3::new(0.3, 1.2, -0.4), 1e-5);
+    let none = Pose::rest(JointModel::Full.dof_count());
+    let at_rest = Pose { wrist: Some(rest_wrist), ..none.clone() };
+    let still = support::world_of(&rig, &none, Limits::Anatomical);
+    for t in [0.25, 0.5, 0.75] {
+        for (a, b) in [(&none, &at_rest), (&at_rest, &none)] {
+            let world = support::world_of(&rig, &a.interpolate(b, t, rest_wrist), Limits::Anatomical);
+            for (w, s) in world.iter().zip(&still) {
+                assert_close!(Vec3::from(w.translation), Vec3::from(s.translation), 1e-5);
+            }
+        }
+    }
+    assert_eq!(none.interpolate(&none, 0.5, rest_wrist).wrist, None, "no wrist on either side stays none");
 }

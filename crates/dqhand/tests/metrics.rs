@@ -2,7 +2,8 @@
 //! built-in hand (DQB keeps volume and radius where LB collapses).
 
 use dqhand::hand::{build, HandParams};
-use dqhand::metrics::{check_closed, edge_distortion, edges, enclosed_volume, measure, winding_number};
+use dqhand::geometry::{check_closed, edges, enclosed_volume, winding_number};
+use dqhand::metrics::{edge_distortion, measure};
 
 /// A unit cube, outward-facing triangles.
 fn cube() -> (Vec<[f32; 3]>, Vec<u32>) {
@@ -56,7 +57,7 @@ fn distortion_is_zero_at_rest_and_measures_stretch() {
 fn dqb_keeps_volume_and_radius_where_lb_collapses() {
     let model = build(&HandParams::default()).unwrap();
     assert_eq!(check_closed(model.mesh.indices()), Ok(()));
-    let report = measure(&model).unwrap();
+    let report = measure(std::sync::Arc::new(model)).unwrap();
     let h = report.headline();
     let row = |label: &str| h.iter().find(|r| r.0.starts_with(label)).unwrap_or_else(|| panic!("no row {label}")).1.map(Option::unwrap);
     let [lb, _, dqb] = row("skin-to-bone distance at 90° PIP, smallest");
@@ -82,7 +83,7 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
 
 #[test]
 fn dqb_flips_past_180_degrees_of_twist_and_the_report_shows_it() {
-    let report = measure(&build(&HandParams::default()).unwrap()).unwrap();
+    let report = measure(std::sync::Arc::new(build(&HandParams::default()).unwrap())).unwrap();
     let twist = report.sweep("index-pip-twist").unwrap();
     let dqb = &twist.frames[2];
     // At 180° the twisted bone's rotation leaves the hemisphere of its neighbour's, the sign

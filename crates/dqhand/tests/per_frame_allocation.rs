@@ -1,16 +1,17 @@
-//! The per-frame path allocates nothing: pose → local transforms → forward kinematics →
-//! skinning transforms → deformation, with buffers made once beforehand; and so does a
-//! viewer session's frame (playback, three methods, heat map, encoding).
+//! The per-frame path allocates nothing: one engine step (pose → local transforms → forward
+//! kinematics → skinning transforms → deformation with each method), with buffers made once
+//! beforehand; and so does a viewer session's frame (playback, three methods, heat map,
+//! encoding).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::Arc;
 
-use dqhand::gesture::tour;
+use dqhand::engine::Engine;
+use dqhand::gesture::Sequence;
 use dqhand::hand::{build, HandParams};
-use dqhand::kinematics::{HandRig, JointModel, Limits};
-use dqhand::model::PoseBuffers;
-use dqhand::skin::{Deformed, Deformer, Method};
+use dqhand::kinematics::{JointModel, Pose};
+use dqhand::skin::MethodSet;
 use dqhand::stream::{Command, Session};
 
 /// Counts the allocations of each thread (tests run on threads of their own).
@@ -38,22 +39,19 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 #[test]
-fn posing_and_skinning_a_frame_allocates_nothing() {
-    let model = build(&HandParams::default()).unwrap();
-    let rig = HandRig::new(&model.skeleton, JointModel::Full).unwrap();
-    let poses = tour(JointModel::Full, 3);
-    let mut buffers = PoseBuffers::new(rig.skeleton());
-    let mut out = Deformed::new(&model.mesh);
-    let mut deformers: Vec<Deformer> = Method::ALL.iter().map(|&m| Deformer::new(m, &model.mesh)).collect();
+fn an_engine_step_allocates_nothing() {
+    let model = Arc::new(build(&HandParams::default()).unwrap());
+    let mut engine = Engine::with_joint_model(model, JointModel::Full).unwrap();
+    engine.set_methods(MethodSet::ALL);
+    let sequence = Sequence::gestures(JointModel::Full);
+    let rest_wrist = engine.rig().unwrap().rest_wrist();
+    let mut pose = Pose::rest(JointModel::Full.dof_count());
     let before = allocations();
-    for pose in &poses {
-        rig.locals(pose, Limits::Anatomical, &mut buffers.locals);
-        let skinning = buffers.evaluate(rig.skeleton(), model.mesh.inverse_bind());
-        for d in &mut deformers {
-            d.deform(&model.mesh, skinning, &mut out);
-        }
+    for f in 0..60 {
+        sequence.sample(f as f32 * 0.35, rest_wrist, &mut pose);
+        engine.step(&pose);
     }
-    assert_eq!(allocations() - before, 0, "allocations during {} frames", poses.len());
+    assert_eq!(allocations() - before, 0, "allocations during 60 engine steps");
 }
 
 #[test]

@@ -4,10 +4,10 @@ mod support;
 
 use dqhand::gesture::gesture;
 use dqhand::hand::{build, HandParams};
-use dqhand::io::PoseTarget;
-use dqhand::kinematics::{JointModel, Limits};
+use dqhand::geometry::vertex_normals;
+use dqhand::kinematics::{JointModel, Limits, PoseTarget};
 use dqhand::math::DualQuat;
-use dqhand::skin::{vertex_normals, Deformed, Deformer, MeshData, Method, SkinnedMesh};
+use dqhand::skin::{Deformed, Deformer, MeshData, Method, SkinnedMesh};
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 use proptest::prelude::*;
 use support::{rotation, vec3};
@@ -151,7 +151,7 @@ fn lb_normals_use_the_inverse_transpose() {
 fn posed_hand(name: &str) -> (dqhand::model::Model, Vec<Affine3A>) {
     let model = build(&HandParams::default()).unwrap();
     let target = PoseTarget::Angles { model: JointModel::Full, pose: gesture(name).unwrap().pose(JointModel::Full) };
-    let (skinning, _) = model.pose_skinning(&target, Limits::Anatomical).unwrap();
+    let (skinning, _) = support::pose_skinning(&model, &target, Limits::Anatomical).unwrap();
     (model, skinning)
 }
 
@@ -235,7 +235,7 @@ fn the_portable_and_simd_kernels_agree() {
 #[test]
 fn the_rest_pose_reproduces_the_mesh() {
     let model = build(&HandParams::default()).unwrap();
-    let skinning = model.pose_skinning(&PoseTarget::LocalRotations(vec![]), Limits::Anatomical).unwrap().0;
+    let skinning = support::pose_skinning(&model, &PoseTarget::LocalRotations(vec![]), Limits::Anatomical).unwrap().0;
     for method in Method::ALL {
         let out = deform(method, &model.mesh, &skinning);
         for v in (0..model.mesh.vertex_count()).step_by(7) {

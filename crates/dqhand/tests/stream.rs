@@ -1,15 +1,18 @@
 //! The viewer stream: the binary format (golden vectors shared with the page's tests, round
 //! trips, refusals) and a session's behaviour against the engine it wraps.
 
+mod support;
+
 use std::path::PathBuf;
 use std::sync::{Arc, LazyLock};
 
 use dqhand::gesture::{gesture, Keyframe, Sequence, GESTURES};
 use dqhand::hand::{build, HandParams};
 use dqhand::kinematics::{HandRig, JointModel, Limits, Pose};
+use dqhand::math::DualQuat;
 use dqhand::metrics::VertexDistortion;
-use dqhand::model::{Model, PoseBuffers};
-use dqhand::skin::{Deformed, Deformer, Method};
+use dqhand::model::Model;
+use dqhand::skin::{skinning_transforms, Deformed, Deformer, Method, MethodSet};
 use dqhand::stream::frame::{STATE_LIMITS, STATE_PLAYING};
 use dqhand::stream::{Applied, Command, FrameHeader, FrameView, FrameWriter, Session, Topology};
 use proptest::prelude::*;
@@ -39,7 +42,7 @@ fn sample_frame() -> (FrameHeader, Vec<u8>) {
         vertex_count: 2,
         joint_count: 2,
         dof_count: 3,
-        methods: [Some(Method::Lb), Some(Method::Dqb), None],
+        methods: MethodSet::new(&[Method::Lb, Method::Dqb]).unwrap(),
         distortion: true,
         engine_us: 123.5,
         engine_fps: 120.0,
@@ -105,7 +108,14 @@ fn malformed_messages_are_refused_with_the_reason() {
     refuse(&method, "method code 7");
     let mut count = frame.clone();
     count[24] = 0;
-    refuse(&count, "method code");
+    refuse(&count, "0 meshes (1 to 3)");
+    // Issue 9 bug 4: a repeated method, or a gap in the list, is refused.
+    let mut repeated = frame.clone();
+    repeated[26] = repeated[25];
+    refuse(&repeated, "given twice");
+    let mut gap = frame.clone();
+    gap[25] = 255;
+    refuse(&gap, "method code 255");
 
     let topology = Topology { vertex_count: 2, indices: vec![0, 1, 2], parents: vec![None] }.encode();
     assert!(Topology::parse(&topology).unwrap_err().to_string().contains("index 2 with 2 vertices"));
@@ -120,10 +130,8 @@ proptest! {
         vertices in 0u32..20, joints in 0u32..5, dofs in 0u32..6, meshes in 1usize..=3,
         distortion: bool, sequence: u32, time in 0f32..100.0, seed in 0u32..1000,
     ) {
-        let mut methods = [None; 3];
-        for (i, m) in methods.iter_mut().take(meshes).enumerate() {
-            *m = Some(Method::ALL[(i + seed as usize) % 3]);
-        }
+        let order: Vec<Method> = (0..meshes).map(|i| Method::ALL[(i + seed as usize) % 3]).collect();
+        let methods = MethodSet::new(&order).unwrap();
         let header = FrameHeader { sequence, vertex_count: vertices, joint_count: joints, dof_count: dofs, methods, distortion, time, ..FrameHeader::default() };
         let values: Vec<f32> = (0..(header.byte_len() - 76) / 4).map(|i| (i as f32 + seed as f32) * 0.5).collect();
         let mut out = Vec::new();
@@ -164,7 +172,7 @@ fn a_frame_carries_what_the_engine_computes_for_the_pose() {
     s.apply(&command(r#"{"type":"angle","dof":"index-finger-phalanx-intermediate.flex","deg":90}"#)).unwrap();
     s.apply(&command(r#"{"type":"view","methods":["qb","dqb"]}"#)).unwrap();
     let f = frame(&mut s);
-    assert_eq!(f.header.methods, [Some(Method::Qb), Some(Method::Dqb), None]);
+    assert_eq!(f.header.methods.as_slice(), [Method::Qb, Method::Dqb]);
     assert_eq!(f.header.vertex_count as usize, HAND.mesh.vertex_count());
     assert_eq!(f.header.state & STATE_PLAYING, 0);
     // The same pose through the engine directly.
@@ -172,18 +180,18 @@ fn a_frame_carries_what_the_engine_computes_for_the_pose() {
     let mut pose = Pose::rest(JointModel::Full.dof_count());
     pose.angles[JointModel::Full.dof_index("index-finger-phalanx-intermediate.flex").unwrap()] = 90f32.to_radians();
     assert_eq!(f.angles, pose.angles);
-    let mut buffers = PoseBuffers::new(rig.skeleton());
-    rig.locals(&pose, Limits::Anatomical, &mut buffers.locals);
-    buffers.evaluate(rig.skeleton(), HAND.mesh.inverse_bind());
+    let world = support::world_of(&rig, &pose, Limits::Anatomical);
+    let mut skinning = world.clone();
+    skinning_transforms(&world, HAND.mesh.inverse_bind(), &mut skinning);
     for (i, m) in [Method::Qb, Method::Dqb].into_iter().enumerate() {
         let mut out = Deformed::new(&HAND.mesh);
-        Deformer::new(m, &HAND.mesh).deform(&HAND.mesh, &buffers.skinning, &mut out);
+        Deformer::new(m, &HAND.mesh).deform(&HAND.mesh, &skinning, &mut out);
         assert_eq!(f.meshes[i][0], out.positions().as_flattened(), "{m} positions");
         assert_eq!(f.meshes[i][1], out.normals().as_flattened(), "{m} normals");
         assert!(f.meshes[i][2].is_empty());
     }
     let tip = rig.skeleton().find("index-finger-tip").unwrap();
-    let t = buffers.world[tip].translation;
+    let t = world[tip].translation;
     assert_eq!(&f.joints[3 * tip..3 * tip + 3], &[t.x, t.y, t.z]);
 }
 
@@ -208,6 +216,8 @@ fn bad_commands_are_refused_and_change_nothing() {
         (r#"{"type":"angle","dof":"index-finger-phalanx-intermediate.flex","deg":1e40}"#, "not a finite number"),
         (r#"{"type":"view","methods":[]}"#, "0 methods"),
         (r#"{"type":"view","methods":["dqb","dqb"]}"#, "given twice"),
+        // Issue 9 bug 4: names are parsed case-insensitively, so repeats are found after parsing.
+        (r#"{"type":"view","methods":["dqb","DQB"]}"#, "given twice"),
         (r#"{"type":"view","methods":["xb"]}"#, "xb"),
         (r#"{"type":"gesture","name":"wave"}"#, "unknown gesture"),
         (r#"{"type":"gesture","name":"fist","seconds":-1}"#, "seconds"),
@@ -252,12 +262,12 @@ fn the_timeline_plays_loops_and_seeks() {
     let f = frame(&mut s);
     assert!(f.header.state & STATE_PLAYING != 0 && (f.header.time - 2.0).abs() < 1e-5);
     let mut expected = Pose::rest(JointModel::Full.dof_count());
-    tour.sample(2.0, &mut expected);
+    tour.sample(2.0, DualQuat::IDENTITY, &mut expected);
     assert_eq!(s.pose().angles, expected.angles);
     s.advance(tour.duration());
     assert!((frame(&mut s).header.time - 2.0).abs() < 1e-3, "loops");
     s.apply(&command(r#"{"type":"seek","time":4.0}"#)).unwrap();
-    tour.sample(4.0, &mut expected);
+    tour.sample(4.0, DualQuat::IDENTITY, &mut expected);
     assert_eq!(s.pose().angles, expected.angles);
     s.apply(&command(r#"{"type":"angle","dof":"index-finger-phalanx-distal.flex","deg":10}"#)).unwrap();
     assert_eq!(frame(&mut s).header.state & STATE_PLAYING, 0, "an edit stops the timeline");
@@ -321,26 +331,29 @@ fn sequences_hit_their_keys_and_ease_between_them() {
     let mut b = a.clone();
     a.angles[0] = 0.0;
     b.angles[0] = 1.0;
-    let key = |time, pose: &Pose| Keyframe { time, label: format!("{time}"), pose: pose.clone() };
+    let key = |time, pose: &Pose| Keyframe { time, pose: pose.clone() };
     let seq = Sequence::new("t", model, vec![key(0.0, &a), key(2.0, &b), key(3.0, &b)]).unwrap();
     let mut out = Pose::rest(model.dof_count());
-    assert_eq!(seq.sample(-1.0, &mut out), "0");
+    let rest = DualQuat::IDENTITY;
+    seq.sample(-1.0, rest, &mut out);
     assert_eq!(out.angles[0], 0.0);
-    seq.sample(1.0, &mut out);
+    seq.sample(1.0, rest, &mut out);
     assert!((out.angles[0] - 0.5).abs() < 1e-6, "smoothstep is ½ at the middle");
-    seq.sample(0.5, &mut out);
+    seq.sample(0.5, rest, &mut out);
     assert!(out.angles[0] < 0.25, "eases in: {}", out.angles[0]);
-    assert_eq!(seq.sample(2.5, &mut out), "2");
+    seq.sample(2.5, rest, &mut out);
     assert_eq!(out.angles[0], 1.0);
-    assert_eq!(seq.sample(99.0, &mut out), "3");
+    seq.sample(99.0, rest, &mut out);
+    assert_eq!(out.angles[0], 1.0);
     let bad = |keys| Sequence::new("bad", model, keys).unwrap_err().to_string();
     assert!(bad(vec![]).contains("no keyframes"));
     assert!(bad(vec![key(1.0, &a), key(0.5, &b)]).contains("goes backwards"));
     assert!(bad(vec![key(f32::NAN, &a)]).contains("not finite"));
     assert!(bad(vec![key(0.0, &Pose::rest(3))]).contains("3 angles"));
     let tour = Sequence::gestures(JointModel::Full);
-    assert_eq!(tour.keys().first().unwrap().label, "open");
-    assert_eq!(tour.keys().last().unwrap().label, "open");
+    let open = gesture("open").unwrap().pose(JointModel::Full);
+    assert_eq!(tour.keys().first().unwrap().pose, open);
+    assert_eq!(tour.keys().last().unwrap().pose, open);
 }
 
 #[test]

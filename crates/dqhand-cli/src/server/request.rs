@@ -46,8 +46,11 @@ impl Request {
             match parsed.parse(&buf) {
                 Ok(httparse::Status::Complete(len)) => {
                     let target = parsed.path.unwrap_or("/");
-                    let path = percent_decode(target.split(['?', '#']).next().unwrap_or("/"))
-                        .ok_or_else(|| refuse(400, "malformed percent-encoding in the path"))?;
+                    let raw = target.split(['?', '#']).next().unwrap_or("/");
+                    let path = percent_encoding::percent_decode_str(raw)
+                        .decode_utf8()
+                        .map_err(|_| refuse(400, "the path is not UTF-8 once percent-decoded"))?
+                        .into_owned();
                     let headers = parsed
                         .headers
                         .iter()
@@ -60,6 +63,20 @@ impl Request {
                 Err(e) => return Err(refuse(400, format!("malformed request: {e}"))),
             }
         }
+    }
+
+    /// Checks that the `Host` header names this machine when the server listens on loopback
+    /// only: a page of another site whose name an attacker re-points at 127.0.0.1 (DNS
+    /// rebinding) sends its own name as `Host`, and is refused here, beside the `Origin`
+    /// check of the WebSocket upgrade.
+    pub fn check_host(&self, loopback_only: bool) -> Result<(), Refusal> {
+        let Some(host) = self.header("host") else {
+            return Err(refuse(400, "Host header missing"));
+        };
+        if loopback_only && !is_loopback_host(host) {
+            return Err(refuse(403, format!("host {host:?} is not this machine (the server listens on loopback only)")));
+        }
+        Ok(())
     }
 
     /// The value of a header (names are compared case-insensitively).
@@ -93,24 +110,6 @@ impl Request {
     }
 }
 
-/// Decodes `%XX` escapes; `None` for a malformed escape or bytes that are not UTF-8.
-fn percent_decode(s: &str) -> Option<String> {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).ok()
-}
-
 /// Writes a complete response and lets the connection close.
 pub fn respond(mut stream: &TcpStream, status: u16, content_type: &str, body: &[u8], head_only: bool) -> std::io::Result<()> {
     let reason = match status {
@@ -137,15 +136,26 @@ pub fn respond(mut stream: &TcpStream, status: u16, content_type: &str, body: &[
     stream.flush()
 }
 
+/// Whether a `Host` value (`name[:port]`, `[v6][:port]`) names a loopback address.
+fn is_loopback_host(host: &str) -> bool {
+    let name = match host.strip_prefix('[') {
+        Some(v6) => v6.split_once(']').map_or("", |(a, _)| a),
+        None => host.rsplit_once(':').filter(|(_, port)| port.bytes().all(|b| b.is_ascii_digit())).map_or(host, |(n, _)| n),
+    };
+    name.eq_ignore_ascii_case("localhost") || name.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback())
+}
+
 #[cfg(test)]
 mod tests {
-    use super::percent_decode;
+    use super::is_loopback_host;
 
     #[test]
-    fn percent_decoding() {
-        assert_eq!(percent_decode("/a%20b/%2e%2e").as_deref(), Some("/a b/.."));
-        assert_eq!(percent_decode("/%zz"), None);
-        assert_eq!(percent_decode("/%2"), None);
-        assert_eq!(percent_decode("/%ff"), None);
+    fn loopback_hosts() {
+        for ok in ["127.0.0.1:8080", "127.0.0.1", "localhost:8080", "LOCALHOST", "[::1]:8080", "[::1]", "127.1.2.3:1"] {
+            assert!(is_loopback_host(ok), "{ok}");
+        }
+        for bad in ["evil.example:8080", "evil.example", "10.0.0.1:8080", "[::2]:80", "localhost.evil.example", "127.0.0.1.evil.example", "", "[::1"] {
+            assert!(!is_loopback_host(bad), "{bad}");
+        }
     }
 }

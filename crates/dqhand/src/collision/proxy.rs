@@ -5,8 +5,9 @@
 //! the joint to its child, its radius the largest distance of the bone's vertices from that
 //! segment plus a margin, so the capsule encloses them. Every other bone (the wrist and the
 //! finger metacarpals, which make the palm) gets the convex hull of its vertices, each pushed
-//! out along its normal by the margin. Shapes are in the joint's rest frame, so they move
-//! rigidly with it.
+//! out along its normal by the margin. Shapes are fitted in bind space (where the mesh's
+//! vertices are, through the inverse bind matrices, not the skeleton's rest pose, which may
+//! differ) and stored in the joint's own frame, so they move rigidly with it.
 
 use glam::{Affine3A, Vec3};
 
@@ -40,7 +41,7 @@ pub struct Proxy {
 pub fn fit_proxies(model: &Model, margin: f32) -> Vec<Proxy> {
     let skeleton = &model.skeleton;
     let mesh = &model.mesh;
-    let world = skeleton.rest_world();
+    let world = model.bind_world();
     let mut owned: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
     for v in 0..mesh.vertex_count() {
         if let Some((j, _)) = mesh.influences(v).next() {

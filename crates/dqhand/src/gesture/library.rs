@@ -4,6 +4,7 @@
 //! (thumb CMC, thumb MCP abduction, palm cupping) stay at rest.
 
 use crate::kinematics::{JointModel, Pose};
+use crate::{Error, Result};
 
 /// A named hand shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,7 +17,8 @@ pub struct Gesture {
 }
 
 impl Gesture {
-    /// The gesture as a pose of `model` (wrist at rest); DOFs the model lacks are skipped.
+    /// The gesture as a pose of `model` (wrist at rest); DOFs the model lacks are skipped
+    /// (every name is a DOF of the `full` model: [`Self::check`]).
     #[must_use]
     pub fn pose(&self, model: JointModel) -> Pose {
         let mut pose = Pose::rest(model.dof_count());
@@ -27,12 +29,33 @@ impl Gesture {
         }
         pose
     }
+
+    /// Checks that every angle names a DOF of the `full` model, so that [`Self::pose`] drops
+    /// only the DOFs a smaller model lacks, never a misspelled one.
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] for the first name that is no DOF, naming the gesture.
+    pub fn check(&self) -> Result<()> {
+        for &(name, _) in self.angles_deg.iter().copied().flatten() {
+            JointModel::Full.dof_index(name).map_err(|e| match e {
+                Error::UnknownName { name, valid, .. } => Error::UnknownName { kind: "degree of freedom (in a gesture)", name: format!("{}: {name}", self.name), valid },
+                other => other,
+            })?;
+        }
+        Ok(())
+    }
 }
 
 /// The library entry called `name`.
-#[must_use]
-pub fn gesture(name: &str) -> Option<&'static Gesture> {
-    GESTURES.iter().find(|g| g.name == name)
+///
+/// # Errors
+/// [`Error::UnknownName`] listing the gestures.
+pub fn gesture(name: &str) -> Result<&'static Gesture> {
+    GESTURES.iter().find(|g| g.name == name).ok_or_else(|| Error::UnknownName {
+        kind: "gesture",
+        name: name.to_owned(),
+        valid: GESTURES.map(|g| g.name).join(", "),
+    })
 }
 
 macro_rules! curl {
@@ -119,15 +142,21 @@ pub const GESTURES: [Gesture; 14] = [
     Gesture { name: "five", angles_deg: &[] },
 ];
 
-/// The whole library as one animation: each gesture reached from the previous one in
-/// `steps` frames (angles interpolated linearly), back to the first at the end.
-#[must_use]
-pub fn tour(model: JointModel, steps: usize) -> Vec<Pose> {
-    let poses: Vec<Pose> = GESTURES.iter().map(|g| g.pose(model)).collect();
-    let mut frames = Vec::with_capacity(poses.len() * steps);
-    for (i, a) in poses.iter().enumerate() {
-        let b = &poses[(i + 1) % poses.len()];
-        frames.extend((0..steps).map(|s| a.interpolate(b, s as f32 / steps as f32)));
+#[cfg(test)]
+mod tests {
+    use super::{Gesture, GESTURES};
+
+    #[test]
+    fn every_library_gesture_names_dofs_of_the_full_model() {
+        for g in &GESTURES {
+            g.check().unwrap();
+        }
     }
-    frames
+
+    #[test]
+    fn a_misspelled_dof_is_an_error() {
+        const TYPO: Gesture = Gesture { name: "typo", angles_deg: &[&[("index-finger-phalanx-intermedaite.flex", 90.0)]] };
+        let e = TYPO.check().unwrap_err().to_string();
+        assert!(e.contains("typo: index-finger-phalanx-intermedaite.flex"), "{e}");
+    }
 }

@@ -4,5 +4,5 @@
 mod library;
 mod sequence;
 
-pub use library::{gesture, tour, Gesture, GESTURES};
+pub use library::{gesture, Gesture, GESTURES};
 pub use sequence::{Keyframe, Sequence};

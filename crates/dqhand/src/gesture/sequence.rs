@@ -2,6 +2,7 @@
 //! of the wrist, as the timeline of the viewer and the smooth move to a chosen gesture.
 
 use crate::kinematics::{JointModel, Pose};
+use crate::math::DualQuat;
 use crate::{Error, Result};
 
 use super::GESTURES;
@@ -11,8 +12,6 @@ use super::GESTURES;
 pub struct Keyframe {
     /// Seconds from the start of the sequence.
     pub time: f32,
-    /// What the pose is called (a gesture name), shown while it is the latest key.
-    pub label: String,
     /// The pose, on the sequence's joint model.
     pub pose: Pose,
 }
@@ -33,11 +32,11 @@ impl Sequence {
     /// A sequence from keyframes.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the sequence if it has no keyframe, a time that is not finite
+    /// [`Error::Sequence`] naming the sequence if it has no keyframe, a time that is not finite
     /// or goes backwards, or a pose with another angle count than `model`'s.
     pub fn new(name: impl Into<String>, model: JointModel, keys: Vec<Keyframe>) -> Result<Self> {
         let name = name.into();
-        let bad = |what: String| Error::Invalid(format!("sequence {name:?}: {what}"));
+        let bad = |what: String| Error::Sequence(format!("sequence {name:?}: {what}"));
         if keys.is_empty() {
             return Err(bad("no keyframes".into()));
         }
@@ -61,7 +60,7 @@ impl Sequence {
         let mut keys = Vec::with_capacity(2 * GESTURES.len() + 1);
         let mut time = 0.0;
         for g in GESTURES.iter().chain(&GESTURES[..1]) {
-            let key = |time| Keyframe { time, label: g.name.to_string(), pose: g.pose(model) };
+            let key = |time| Keyframe { time, pose: g.pose(model) };
             keys.push(key(time));
             keys.push(key(time + HOLD_SECONDS));
             time += HOLD_SECONDS + MOVE_SECONDS;
@@ -75,11 +74,8 @@ impl Sequence {
     /// # Panics
     /// If a pose does not belong to `model`.
     #[must_use]
-    pub fn transition(model: JointModel, from: &Pose, to: (&str, Pose), seconds: f32) -> Self {
-        let keys = vec![
-            Keyframe { time: 0.0, label: String::new(), pose: from.clone() },
-            Keyframe { time: seconds.max(0.0), label: to.0.into(), pose: to.1 },
-        ];
+    pub fn transition(model: JointModel, from: &Pose, to: Pose, seconds: f32) -> Self {
+        let keys = vec![Keyframe { time: 0.0, pose: from.clone() }, Keyframe { time: seconds.max(0.0), pose: to }];
         Self::new("transition", model, keys).expect("poses of the sequence's model")
     }
 
@@ -107,24 +103,23 @@ impl Sequence {
         self.keys.last().map_or(0.0, |k| k.time)
     }
 
-    /// The pose at `time` (clamped to the sequence) into `out`, and the label of the latest
-    /// keyframe at or before it. Between two keys the weight eases in and out (smoothstep),
-    /// so a hand starts and stops moving gently; angles are interpolated linearly in that
-    /// weight and the wrist by ScLERP. Allocates nothing.
+    /// The pose at `time` (clamped to the sequence) into `out`. Between two keys the weight
+    /// eases in and out (smoothstep), so a hand starts and stops moving gently; angles are
+    /// interpolated linearly in that weight and the wrist by ScLERP, a missing wrist standing
+    /// for `rest_wrist` ([`Pose::interpolate`]). Allocates nothing.
     ///
     /// # Panics
     /// If `out` has another angle count than the sequence's model.
-    pub fn sample(&self, time: f32, out: &mut Pose) -> &str {
+    pub fn sample(&self, time: f32, rest_wrist: DualQuat, out: &mut Pose) {
         let t = time.clamp(0.0, self.duration());
         let next = self.keys.partition_point(|k| k.time <= t);
         let a = &self.keys[next.saturating_sub(1)];
         let Some(b) = self.keys.get(next) else {
-            a.pose.interpolate_into(&a.pose, 0.0, out);
-            return &a.label;
+            a.pose.interpolate_into(&a.pose, 0.0, rest_wrist, out);
+            return;
         };
         let span = b.time - a.time;
         let s = if span > 0.0 { ((t - a.time) / span).clamp(0.0, 1.0) } else { 1.0 };
-        a.pose.interpolate_into(&b.pose, s * s * (3.0 - 2.0 * s), out);
-        &a.label
+        a.pose.interpolate_into(&b.pose, s * s * (3.0 - 2.0 * s), rest_wrist, out);
     }
 }

@@ -77,25 +77,25 @@ impl HandParams {
     /// Checks that the parameters describe a hand.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the parameter: a measurement that is not positive and finite,
+    /// [`Error::HandParameter`] naming the parameter: a measurement that is not positive and finite,
     /// a breadth outside 30–75 % of the length (hands measure 40–50 %), a vertex count
     /// outside [`VERTEX_RANGE`].
     pub fn validate(&self) -> Result<()> {
         let Self { length: l, breadth: b, vertices, .. } = *self;
         if !(l.is_finite() && l > 0.0) {
-            return Err(Error::Invalid(format!("hand length {l} m is not a positive length")));
+            return Err(Error::HandParameter(format!("hand length {l} m is not a positive length")));
         }
         if !(b.is_finite() && b > 0.0) {
-            return Err(Error::Invalid(format!("hand breadth {b} m is not a positive length")));
+            return Err(Error::HandParameter(format!("hand breadth {b} m is not a positive length")));
         }
         if !(0.3 * l..=0.75 * l).contains(&b) {
-            return Err(Error::Invalid(format!(
+            return Err(Error::HandParameter(format!(
                 "hand breadth {b} m is {:.0} % of the length {l} m; hands measure 40–50 % (30–75 % accepted)",
                 100.0 * b / l
             )));
         }
         if !VERTEX_RANGE.contains(&vertices) {
-            return Err(Error::Invalid(format!(
+            return Err(Error::HandParameter(format!(
                 "{vertices} vertices is outside the supported density {}–{}",
                 VERTEX_RANGE.start(),
                 VERTEX_RANGE.end()
@@ -108,7 +108,7 @@ impl HandParams {
 /// Builds the hand: skeleton, skin mesh with normals and UVs, skin weights.
 ///
 /// # Errors
-/// [`Error::Invalid`] for parameters [`HandParams::validate`] rejects, or (not expected at
+/// [`Error::HandParameter`] for parameters [`HandParams::validate`] rejects, or [`Error::Tessellation`] (not expected at
 /// supported densities) a surface that fails to mesh as a closed surface of that many vertices.
 pub fn build(params: &HandParams) -> Result<Model> {
     params.validate()?;

@@ -19,7 +19,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::shape::HandShape;
-use crate::metrics::{check_closed, enclosed_volume};
+use crate::geometry::{check_closed, enclosed_volume};
 use crate::{Error, Result};
 
 /// Surface-nets vertices per wanted vertex: enough for the simplifier to choose from.
@@ -44,7 +44,7 @@ pub(crate) struct Surface {
 /// Meshes `shape` with exactly `vertices` vertices.
 ///
 /// # Errors
-/// [`Error::Invalid`] if the extracted surface is not closed, or cannot be simplified to
+/// [`Error::Tessellation`] if the extracted surface is not closed, or cannot be simplified to
 /// `vertices` (asked for fewer than the hand's shape can keep).
 pub(crate) fn tessellate(shape: &HandShape, vertices: usize) -> Result<Surface> {
     let extent = shape.bounds[1] - shape.bounds[0];
@@ -121,7 +121,7 @@ fn closed_sample(shape: &HandShape, h: f32) -> Result<Surface> {
 /// Checks that the extracted surface is closed and orients it outward.
 fn closed(surface: Surface, h: f32) -> Result<Surface> {
     let Surface { positions, mut indices, .. } = surface;
-    check_closed(&indices).map_err(|e| Error::Invalid(format!("the hand's surface at grid spacing {h:.5} m is not closed: {e}")))?;
+    check_closed(&indices).map_err(|e| Error::Tessellation(format!("the hand's surface at grid spacing {h:.5} m is not closed: {e}")))?;
     if enclosed_volume(&positions, &indices) < 0.0 {
         indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
     }
@@ -135,10 +135,10 @@ fn simplify(dense: &Surface, vertices: usize) -> Result<Surface> {
     let euler = v - f / 2; // V − E + F with E = 3F/2 on a closed triangle mesh
     let target_triangles = 2 * (vertices as i64 - euler);
     if vertices as i64 > v || target_triangles < 4 {
-        return Err(Error::Invalid(format!("cannot mesh the hand with {vertices} vertices (its dense surface has {v})")));
+        return Err(Error::Tessellation(format!("cannot mesh the hand with {vertices} vertices (its dense surface has {v})")));
     }
     let bytes = meshopt::typed_to_bytes(&dense.positions);
-    let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Invalid(format!("meshopt: {e}")))?;
+    let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Tessellation(format!("meshopt: {e}")))?;
     let options = meshopt::SimplifyOptions::Regularize;
     let mut indices = meshopt::simplify(&dense.indices, &adapter, 3 * target_triangles as usize, 1.0, options, None);
     // Keep the vertices still referenced, in first-use order.
@@ -153,12 +153,12 @@ fn simplify(dense: &Surface, vertices: usize) -> Result<Surface> {
         *i = *r;
     }
     if positions.len() != vertices {
-        return Err(Error::Invalid(format!(
+        return Err(Error::Tessellation(format!(
             "the simplifier stopped at {} vertices instead of {vertices}; ask for more vertices",
             positions.len()
         )));
     }
-    check_closed(&indices).map_err(|e| Error::Invalid(format!("the simplified hand surface is not closed: {e}")))?;
+    check_closed(&indices).map_err(|e| Error::Tessellation(format!("the simplified hand surface is not closed: {e}")))?;
     Ok(Surface { positions, normals: Vec::new(), indices })
 }
 

@@ -200,7 +200,7 @@ fn proxy_json(shape: &ProxyShape) -> Value {
 /// * `positions`, `normals` — #V; `uvs` — #V or empty; `indices` — #F × 3.
 ///
 /// # Errors
-/// [`crate::Error::Io`] if the file cannot be written; [`crate::Error::Invalid`] if the
+/// [`crate::Error::Io`] if the file cannot be written; [`crate::Error::Mesh`] if the
 /// array lengths disagree.
 pub fn write_posed_glb(path: &Path, positions: &[[f32; 3]], normals: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[u32]) -> Result<()> {
     check_lengths(positions, normals, indices)?;

@@ -30,7 +30,7 @@ pub fn load_gltf(path: &Path) -> Result<Model> {
 }
 
 fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
-    let bad = |m: String| Error::Invalid(m);
+    let bad = |m: String| Error::Gltf(m);
     if bytes.len() >= 12 && &bytes[..4] == b"glTF" {
         let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
         if declared > bytes.len() {
@@ -114,6 +114,18 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
         }
     }
 
+    // Joints outside the skin (ancestors of its joints) deform nothing, but the bind pose
+    // must place them too: they keep their rest offset from their parent's bind pose.
+    let mut bind_world = vec![Affine3A::IDENTITY; skeleton.len()];
+    for &j in skeleton.order() {
+        let joint = &skeleton.joints()[j];
+        bind_world[j] = if skin_joints.contains(&j) {
+            inverse_bind[j].inverse()
+        } else {
+            joint.parent.map_or(Affine3A::IDENTITY, |p| bind_world[p]) * joint.rest.to_affine()
+        };
+        inverse_bind[j] = bind_world[j].inverse();
+    }
     let mut data = MeshData { inverse_bind, ..MeshData::default() };
     let mut stride = 0;
     let mut primitives = Vec::new();
@@ -222,26 +234,26 @@ fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => {
-                gltf.blob.clone().ok_or_else(|| Error::Invalid(format!("buffer {} refers to a GLB binary chunk the file does not have", buffer.index())))?
+                gltf.blob.clone().ok_or_else(|| Error::Gltf(format!("buffer {} refers to a GLB binary chunk the file does not have", buffer.index())))?
             }
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let b64 = uri.split_once(";base64,").map(|s| s.1).ok_or_else(|| {
-                    Error::Invalid(format!("buffer {} has a data URI that is not base64", buffer.index()))
+                    Error::Gltf(format!("buffer {} has a data URI that is not base64", buffer.index()))
                 })?;
                 base64::engine::general_purpose::STANDARD
                     .decode(b64)
-                    .map_err(|e| Error::Invalid(format!("buffer {} has invalid base64: {e}", buffer.index())))?
+                    .map_err(|e| Error::Gltf(format!("buffer {} has invalid base64: {e}", buffer.index())))?
             }
             gltf::buffer::Source::Uri(uri) => {
                 if uri.contains("://") {
-                    return Err(Error::Invalid(format!("buffer {} refers to {uri:?}; only local files are read", buffer.index())));
+                    return Err(Error::Gltf(format!("buffer {} refers to {uri:?}; only local files are read", buffer.index())));
                 }
                 let file = path.parent().unwrap_or(Path::new(".")).join(uri);
-                std::fs::read(&file).map_err(|e| Error::Invalid(format!("buffer {} file {}: {e}", buffer.index(), file.display())))?
+                std::fs::read(&file).map_err(|e| Error::Gltf(format!("buffer {} file {}: {e}", buffer.index(), file.display())))?
             }
         };
         if data.len() < buffer.length() {
-            return Err(Error::Invalid(format!(
+            return Err(Error::Gltf(format!(
                 "buffer {} is truncated: {} bytes of the declared {}",
                 buffer.index(),
                 data.len(),
@@ -259,7 +271,7 @@ fn influence_sets(prim: &gltf::Primitive<'_>, mesh: &str) -> Result<usize> {
     match (has(Semantic::Joints(1)), has(Semantic::Weights(1))) {
         (false, false) => Ok(1),
         (true, true) => Ok(2),
-        _ => Err(Error::Invalid(format!("mesh {mesh:?} primitive {} has only one of JOINTS_1 and WEIGHTS_1", prim.index()))),
+        _ => Err(Error::Gltf(format!("mesh {mesh:?} primitive {} has only one of JOINTS_1 and WEIGHTS_1", prim.index()))),
     }
 }
 
@@ -270,7 +282,7 @@ fn influence_sets(prim: &gltf::Primitive<'_>, mesh: &str) -> Result<usize> {
 fn check_accessor(a: Option<gltf::Accessor<'_>>, what: &str, kind: (Dimensions, &[DataType]), buffers: &[Vec<u8>]) -> Result<()> {
     let Some(a) = a else { return Ok(()) };
     let i = a.index();
-    let bad = |m: String| Err(Error::Invalid(format!("{what} accessor {i} {m}")));
+    let bad = |m: String| Err(Error::Gltf(format!("{what} accessor {i} {m}")));
     let (dims, types) = kind;
     if a.dimensions() != dims || !types.contains(&a.data_type()) {
         return bad(format!("is {:?} {:?}; expected {dims:?} of {types:?}", a.dimensions(), a.data_type()));

@@ -12,38 +12,26 @@ pub use gltf_export::{write_posed_glb, write_skinned_glb};
 pub use gltf_import::load_gltf;
 pub use obj::write_obj;
 pub use ply::write_ply;
-pub use pose_file::{PoseFile, PoseTarget, WristPose};
+pub use pose_file::{PoseFile, WristPose};
 
 use crate::{Error, Result};
-
-/// Loads `builtin` (the built-in hand at its defaults) or a `.glb`/`.gltf` file.
-///
-/// # Errors
-/// As [`load_gltf`].
-pub fn load_model(spec: &str) -> Result<crate::model::Model> {
-    if spec == "builtin" {
-        crate::hand::build(&crate::hand::HandParams::default())
-    } else {
-        load_gltf(Path::new(spec))
-    }
-}
 
 /// Writes a posed mesh, the format chosen by the extension: `.ply`, `.obj` or `.glb`.
 ///
 /// # Errors
-/// [`Error::File`] for another extension, else as the writer.
+/// [`Error::OutputFormat`] for another extension, else as the writer.
 pub fn write_posed(path: &Path, positions: &[[f32; 3]], normals: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[u32]) -> Result<()> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("ply") => write_ply(path, positions, normals, indices),
         Some("obj") => write_obj(path, positions, normals, indices),
         Some("glb") => write_posed_glb(path, positions, normals, uvs, indices),
-        _ => Err(Error::File { path: path.into(), message: "unknown output format; use .ply, .obj or .glb".into() }),
+        _ => Err(Error::OutputFormat(path.into())),
     }
 }
 
 fn check_lengths(positions: &[[f32; 3]], normals: &[[f32; 3]], indices: &[u32]) -> Result<()> {
     if positions.len() != normals.len() || indices.len() % 3 != 0 {
-        return Err(Error::Invalid(format!(
+        return Err(Error::Mesh(format!(
             "{} positions, {} normals and {} indices do not make a triangle mesh",
             positions.len(),
             normals.len(),

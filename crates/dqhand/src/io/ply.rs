@@ -11,7 +11,7 @@ use crate::Result;
 /// * `positions`, `normals` — #V each; `indices` — #F × 3.
 ///
 /// # Errors
-/// [`crate::Error::Io`] if the file cannot be written; [`crate::Error::Invalid`] if the
+/// [`crate::Error::Io`] if the file cannot be written; [`crate::Error::Mesh`] if the
 /// array lengths disagree.
 pub fn write_ply(path: &Path, positions: &[[f32; 3]], normals: &[[f32; 3]], indices: &[u32]) -> Result<()> {
     check_lengths(positions, normals, indices)?;

@@ -18,9 +18,8 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::kinematics::{JointModel, Pose};
+use crate::kinematics::{JointModel, Pose, PoseTarget, Skeleton};
 use crate::math::DualQuat;
-use crate::model::Model;
 use crate::{Error, Result};
 
 /// The wrist's world pose as written in a pose file.
@@ -57,52 +56,38 @@ pub struct PoseFile {
     pub local_rotations: BTreeMap<String, [f32; 4]>,
 }
 
-/// A pose file resolved against a model.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PoseTarget {
-    /// Joint angles of a joint model (and the wrist), posed on the anatomical chain.
-    Angles {
-        /// The joint model the angles belong to.
-        model: JointModel,
-        /// Wrist pose and angles in radians.
-        pose: Pose,
-    },
-    /// Replacement local rotations of nodes in the file's own hierarchy.
-    LocalRotations(Vec<(usize, Quat)>),
-}
-
 impl PoseFile {
     /// Reads and parses a pose file.
     ///
     /// # Errors
-    /// [`Error::Io`] or [`Error::File`] naming the file and the problem.
+    /// [`Error::Io`], or [`Error::File`] naming the file around an [`Error::Pose`].
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(Error::io(path))?;
-        serde_json::from_str(&text).map_err(|e| Error::File { path: path.into(), message: format!("not a valid pose file: {e}") })
+        serde_json::from_str(&text).map_err(|e| Error::Pose(format!("not a valid pose file: {e}")).in_file(path))
     }
 
-    /// Resolves names against `model`'s skeleton and joint model.
+    /// Resolves names against `skeleton` (node names) and the joint models (DOF names).
     ///
     /// # Errors
     /// [`Error::UnknownName`] for an unknown DOF or node (listing the valid ones),
-    /// [`Error::Invalid`] for a zero or non-finite rotation, a non-finite value, or a file
+    /// [`Error::Pose`] for a zero or non-finite rotation, a non-finite value, or a file
     /// that mixes `angles_deg` and `local_rotations`.
-    pub fn resolve(&self, model: &Model) -> Result<PoseTarget> {
+    pub fn resolve(&self, skeleton: &Skeleton) -> Result<PoseTarget> {
         let quat = |what: &str, q: [f32; 4]| -> Result<Quat> {
             let q = Quat::from_array(q);
             if !q.is_finite() || q.length() < 1e-6 {
-                return Err(Error::Invalid(format!("{what} rotation {:?} is not a rotation", q.to_array())));
+                return Err(Error::Pose(format!("{what} rotation {:?} is not a rotation", q.to_array())));
             }
             Ok(q.normalize())
         };
         if !self.local_rotations.is_empty() {
             if !self.angles_deg.is_empty() || self.wrist.is_some() || self.model.is_some() {
-                return Err(Error::Invalid("local_rotations cannot be mixed with model, wrist or angles_deg".into()));
+                return Err(Error::Pose("local_rotations cannot be mixed with model, wrist or angles_deg".into()));
             }
             return self
                 .local_rotations
                 .iter()
-                .map(|(name, &q)| Ok((model.skeleton.index_of(name).map_err(node_kind)?, quat(name, q)?)))
+                .map(|(name, &q)| Ok((skeleton.index_of(name).map_err(node_kind)?, quat(name, q)?)))
                 .collect::<Result<_>>()
                 .map(PoseTarget::LocalRotations);
         }
@@ -111,21 +96,21 @@ impl PoseFile {
             return Ok(PoseTarget::LocalRotations(Vec::new()));
         }
         let joint_model = match &self.model {
-            Some(m) => m.parse().map_err(Error::Invalid)?,
+            Some(m) => m.parse()?,
             None if self.angles_deg.keys().all(|k| JointModel::Paper.dof_index(k).is_ok()) => JointModel::Paper,
             None => JointModel::Full,
         };
         let mut pose = Pose::rest(joint_model.dof_count());
         for (name, &deg) in &self.angles_deg {
             if !deg.is_finite() {
-                return Err(Error::Invalid(format!("angle {name} = {deg} is not finite")));
+                return Err(Error::Pose(format!("angle {name} = {deg} is not finite")));
             }
             pose.angles[joint_model.dof_index(name)?] = deg.to_radians();
         }
         if let Some(w) = self.wrist {
             let t = Vec3::from(w.translation);
             if !t.is_finite() {
-                return Err(Error::Invalid(format!("wrist translation {:?} is not finite", w.translation)));
+                return Err(Error::Pose(format!("wrist translation {:?} is not finite", w.translation)));
             }
             pose.wrist = Some(DualQuat::from_rotation_translation(quat("wrist", w.rotation)?, t));
         }

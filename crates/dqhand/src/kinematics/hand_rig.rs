@@ -6,6 +6,7 @@
 use glam::{Affine3A, Quat, Vec3};
 
 use super::{webxr, JointModel, Motion, Pose, Skeleton, Transform};
+use crate::math::DualQuat;
 use crate::{Error, Result};
 
 /// One resolved degree of freedom.
@@ -45,8 +46,13 @@ impl HandRig {
     /// wrist → metacarpal → phalanges, keeping every rest transform; a joint whose anatomical
     /// parent is missing hangs from the nearest ancestor in the chain that exists.
     ///
+    /// Flexion turns a bone about its −X axis, which is right only in WebXR joint frames (−Z
+    /// along the bone toward the tip); a rig in another convention (Blender's +Y along the
+    /// bone) would flex sideways, so its frames are checked and refused.
+    ///
     /// # Errors
-    /// [`Error::Invalid`] if a joint the model needs is missing.
+    /// [`Error::MissingJoint`] if a joint the model needs is missing, [`Error::JointFrame`]
+    /// if a moving joint's −Z axis is more than 45° from its bone.
     pub fn new(skeleton: &Skeleton, model: JointModel) -> Result<Self> {
         let nearest_parent = |name: &str| {
             let mut parent = webxr::anatomical_parent(name);
@@ -68,6 +74,7 @@ impl HandRig {
         let mut dofs = Vec::new();
         for d in model.dofs() {
             let joint = skeleton.find(d.bone).ok_or_else(|| missing(d.bone))?;
+            check_frame(&skeleton, &world, d.bone)?;
             let axis = match d.motion {
                 Motion::Flex => Vec3::NEG_X,
                 Motion::Abd => {
@@ -95,6 +102,13 @@ impl HandRig {
     #[must_use]
     pub fn model(&self) -> JointModel {
         self.model
+    }
+
+    /// The wrist's world pose at rest: what a pose without a wrist is posed with.
+    #[must_use]
+    pub fn rest_wrist(&self) -> DualQuat {
+        let (_, rotation, translation) = self.skeleton.rest_world()[self.wrist].to_scale_rotation_translation();
+        DualQuat::from_rotation_translation(rotation.normalize(), translation)
     }
 
     /// Clamps the pose's angles to the anatomical ranges; returns the indices of the DOFs that
@@ -144,11 +158,35 @@ impl HandRig {
     }
 }
 
+/// The joint after `bone` along its finger (its child in the anatomical chain), if the
+/// skeleton has it.
+fn next_joint(skeleton: &Skeleton, bone: &str) -> Option<usize> {
+    let i = webxr::JOINT_NAMES.iter().position(|&n| n == bone)?;
+    webxr::JOINT_NAMES.get(i + 1).filter(|n| webxr::anatomical_parent(n) == Some(bone)).and_then(|n| skeleton.find(n))
+}
+
+/// Checks that `bone`'s −Z axis runs along the bone toward the next joint (within 45°).
+fn check_frame(skeleton: &Skeleton, world: &[Affine3A], bone: &str) -> Result<()> {
+    let (Some(j), Some(c)) = (skeleton.find(bone), next_joint(skeleton, bone)) else { return Ok(()) };
+    let along = Vec3::from(world[c].translation - world[j].translation);
+    let minus_z = -Vec3::from(world[j].matrix3.z_axis);
+    if along.length() < 1e-6 || minus_z.length() < 1e-6 {
+        return Ok(());
+    }
+    let angle = minus_z.angle_between(along).to_degrees();
+    if angle > 45.0 {
+        return Err(Error::JointFrame {
+            joint: bone.to_owned(),
+            problem: format!("its −Z axis is {angle:.0}° from the bone toward {:?}", skeleton.joints()[c].name),
+        });
+    }
+    Ok(())
+}
+
 /// +1 if turning `bone` about its +Y axis moves the next joint of its finger away along
 /// `away`, else −1.
 fn abduction_sign(skeleton: &Skeleton, world: &[Affine3A], bone: &str, away: Vec3) -> f32 {
-    let next = webxr::JOINT_NAMES.iter().position(|&n| n == bone).and_then(|i| webxr::JOINT_NAMES.get(i + 1));
-    let (Some(joint), Some(child)) = (skeleton.find(bone), next.and_then(|n| skeleton.find(n))) else { return 1.0 };
+    let (Some(joint), Some(child)) = (skeleton.find(bone), next_joint(skeleton, bone)) else { return 1.0 };
     let tip: Vec3 = world[child].translation.into();
     let turned = world[joint] * Affine3A::from_rotation_y(0.1) * world[joint].inverse();
     if (turned.transform_point3(tip) - tip).dot(away) >= 0.0 {
@@ -159,5 +197,5 @@ fn abduction_sign(skeleton: &Skeleton, world: &[Affine3A], bone: &str, away: Vec
 }
 
 fn missing(name: &str) -> Error {
-    Error::Invalid(format!("skeleton has no joint {name:?}; joint angles need the WebXR hand joint names"))
+    Error::MissingJoint { joint: name.into(), needed_for: "joint angles need the WebXR hand joint names" }
 }

@@ -173,8 +173,13 @@ impl fmt::Display for JointModel {
 }
 
 impl core::str::FromStr for JointModel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL.into_iter().find(|m| m.as_str() == s).ok_or_else(|| format!("unknown joint model {s:?}; valid: paper, full"))
+    type Err = crate::Error;
+    /// `paper` or `full`; anything else is [`crate::Error::UnknownName`].
+    fn from_str(s: &str) -> crate::Result<Self> {
+        Self::ALL.into_iter().find(|m| m.as_str() == s).ok_or_else(|| crate::Error::UnknownName {
+            kind: "joint model",
+            name: s.to_owned(),
+            valid: "paper, full".into(),
+        })
     }
 }

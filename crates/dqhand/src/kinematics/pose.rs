@@ -18,15 +18,21 @@ impl Pose {
         Self { wrist: None, angles: vec![0.0; dof_count] }
     }
 
-    /// Interpolates toward `end` by `t` in [0, 1]: angles linearly, the wrist by ScLERP
-    /// (a missing wrist stands for the identity).
+    /// Interpolates toward `end` by `t` in [0, 1]: angles linearly, the wrist by ScLERP.
+    ///
+    /// A missing wrist means the rest wrist, as when posing ([`HandRig::locals`]), so it
+    /// stands for `rest_wrist` ([`HandRig::rest_wrist`]) when only one pose has a wrist; the
+    /// result has none when neither has.
+    ///
+    /// [`HandRig::locals`]: super::HandRig::locals
+    /// [`HandRig::rest_wrist`]: super::HandRig::rest_wrist
     ///
     /// # Panics
     /// If the poses have different angle counts.
     #[must_use]
-    pub fn interpolate(&self, end: &Pose, t: f32) -> Pose {
+    pub fn interpolate(&self, end: &Pose, t: f32, rest_wrist: DualQuat) -> Pose {
         let mut out = self.clone();
-        self.interpolate_into(end, t, &mut out);
+        self.interpolate_into(end, t, rest_wrist, &mut out);
         out
     }
 
@@ -34,14 +40,14 @@ impl Pose {
     ///
     /// # Panics
     /// If the three poses have different angle counts.
-    pub fn interpolate_into(&self, end: &Pose, t: f32, out: &mut Pose) {
+    pub fn interpolate_into(&self, end: &Pose, t: f32, rest_wrist: DualQuat, out: &mut Pose) {
         assert!(self.angles.len() == end.angles.len() && out.angles.len() == end.angles.len(), "poses of different joint models");
         for ((o, a), b) in out.angles.iter_mut().zip(&self.angles).zip(&end.angles) {
             *o = a + (b - a) * t;
         }
         out.wrist = match (self.wrist, end.wrist) {
             (None, None) => None,
-            (a, b) => Some(a.unwrap_or(DualQuat::IDENTITY).sclerp(b.unwrap_or(DualQuat::IDENTITY), t)),
+            (a, b) => Some(a.unwrap_or(rest_wrist).sclerp(b.unwrap_or(rest_wrist), t)),
         };
     }
 }

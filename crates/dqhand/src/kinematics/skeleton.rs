@@ -31,21 +31,21 @@ impl Skeleton {
     /// and transforms are finite.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the offending joint.
+    /// [`Error::Skeleton`] naming the offending joint.
     pub fn new(joints: Vec<Joint>) -> Result<Self> {
         let n = joints.len();
         let mut seen = std::collections::HashSet::new();
         for (i, j) in joints.iter().enumerate() {
             if !seen.insert(j.name.as_str()) {
-                return Err(Error::Invalid(format!("joint name {:?} is used twice", j.name)));
+                return Err(Error::Skeleton(format!("joint name {:?} is used twice", j.name)));
             }
             if let Some(p) = j.parent {
                 if p >= n || p == i {
-                    return Err(Error::Invalid(format!("joint {:?} has invalid parent index {p}", j.name)));
+                    return Err(Error::Skeleton(format!("joint {:?} has invalid parent index {p}", j.name)));
                 }
             }
             if !j.rest.is_finite() {
-                return Err(Error::Invalid(format!("joint {:?} has a non-finite rest transform", j.name)));
+                return Err(Error::Skeleton(format!("joint {:?} has a non-finite rest transform", j.name)));
             }
         }
         // Depth-first order from the roots; a joint never reached lies on a cycle.
@@ -63,7 +63,7 @@ impl Skeleton {
         }
         if order.len() != n {
             let stuck = (0..n).find(|i| !order.contains(i)).unwrap_or(0);
-            return Err(Error::Invalid(format!("joint {:?} is part of a parent cycle", joints[stuck].name)));
+            return Err(Error::Skeleton(format!("joint {:?} is part of a parent cycle", joints[stuck].name)));
         }
         Ok(Self { joints, order })
     }
@@ -134,7 +134,7 @@ impl Skeleton {
     /// `None` to keep it), with rest locals recomputed so every rest world transform is kept.
     ///
     /// # Errors
-    /// [`Error::Invalid`] if the new parents form a cycle.
+    /// [`Error::Skeleton`] if the new parents form a cycle.
     pub fn reparented(&self, parent_of: impl Fn(&str) -> Option<&'static str>) -> Result<Self> {
         let world = self.rest_world();
         let mut joints = self.joints.clone();

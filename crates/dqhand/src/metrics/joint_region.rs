@@ -19,9 +19,9 @@ pub struct JointRegion {
     pub joints: [usize; 3],
     /// The vertices of the region.
     pub vertices: Vec<usize>,
-    /// The skin radius at the joint in the rest pose (m).
+    /// The skin radius at the joint in the bind pose (m).
     pub radius: f32,
-    /// The smallest distance of the region's vertices from the axis of `J → C` at rest (m):
+    /// The smallest distance of the region's vertices from the axis of `J → C` in the bind pose (m):
     /// the reference of [`Self::section_radius`] (less than `radius` where the section is
     /// not round).
     pub min_radius: f32,
@@ -30,15 +30,17 @@ pub struct JointRegion {
 impl JointRegion {
     /// The region around `joint`, whose next joint along the chain is `next`.
     ///
-    /// * `rest_world` — #joints rest world transforms of `skeleton`.
+    /// * `bind_world` — #joints world transforms of the pose the mesh is bound in
+    ///   ([`crate::model::Model::bind_world`]).
     ///
     /// # Errors
-    /// [`Error::Invalid`] if a joint is missing or has no parent, or no vertex is near it.
-    pub fn new(skeleton: &Skeleton, rest_world: &[Affine3A], mesh: &SkinnedMesh, joint: &str, next: &str) -> Result<Self> {
+    /// [`Error::UnknownName`] if a joint is missing, [`Error::Skeleton`] if it has no parent,
+    /// [`Error::NoSkin`] if no vertex is near it.
+    pub fn new(skeleton: &Skeleton, bind_world: &[Affine3A], mesh: &SkinnedMesh, joint: &str, next: &str) -> Result<Self> {
         let j = skeleton.index_of(joint)?;
         let c = skeleton.index_of(next)?;
-        let a = skeleton.joints()[j].parent.ok_or_else(|| Error::Invalid(format!("joint {joint:?} has no parent bone")))?;
-        let (pj, pc) = (Vec3::from(rest_world[j].translation), Vec3::from(rest_world[c].translation));
+        let a = skeleton.joints()[j].parent.ok_or_else(|| Error::Skeleton(format!("joint {joint:?} has no parent bone")))?;
+        let (pj, pc) = (Vec3::from(bind_world[j].translation), Vec3::from(bind_world[c].translation));
         let (dir, length) = ((pc - pj).normalize_or_zero(), pc.distance(pj));
         let candidates: Vec<(usize, f32, f32)> = (0..mesh.vertex_count())
             .filter(|&v| mesh.influences(v).next().is_some_and(|(h, _)| h == a || h == j))
@@ -50,7 +52,7 @@ impl JointRegion {
             .collect();
         let mut radial: Vec<f32> = candidates.iter().filter(|c| (0.0..0.5 * length).contains(&c.1)).map(|c| c.2).collect();
         radial.sort_by(f32::total_cmp);
-        let radius = *radial.get(radial.len() / 2).ok_or_else(|| Error::Invalid(format!("no skin around joint {joint:?}")))?;
+        let radius = *radial.get(radial.len() / 2).ok_or_else(|| Error::NoSkin(joint.into()))?;
         let region: Vec<&(usize, f32, f32)> = candidates.iter().filter(|c| c.1.abs() <= radius).collect();
         let min_radius = region.iter().map(|c| c.2).fold(f32::MAX, f32::min);
         let vertices = region.iter().map(|c| c.0).collect();
@@ -58,14 +60,14 @@ impl JointRegion {
     }
 
     /// Smallest and largest ratio, over the region, of a vertex's distance to the two bones
-    /// `A → J → C` posed (`world`, `positions`) to the same distance at rest. Below 1: the
-    /// skin collapses toward the bones; above 1: it bulges.
+    /// `A → J → C` posed (`world`, `positions`) to the same distance in the bind pose. Below
+    /// 1: the skin collapses toward the bones; above 1: it bulges.
     ///
-    /// * `rest_world`, `world` — #joints; `positions` — #V deformed.
+    /// * `bind_world`, `world` — #joints; `positions` — #V deformed.
     #[must_use]
-    pub fn distance_ratios(&self, mesh: &SkinnedMesh, rest_world: &[Affine3A], world: &[Affine3A], positions: &[[f32; 3]]) -> (f32, f32) {
+    pub fn distance_ratios(&self, mesh: &SkinnedMesh, bind_world: &[Affine3A], world: &[Affine3A], positions: &[[f32; 3]]) -> (f32, f32) {
         let bones = |w: &[Affine3A]| self.joints.map(|i| Vec3::from(w[i].translation));
-        let (r, p) = (bones(rest_world), bones(world));
+        let (r, p) = (bones(bind_world), bones(world));
         let distance = |b: &[Vec3; 3], x: Vec3| segment_distance(x, b[0], b[1]).min(segment_distance(x, b[1], b[2]));
         self.vertices.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| {
             let ratio = distance(&p, Vec3::from(positions[v])) / distance(&r, mesh.position(v)).max(1e-9);

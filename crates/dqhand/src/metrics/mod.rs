@@ -4,14 +4,12 @@
 //! joint, edge-length distortion, the continuity of sweeps and self-intersections in gesture
 //! poses, each for the three methods.
 
-mod closed_surface;
 mod distortion;
 mod joint_region;
 mod report;
 mod self_intersection;
 
-pub use closed_surface::{check_closed, enclosed_volume, winding_number};
-pub use distortion::{edge_distortion, edges, VertexDistortion};
+pub use distortion::{edge_distortion, VertexDistortion};
 pub use joint_region::JointRegion;
 pub use report::{format_value, measure, FrameMetrics, Report, Sweep};
 pub use self_intersection::count_self_intersections;

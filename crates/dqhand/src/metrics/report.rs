@@ -2,15 +2,18 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 use serde_json::{json, Value};
 
-use super::{check_closed, count_self_intersections, edge_distortion, edges, enclosed_volume, JointRegion};
+use super::{count_self_intersections, edge_distortion, JointRegion};
+use crate::geometry::{check_closed, edges, enclosed_volume};
+use crate::engine::Engine;
 use crate::gesture::gesture;
 use crate::kinematics::{HandRig, JointModel, Limits, Pose, Transform};
-use crate::model::{Model, PoseBuffers};
-use crate::skin::{Deformed, Deformer, Method};
+use crate::model::Model;
+use crate::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// What one sweep moves.
@@ -106,25 +109,27 @@ pub struct Report {
 /// The gestures whose self-intersections are counted.
 const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs-up"];
 
-/// Measures LB, QB and DQB on every sweep.
+/// Measures LB, QB and DQB on every sweep, each frame one step of the [`Engine`].
 ///
 /// # Errors
-/// [`Error::Invalid`] if the model lacks the WebXR hand joints the sweeps move.
-pub fn measure(model: &Model) -> Result<Report> {
-    let rig = HandRig::new(&model.skeleton, JointModel::Full)?;
+/// [`Error::MissingJoint`] or [`Error::JointFrame`] if the model lacks the WebXR hand joints
+/// the sweeps move; [`Error::NoSkin`] if no skin lies around a measured joint.
+pub fn measure(model: Arc<Model>) -> Result<Report> {
+    let mut engine = Engine::with_joint_model(model.clone(), JointModel::Full)?;
+    engine.set_methods(MethodSet::ALL);
+    let rig = engine.rig().expect("made with a joint model").clone();
     let skeleton = rig.skeleton();
     let mesh = &model.mesh;
     let closed = check_closed(mesh.indices());
     let rest_positions = mesh.positions();
     let rest_volume = closed.is_ok().then(|| enclosed_volume(&rest_positions, mesh.indices()));
     let rest_world = skeleton.rest_world();
+    let bind_world = model.bind_world();
     let all_edges = edges(mesh.indices());
-    let mut deformers = Method::ALL.map(|m| Deformer::new(m, mesh));
-    let mut out = Deformed::new(mesh);
-    let mut frame = PoseBuffers::new(skeleton);
+    let mut locals = skeleton.rest_locals();
     let mut sweeps = Vec::new();
     for spec in specs() {
-        let region = JointRegion::new(skeleton, &rest_world, mesh, spec.joint, spec.next)?;
+        let region = JointRegion::new(skeleton, &bind_world, mesh, spec.joint, spec.next)?;
         let in_region = {
             let mut mark = vec![false; mesh.vertex_count()];
             region.vertices.iter().for_each(|&v| mark[v] = true);
@@ -134,47 +139,39 @@ pub fn measure(model: &Model) -> Result<Report> {
         let mut frames: [Vec<FrameMetrics>; 3] = Default::default();
         let mut previous: [Option<Vec<[f32; 3]>>; 3] = Default::default();
         for &value in &spec.values {
-            pose_sweep(&rig, &spec, value, &region, &rest_world, &mut frame.locals)?;
-            frame.evaluate(skeleton, mesh.inverse_bind());
-            for (m, deformer) in deformers.iter_mut().enumerate() {
-                deformer.deform(mesh, &frame.skinning, &mut out);
-                let posed = out.positions();
-                let (min_distance, max_distance) = region.distance_ratios(mesh, &rest_world, &frame.world, posed);
+            pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
+            engine.pose_locals(&locals);
+            for m in Method::ALL {
+                engine.skin(m);
+                let posed = engine.deformed(m).positions();
+                let world = engine.world();
+                let (min_distance, max_distance) = region.distance_ratios(mesh, &bind_world, world, posed);
                 let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
-                let jump = previous[m].as_ref().map_or(0.0, |p| {
+                let jump = previous[m.index()].as_ref().map_or(0.0, |p| {
                     p.iter().zip(posed).map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b))).fold(0.0, f32::max)
                 });
-                frames[m].push(FrameMetrics {
+                frames[m.index()].push(FrameMetrics {
                     volume: rest_volume.map(|v0| (enclosed_volume(posed, mesh.indices()) / v0) as f32),
                     min_distance,
                     max_distance,
-                    section_radius: region.section_radius(&frame.world, posed),
+                    section_radius: region.section_radius(world, posed),
                     distortion_mean,
                     distortion_max,
                     jump,
                 });
-                previous[m] = Some(posed.to_vec());
+                previous[m.index()] = Some(posed.to_vec());
             }
         }
         sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
     }
     let mut intersections = Vec::new();
     for name in INTERSECTION_GESTURES {
-        rig.locals(&library_pose(name)?, Limits::Anatomical, &mut frame.locals);
-        let skinning = frame.evaluate(skeleton, mesh.inverse_bind());
-        let counts = deformers.each_mut().map(|d| {
-            d.deform(mesh, skinning, &mut out);
-            count_self_intersections(out.positions(), mesh.indices())
-        });
+        engine.step(&gesture(name)?.pose(JointModel::Full));
+        let counts = Method::ALL.map(|m| count_self_intersections(engine.deformed(m).positions(), mesh.indices()));
         intersections.push((name, counts));
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
     Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections })
-}
-
-/// A gesture of the library as a `full`-model pose.
-fn library_pose(name: &str) -> Result<Pose> {
-    gesture(name).map(|g| g.pose(JointModel::Full)).ok_or_else(|| Error::Invalid(format!("no gesture {name:?}")))
 }
 
 /// Writes the local transforms of one sweep value.
@@ -184,7 +181,7 @@ fn pose_sweep(rig: &HandRig, spec: &SweepSpec, value: f32, region: &JointRegion,
     match spec.motion {
         Motion::Dof(name) => pose.angles[model.dof_index(name)?] = value.to_radians(),
         Motion::Gesture(name) => {
-            pose = pose.interpolate(&library_pose(name)?, value / 100.0);
+            pose = pose.interpolate(&gesture(name)?.pose(model), value / 100.0, rig.rest_wrist());
         }
         Motion::Twist(_) => {}
     }

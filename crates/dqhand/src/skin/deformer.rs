@@ -1,54 +1,11 @@
 //! The one interface to the three deformers: LB, QB and DQB (paper section 4.4).
 
-use core::fmt;
-
 use glam::Affine3A;
 
 use super::kernel::{self, Frame};
 use super::skinned_mesh::SkinnedMesh;
+use super::Method;
 use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
-
-/// A skinning method.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Linear blending of matrices.
-    Lb,
-    /// Quaternion blending: rotations as quaternions, translations linearly.
-    Qb,
-    /// Dual quaternion blending, paper eq. (3)–(6).
-    Dqb,
-}
-
-impl Method {
-    /// All three, in the paper's Table 3 order.
-    pub const ALL: [Method; 3] = [Method::Lb, Method::Qb, Method::Dqb];
-
-    /// `lb`, `qb` or `dqb`.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Method::Lb => "lb",
-            Method::Qb => "qb",
-            Method::Dqb => "dqb",
-        }
-    }
-}
-
-impl fmt::Display for Method {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl core::str::FromStr for Method {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.as_str() == s.to_ascii_lowercase())
-            .ok_or_else(|| format!("unknown skinning method {s:?}; valid: lb, qb, dqb"))
-    }
-}
 
 /// Deformed positions and normals of one frame, in the mesh's vertex order.
 #[derive(Clone, Debug, PartialEq)]

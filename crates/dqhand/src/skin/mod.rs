@@ -4,9 +4,13 @@ mod deformer;
 mod dual_quaternion_blend;
 mod kernel;
 mod linear_blend;
+mod method;
+mod method_set;
 mod quaternion_blend;
 mod skinned_mesh;
 
+pub use deformer::{skinning_transforms, Deformed, Deformer};
 pub use kernel::simd_available;
-pub use deformer::{skinning_transforms, Deformed, Deformer, Method};
-pub use skinned_mesh::{vertex_normals, MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};
+pub use method::Method;
+pub use method_set::MethodSet;
+pub use skinned_mesh::{MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};

@@ -77,14 +77,14 @@ impl SkinnedMesh {
     /// Validates and packs mesh data. Returns the mesh and warnings (weights renormalised).
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a non-finite value, a joint index out of range, a vertex with no
+    /// [`Error::Mesh`] for a non-finite value, a joint index out of range, a vertex with no
     /// positive weight or a negative weight, a triangle index out of range, a non-invertible
     /// inverse bind matrix, or inconsistent array lengths. The message names the vertex,
     /// triangle or joint.
     pub fn new(data: MeshData) -> Result<(Self, Vec<String>)> {
         let n = data.positions.len();
         let joint_count = data.inverse_bind.len();
-        let bad = |m: String| Err(Error::Invalid(m));
+        let bad = |m: String| Err(Error::Mesh(m));
         if n == 0 {
             return bad("mesh has no vertices".into());
         }
@@ -201,9 +201,9 @@ impl SkinnedMesh {
             .map(|c| c.iter().map(Vec::len).max().unwrap_or(1) as u8)
             .collect();
         let normals = if data.normals.is_empty() {
-            vertex_normals(&data.positions, &data.indices)
+            crate::geometry::vertex_normals(&data.positions, &data.indices)
         } else {
-            let faces = vertex_normals(&data.positions, &data.indices);
+            let faces = crate::geometry::vertex_normals(&data.positions, &data.indices);
             let mut replaced = 0;
             let normals = data
                 .normals
@@ -358,18 +358,4 @@ impl SkinnedMesh {
         }
         used.iter().filter(|&&u| u).count()
     }
-}
-
-/// Area-weighted vertex normals of a triangle mesh, #V (unit; +Y where undefined).
-#[must_use]
-pub fn vertex_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> {
-    let mut acc = vec![Vec3::ZERO; positions.len()];
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(positions[i as usize]));
-        let n = (b - a).cross(c - a);
-        for &i in t {
-            acc[i as usize] += n;
-        }
-    }
-    acc.into_iter().map(|n| n.normalize_or(Vec3::Y).to_array()).collect()
 }

@@ -22,7 +22,7 @@
 //!                   (flag 0) f32 distortion[vertex count]
 //! ```
 
-use crate::skin::Method;
+use crate::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// Version of the format written here; a reader refuses any other.
@@ -37,6 +37,8 @@ pub const FRAME_HEADER_BYTES: usize = 76;
 pub const TOPOLOGY_HEADER_BYTES: usize = 20;
 /// Frame flag: a distortion array follows each mesh's normals.
 pub const FLAG_DISTORTION: u16 = 1;
+/// Method code of a mesh slot the frame does not use.
+const UNUSED_METHOD: u8 = 255;
 /// State bit: the timeline is playing.
 pub const STATE_PLAYING: u32 = 1;
 /// State bit: angles are clamped to the anatomical limits.
@@ -53,8 +55,8 @@ pub struct FrameHeader {
     pub joint_count: u32,
     /// Angles in the pose.
     pub dof_count: u32,
-    /// The method of each mesh, in order (1–3 of them).
-    pub methods: [Option<Method>; 3],
+    /// The method of each mesh, in order (1–3 of them, distinct).
+    pub methods: MethodSet,
     /// Whether each mesh carries a distortion array.
     pub distortion: bool,
     /// Engine time spent on this frame, µs.
@@ -75,7 +77,7 @@ impl FrameHeader {
     /// Meshes in the frame.
     #[must_use]
     pub fn mesh_count(&self) -> usize {
-        self.methods.iter().take_while(|m| m.is_some()).count()
+        self.methods.len()
     }
 
     /// Total size of the frame in bytes.
@@ -85,10 +87,6 @@ impl FrameHeader {
         let per_mesh = 6 * v + if self.distortion { v } else { 0 };
         FRAME_HEADER_BYTES + 4 * (self.dof_count as usize + 3 * self.joint_count as usize + self.mesh_count() * per_mesh)
     }
-}
-
-fn method_code(m: Option<Method>) -> u8 {
-    m.map_or(255, |m| Method::ALL.iter().position(|&a| a == m).expect("a method") as u8)
 }
 
 /// Appends `values` as little-endian f32.
@@ -120,7 +118,11 @@ impl<'a> FrameWriter<'a> {
             out.extend_from_slice(&v.to_le_bytes());
         }
         out.push(h.mesh_count() as u8);
-        out.extend(h.methods.map(method_code));
+        let mut codes = [UNUSED_METHOD; 3];
+        for (c, m) in codes.iter_mut().zip(h.methods.as_slice()) {
+            *c = m.index() as u8;
+        }
+        out.extend(codes);
         put_f32s(out, &[h.engine_us, h.engine_fps, h.time, h.duration]);
         out.extend_from_slice(&h.state.to_le_bytes());
         put_f32s(out, &h.wrist);
@@ -156,7 +158,7 @@ pub struct FrameView {
 }
 
 fn bad(message: impl Into<String>) -> Error {
-    Error::Invalid(format!("stream message: {}", message.into()))
+    Error::Frame(message.into())
 }
 
 /// Little-endian reader over a message that reports truncation as an error.
@@ -206,7 +208,7 @@ impl FrameView {
     /// Parses a frame.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a wrong magic or version, an unknown method, or a length that
+    /// [`Error::Frame`] for a wrong magic or version, an unknown method, or a length that
     /// does not match the header.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };
@@ -214,17 +216,18 @@ impl FrameView {
         let (sequence, vertex_count, joint_count, dof_count) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
         let codes = r.take(4)?;
         let mesh_count = usize::from(codes[0]);
-        let mut methods = [None; 3];
-        for (i, (m, &c)) in methods.iter_mut().zip(&codes[1..]).enumerate() {
-            *m = match (i < mesh_count, Method::ALL.get(usize::from(c))) {
-                (true, Some(&m)) => Some(m),
-                (false, _) if c == 255 => None,
-                _ => return Err(bad(format!("mesh {i}: method code {c} with {mesh_count} meshes"))),
-            };
-        }
         if mesh_count == 0 || mesh_count > 3 {
             return Err(bad(format!("{mesh_count} meshes (1 to 3)")));
         }
+        let mut methods = [Method::Dqb; 3];
+        for (i, &c) in codes[1..].iter().enumerate() {
+            match (i < mesh_count, Method::ALL.get(usize::from(c))) {
+                (true, Some(&m)) => methods[i] = m,
+                (false, _) if c == UNUSED_METHOD => {}
+                _ => return Err(bad(format!("mesh {i}: method code {c} with {mesh_count} meshes"))),
+            }
+        }
+        let methods = MethodSet::new(&methods[..mesh_count]).map_err(|e| bad(e.to_string()))?;
         let s = r.f32s(4)?;
         let state = r.u32()?;
         let wrist: [f32; 7] = r.f32s(7)?.try_into().expect("7 values");
@@ -288,7 +291,7 @@ impl Topology {
     /// Parses a topology message.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a wrong magic or version, a truncated message, an index out of
+    /// [`Error::Frame`] for a wrong magic or version, a truncated message, an index out of
     /// range or a parent that is not another joint.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };

@@ -12,12 +12,13 @@ use serde_json::json;
 
 use super::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYING, VERSION};
 use super::Command;
+use crate::engine::Engine;
 use crate::gesture::{gesture, Sequence, GESTURES};
-use crate::kinematics::{HandRig, JointModel, Limits, Pose};
+use crate::kinematics::{JointModel, Limits, Pose};
 use crate::math::DualQuat;
 use crate::metrics::VertexDistortion;
-use crate::model::{Model, PoseBuffers};
-use crate::skin::{Deformed, Deformer, Method};
+use crate::model::Model;
+use crate::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// Length of a move to a gesture chosen without a duration, seconds.
@@ -32,22 +33,19 @@ pub enum Applied {
     Hello,
 }
 
-/// The state of one connected viewer.
+/// The state of one connected viewer: the pose source (edits, the timeline, a move to a
+/// gesture) of its own [`Engine`], and the view.
 pub struct Session {
-    model: Arc<Model>,
-    rig: HandRig,
+    engine: Engine,
     pose: Pose,
     /// The wrist set by the user, kept over sequence playback (which leaves the wrist alone).
     wrist: Option<DualQuat>,
-    limits: Limits,
-    view: [Option<Method>; 3],
+    /// The rig's rest wrist, which a pose without a wrist stands for.
+    rest_wrist: DualQuat,
     heatmap: bool,
-    /// One deformer, output and distortion buffer per method, in [`Method::ALL`] order.
-    deformers: [Deformer; 3],
-    deformed: [Deformed; 3],
+    /// One distortion buffer per method, in [`Method::ALL`] order.
     distortion: [Vec<f32>; 3],
     vertex_distortion: VertexDistortion,
-    buffers: PoseBuffers,
     joints: Vec<[f32; 3]>,
     timeline: Sequence,
     time: f32,
@@ -56,48 +54,45 @@ pub struct Session {
     sequence: u32,
 }
 
-fn slot(m: Method) -> usize {
-    Method::ALL.iter().position(|&a| a == m).expect("a method")
-}
-
 impl Session {
     /// A session on `model` with the `joint_model`'s DOFs, showing DQB and playing the
     /// bundled gesture sequence.
     ///
     /// # Errors
-    /// [`Error::Invalid`] if the model's skeleton lacks the WebXR hand joints.
+    /// [`Error::MissingJoint`] if the model's skeleton lacks the WebXR hand joints.
     pub fn new(model: Arc<Model>, joint_model: JointModel) -> Result<Self> {
-        let rig = HandRig::new(&model.skeleton, joint_model)?;
         let mesh = &model.mesh;
         let n = mesh.vertex_count();
+        let vertex_distortion = VertexDistortion::new(&mesh.positions(), mesh.indices());
+        let engine = Engine::with_joint_model(model, joint_model)?;
+        let rig = engine.rig().expect("made with a joint model");
         Ok(Self {
             pose: Pose::rest(joint_model.dof_count()),
             wrist: None,
-            limits: Limits::Anatomical,
-            view: [Some(Method::Dqb), None, None],
+            rest_wrist: rig.rest_wrist(),
             heatmap: false,
-            deformers: Method::ALL.map(|m| Deformer::new(m, mesh)),
-            deformed: Method::ALL.map(|_| Deformed::new(mesh)),
             distortion: Method::ALL.map(|_| vec![0.0; n]),
-            vertex_distortion: VertexDistortion::new(&mesh.positions(), mesh.indices()),
-            buffers: PoseBuffers::new(rig.skeleton()),
-            joints: vec![[0.0; 3]; rig.skeleton().len()],
+            vertex_distortion,
+            joints: vec![[0.0; 3]; engine.skeleton().len()],
             timeline: Sequence::gestures(joint_model),
             time: 0.0,
             playing: true,
             transition: None,
             sequence: 0,
-            rig,
-            model,
+            engine,
         })
+    }
+
+    fn joint_model_now(&self) -> JointModel {
+        self.engine.rig().expect("a session's engine has a joint model").model()
     }
 
     /// The JSON greeting: the model, the DOFs with their ranges, the gestures, sequences and
     /// methods the page can ask for.
     #[must_use]
     pub fn hello(&self, max_message_bytes: usize) -> String {
-        let model = self.rig.model();
-        let mesh = &self.model.mesh;
+        let model = self.joint_model_now();
+        let (description, mesh) = (&self.engine.model().description, &self.engine.model().mesh);
         let dofs: Vec<_> = model
             .dofs()
             .map(|d| json!({ "name": d.name(), "joint": d.joint, "min_deg": d.min_deg, "max_deg": d.max_deg }))
@@ -105,10 +100,10 @@ impl Session {
         json!({
             "type": "hello",
             "version": VERSION,
-            "description": self.model.description,
+            "description": description,
             "vertices": mesh.vertex_count(),
             "triangles": mesh.triangle_count(),
-            "joints": self.rig.skeleton().joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(),
+            "joints": self.engine.skeleton().names().collect::<Vec<_>>(),
             "joint_model": model.as_str(),
             "joint_models": JointModel::ALL.map(JointModel::as_str),
             "dofs": dofs,
@@ -125,9 +120,9 @@ impl Session {
     #[must_use]
     pub fn topology(&self) -> Topology {
         Topology {
-            vertex_count: self.model.mesh.vertex_count() as u32,
-            indices: self.model.mesh.indices().to_vec(),
-            parents: self.rig.skeleton().joints().iter().map(|j| j.parent).collect(),
+            vertex_count: self.engine.model().mesh.vertex_count() as u32,
+            indices: self.engine.model().mesh.indices().to_vec(),
+            parents: self.engine.skeleton().joints().iter().map(|j| j.parent).collect(),
         }
     }
 
@@ -140,43 +135,30 @@ impl Session {
     /// The joint model of the pose.
     #[must_use]
     pub fn joint_model(&self) -> JointModel {
-        self.rig.model()
+        self.joint_model_now()
     }
 
     /// Applies one command from the page. Acks are the transport's business and change
     /// nothing here.
     ///
     /// # Errors
-    /// [`Error::Invalid`] or [`Error::UnknownName`] naming the bad value; the session is
+    /// [`Error::Command`] or [`Error::UnknownName`] naming the bad value; the session is
     /// unchanged then.
     pub fn apply(&mut self, command: &Command) -> Result<Applied> {
         match command {
             Command::Ack { .. } => {}
-            Command::View { methods } => {
-                if methods.is_empty() || methods.len() > 3 {
-                    return Err(Error::Invalid(format!("view: {} methods (1 to 3)", methods.len())));
-                }
-                let mut view = [None; 3];
-                for (v, name) in view.iter_mut().zip(methods) {
-                    let m: Method = name.parse().map_err(Error::Invalid)?;
-                    if methods.iter().filter(|n| n.as_str() == name).count() > 1 {
-                        return Err(Error::Invalid(format!("view: method {name:?} given twice")));
-                    }
-                    *v = Some(m);
-                }
-                self.view = view;
-            }
+            Command::View { methods } => self.engine.set_methods(MethodSet::parse(methods)?),
             Command::JointModel { name } => {
-                let model: JointModel = name.parse().map_err(Error::Invalid)?;
-                if model != self.rig.model() {
+                let model: JointModel = name.parse()?;
+                if model != self.joint_model_now() {
                     self.set_joint_model(model)?;
                     return Ok(Applied::Hello);
                 }
             }
             Command::Angle { dof, deg } => {
-                let i = self.rig.model().dof_index(dof)?;
-                let d = self.rig.model().dofs().nth(i).expect("index from the model");
-                let (lo, hi) = match self.limits {
+                let i = self.joint_model_now().dof_index(dof)?;
+                let d = self.joint_model_now().dofs().nth(i).expect("index from the model");
+                let (lo, hi) = match self.engine.limits() {
                     Limits::Anatomical => (d.min_deg, d.max_deg),
                     Limits::Off => (-180.0, 180.0),
                 };
@@ -194,19 +176,16 @@ impl Session {
                 self.pose.wrist = self.wrist;
             }
             Command::Gesture { name, seconds } => {
-                let g = gesture(name).ok_or_else(|| Error::UnknownName {
-                    kind: "gesture",
-                    name: name.clone(),
-                    valid: GESTURES.map(|g| g.name).join(", "),
-                })?;
+                let g = gesture(name)?;
                 let seconds = seconds.unwrap_or(GESTURE_SECONDS);
                 if !(0.0..=10.0).contains(&seconds) {
-                    return Err(Error::Invalid(format!("gesture: {seconds} seconds (0 to 10)")));
+                    return Err(Error::Command(format!("gesture: {seconds} seconds (0 to 10)")));
                 }
                 self.stop();
-                let mut to = g.pose(self.rig.model());
+                let model = self.joint_model_now();
+                let mut to = g.pose(model);
                 to.wrist = self.wrist;
-                self.transition = Some((Sequence::transition(self.rig.model(), &self.pose, (g.name, to), seconds), 0.0));
+                self.transition = Some((Sequence::transition(model, &self.pose, to, seconds), 0.0));
             }
             Command::Play => {
                 self.transition = None;
@@ -223,11 +202,11 @@ impl Session {
                 self.sample_timeline();
             }
             Command::Heatmap { on } => self.heatmap = *on,
-            Command::Limits { on } => self.limits = if *on { Limits::Anatomical } else { Limits::Off },
+            Command::Limits { on } => self.engine.set_limits(if *on { Limits::Anatomical } else { Limits::Off }),
             Command::Rest => {
                 self.stop();
                 self.wrist = None;
-                self.pose = Pose::rest(self.rig.model().dof_count());
+                self.pose = Pose::rest(self.joint_model_now().dof_count());
             }
         }
         Ok(Applied::Frame)
@@ -239,8 +218,8 @@ impl Session {
     }
 
     fn set_joint_model(&mut self, model: JointModel) -> Result<()> {
-        let rig = HandRig::new(&self.model.skeleton, model)?;
-        let old = self.rig.model();
+        let old = self.joint_model_now();
+        self.engine.set_joint_model(model)?;
         let mut pose = Pose::rest(model.dof_count());
         for (d, a) in old.dofs().zip(&self.pose.angles) {
             if let Ok(i) = model.dof_index(&d.name()) {
@@ -248,7 +227,6 @@ impl Session {
             }
         }
         pose.wrist = self.wrist;
-        self.rig = rig;
         self.pose = pose;
         self.timeline = Sequence::gestures(model);
         self.time = self.time.min(self.timeline.duration());
@@ -257,7 +235,7 @@ impl Session {
     }
 
     fn sample_timeline(&mut self) {
-        self.timeline.sample(self.time, &mut self.pose);
+        self.timeline.sample(self.time, self.rest_wrist, &mut self.pose);
         self.pose.wrist = self.wrist;
     }
 
@@ -265,7 +243,7 @@ impl Session {
     pub fn advance(&mut self, dt: f32) {
         if let Some((sequence, elapsed)) = &mut self.transition {
             *elapsed += dt;
-            sequence.sample(*elapsed, &mut self.pose);
+            sequence.sample(*elapsed, self.rest_wrist, &mut self.pose);
             if *elapsed >= sequence.duration() {
                 self.transition = None;
             }
@@ -282,46 +260,43 @@ impl Session {
     /// * `engine_fps` — the rate the transport is achieving, reported to the page.
     pub fn render(&mut self, engine_fps: f32, out: &mut Vec<u8>) {
         let start = Instant::now();
-        let mesh = &self.model.mesh;
-        self.rig.locals(&self.pose, self.limits, &mut self.buffers.locals);
-        self.buffers.evaluate(self.rig.skeleton(), mesh.inverse_bind());
-        for m in self.view.iter().flatten() {
-            let s = slot(*m);
-            self.deformers[s].deform(mesh, &self.buffers.skinning, &mut self.deformed[s]);
-            if self.heatmap {
-                self.vertex_distortion.compute(self.deformed[s].positions(), &mut self.distortion[s]);
+        self.engine.step(&self.pose);
+        let methods = self.engine.methods();
+        if self.heatmap {
+            for &m in methods.as_slice() {
+                self.vertex_distortion.compute(self.engine.deformed(m).positions(), &mut self.distortion[m.index()]);
             }
         }
-        for (j, w) in self.joints.iter_mut().zip(&self.buffers.world) {
+        for (j, w) in self.joints.iter_mut().zip(self.engine.world()) {
             *j = w.translation.into();
         }
         let engine_us = start.elapsed().as_secs_f32() * 1e6;
-        let (rotation, translation) = self.pose.wrist.unwrap_or(DualQuat::IDENTITY).to_rotation_translation();
+        let (rotation, translation) = self.pose.wrist.unwrap_or(self.rest_wrist).to_rotation_translation();
         let mut wrist = [0.0; 7];
         wrist[..3].copy_from_slice(&translation.to_array());
         wrist[3..].copy_from_slice(&rotation.to_array());
         let header = FrameHeader {
             sequence: self.sequence,
-            vertex_count: mesh.vertex_count() as u32,
+            vertex_count: self.engine.model().mesh.vertex_count() as u32,
             joint_count: self.joints.len() as u32,
             dof_count: self.pose.angles.len() as u32,
-            methods: self.view,
+            methods,
             distortion: self.heatmap,
             engine_us,
             engine_fps,
             time: self.time,
             duration: self.timeline.duration(),
-            state: if self.playing { STATE_PLAYING } else { 0 } | if self.limits == Limits::Anatomical { STATE_LIMITS } else { 0 },
+            state: if self.playing { STATE_PLAYING } else { 0 } | if self.engine.limits() == Limits::Anatomical { STATE_LIMITS } else { 0 },
             wrist,
         };
         self.sequence = self.sequence.wrapping_add(1);
         let mut w = FrameWriter::begin(out, header);
         w.floats(&self.pose.angles).floats(self.joints.as_flattened());
-        for m in self.view.iter().flatten() {
-            let s = slot(*m);
-            w.floats(self.deformed[s].positions().as_flattened()).floats(self.deformed[s].normals().as_flattened());
+        for &m in methods.as_slice() {
+            let deformed = self.engine.deformed(m);
+            w.floats(deformed.positions().as_flattened()).floats(deformed.normals().as_flattened());
             if self.heatmap {
-                w.floats(&self.distortion[s]);
+                w.floats(&self.distortion[m.index()]);
             }
         }
         w.finish();
@@ -330,7 +305,7 @@ impl Session {
 
 fn finite(what: &str, values: &[f32]) -> Result<()> {
     match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(Error::Invalid(format!("{what}: {v} is not a finite number"))),
+        Some(v) => Err(Error::Command(format!("{what}: {v} is not a finite number"))),
         None => Ok(()),
     }
 }

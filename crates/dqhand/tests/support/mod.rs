@@ -48,3 +48,22 @@ pub fn rotation() -> impl Strategy<Value = Quat> {
         (axis.length() > 0.1).then(|| Quat::from_axis_angle(axis.normalize(), angle))
     })
 }
+
+/// Poses `model` with `target` through the engine; returns the skinning transforms and the
+/// clamping warnings.
+pub fn pose_skinning(model: &dqhand::model::Model, target: &dqhand::kinematics::PoseTarget, limits: dqhand::kinematics::Limits) -> dqhand::Result<(Vec<glam::Affine3A>, Vec<String>)> {
+    let mut engine = dqhand::engine::Engine::for_target(std::sync::Arc::new(model.clone()), target)?;
+    engine.set_limits(limits);
+    let warnings = engine.pose_target(target);
+    Ok((engine.skinning().to_vec(), warnings))
+}
+
+/// World transforms of `rig`'s skeleton posed by `pose`: the rig's local transforms, then
+/// forward kinematics.
+pub fn world_of(rig: &dqhand::kinematics::HandRig, pose: &dqhand::kinematics::Pose, limits: dqhand::kinematics::Limits) -> Vec<glam::Affine3A> {
+    let mut locals = rig.skeleton().rest_locals();
+    rig.locals(pose, limits, &mut locals);
+    let mut world = vec![glam::Affine3A::IDENTITY; locals.len()];
+    dqhand::kinematics::forward_kinematics(rig.skeleton(), &locals, &mut world);
+    world
+}

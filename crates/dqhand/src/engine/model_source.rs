@@ -1,0 +1,47 @@
+//! Where a model comes from: the built-in hand, or a glTF file.
+
+use std::path::PathBuf;
+
+use crate::hand::{build, HandParams};
+use crate::io::load_gltf;
+use crate::model::Model;
+use crate::Result;
+
+/// A model to load, as written on a command line: `builtin` or a `.glb`/`.gltf` path.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelSource {
+    /// The built-in anatomical hand at these parameters.
+    Builtin(HandParams),
+    /// A skinned glTF 2.0 file.
+    File(PathBuf),
+}
+
+impl ModelSource {
+    /// Builds or reads the model.
+    ///
+    /// # Errors
+    /// As [`build`] or [`load_gltf`].
+    pub fn load(&self) -> Result<Model> {
+        match self {
+            ModelSource::Builtin(params) => build(params),
+            ModelSource::File(path) => load_gltf(path),
+        }
+    }
+}
+
+impl core::str::FromStr for ModelSource {
+    type Err = std::convert::Infallible;
+    /// `builtin` is the built-in hand at its defaults; anything else is a file path.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ok(if s == "builtin" { ModelSource::Builtin(HandParams::default()) } else { ModelSource::File(s.into()) })
+    }
+}
+
+impl core::fmt::Display for ModelSource {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ModelSource::Builtin(_) => f.write_str("builtin"),
+            ModelSource::File(path) => write!(f, "{}", path.display()),
+        }
+    }
+}

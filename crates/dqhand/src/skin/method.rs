@@ -1,0 +1,55 @@
+//! The three skinning methods the paper compares (section 4.4).
+
+use core::fmt;
+
+/// A skinning method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Method {
+    /// Linear blending of matrices.
+    Lb,
+    /// Quaternion blending: rotations as quaternions, translations linearly.
+    Qb,
+    /// Dual quaternion blending, paper eq. (3)–(6).
+    Dqb,
+}
+
+impl Method {
+    /// All three, in the paper's Table 3 order.
+    pub const ALL: [Method; 3] = [Method::Lb, Method::Qb, Method::Dqb];
+
+    /// The position in [`Self::ALL`] (0 LB, 1 QB, 2 DQB): the index of per-method arrays
+    /// and the method's code in the viewer stream.
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// `lb`, `qb` or `dqb`.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Method::Lb => "lb",
+            Method::Qb => "qb",
+            Method::Dqb => "dqb",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl core::str::FromStr for Method {
+    type Err = crate::Error;
+    /// `lb`, `qb` or `dqb`, in any case; anything else is [`crate::Error::UnknownName`].
+    fn from_str(s: &str) -> crate::Result<Self> {
+        Self::ALL.into_iter().find(|m| m.as_str().eq_ignore_ascii_case(s)).ok_or_else(|| crate::Error::UnknownName {
+            kind: "skinning method",
+            name: s.to_owned(),
+            valid: "lb, qb, dqb".into(),
+        })
+    }
+}

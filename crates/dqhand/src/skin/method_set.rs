@@ -1,0 +1,85 @@
+//! Which methods to skin and show, in order: one (a single view) or several side by side.
+
+use super::Method;
+use crate::{Error, Result};
+
+/// One to three distinct skinning methods in display order.
+///
+/// A gap or a repeat cannot be represented, so whatever holds one (a viewer's view, a frame
+/// header) always describes 1–3 meshes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MethodSet {
+    methods: [Method; 3],
+    len: u8,
+}
+
+impl MethodSet {
+    /// DQB alone: the paper's method.
+    pub const DQB: Self = Self { methods: [Method::Dqb; 3], len: 1 };
+    /// LB, QB and DQB, in the paper's order.
+    pub const ALL: Self = Self { methods: Method::ALL, len: 3 };
+
+    /// The methods given, in that order.
+    ///
+    /// # Errors
+    /// [`Error::Command`] if there are none, more than three, or one is repeated.
+    pub fn new(methods: &[Method]) -> Result<Self> {
+        if methods.is_empty() || methods.len() > 3 {
+            return Err(Error::Command(format!("view: {} methods (1 to 3)", methods.len())));
+        }
+        let mut set = Self { methods: [methods[0]; 3], len: 0 };
+        for &m in methods {
+            if set.contains(m) {
+                return Err(Error::Command(format!("view: method {:?} given twice", m.as_str())));
+            }
+            set.methods[usize::from(set.len)] = m;
+            set.len += 1;
+        }
+        Ok(set)
+    }
+
+    /// The methods named (`lb`, `qb`, `dqb`, in any case), in that order.
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] for a name that is no method, else as [`Self::new`].
+    pub fn parse<S: AsRef<str>>(names: &[S]) -> Result<Self> {
+        let mut methods = [Method::Dqb; 3];
+        if names.len() > 3 {
+            return Err(Error::Command(format!("view: {} methods (1 to 3)", names.len())));
+        }
+        for (m, name) in methods.iter_mut().zip(names) {
+            *m = name.as_ref().parse()?;
+        }
+        Self::new(&methods[..names.len()])
+    }
+
+    /// The methods, in order.
+    #[must_use]
+    pub fn as_slice(&self) -> &[Method] {
+        &self.methods[..usize::from(self.len)]
+    }
+
+    /// How many methods (1 to 3).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// Never true: a set holds at least one method.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Whether `method` is in the set.
+    #[must_use]
+    pub fn contains(&self, method: Method) -> bool {
+        self.as_slice().contains(&method)
+    }
+}
+
+impl Default for MethodSet {
+    fn default() -> Self {
+        Self::DQB
+    }
+}
