@@ -4,6 +4,7 @@ import './style.css';
 import { Connection } from './connection';
 import { type Command, type Frame, type Hello, type Method, METHODS } from './protocol';
 import { HandScene } from './scene';
+import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 const params = new URLSearchParams(location.search);
@@ -108,6 +109,10 @@ function slider(label: string, min: number, max: number, step: number, onInput: 
 
 /** The slider of each DOF, in the hello's order (found once per rebuild, not per frame). */
 let dofInputs: (HTMLInputElement | null)[] = [];
+/** The wrist sliders, in `WRIST_SLIDERS`' order (built once, with the first hello). */
+let wristInputs: HTMLInputElement[] = [];
+/** The wrist slider values of the latest frame (scratch, per animation frame). */
+const _wrist = [0, 0, 0, 0, 0, 0];
 
 function buildSliders(h: Hello): void {
   const limits = $<HTMLInputElement>('limits').checked;
@@ -126,25 +131,27 @@ function buildSliders(h: Hello): void {
   });
   $('sliders').replaceChildren(...groups);
   dofInputs = h.dofs.map((d) => $('sliders').querySelector<HTMLInputElement>(`input[data-dof="${d.name}"]`));
-  if ($('wrist').childElementCount === 0) {
-    const wrist = [0, 0, 0, 0, 0, 0];
-    const send = () => connection.send({ type: 'wrist', translation: [wrist[0] / 100, wrist[1] / 100, wrist[2] / 100], rotation_deg: [wrist[3], wrist[4], wrist[5]] });
-    const axes = ['x cm', 'y cm', 'z cm', 'rot x°', 'rot y°', 'rot z°'];
-    $('wrist').append(...axes.map((a, i) => slider(a, i < 3 ? -15 : -180, i < 3 ? 15 : 180, i < 3 ? 0.5 : 1, (v) => ((wrist[i] = v), send()), { wrist: String(i) })));
+  if (wristInputs.length === 0) {
+    // All six as shown: the others show the engine's wrist (a Rest, a gesture, another page).
+    const send = () => connection.send(wristCommand(wristInputs.map((input) => Number(input.value))));
+    $('wrist').append(...WRIST_SLIDERS.map(({ label, min, max, step }, i) => slider(label, min, max, step, send, { wrist: String(i) })));
+    wristInputs = Array.from($('wrist').querySelectorAll('input'));
   }
+}
+
+/** Shows a value on a slider and its output, unless the user is dragging that slider. */
+function showValue(input: HTMLInputElement | null, value: number): void {
+  if (!input || input === dragging || input.value === String(value)) return;
+  input.value = String(value);
+  input.nextElementSibling!.textContent = input.value;
 }
 
 /** Moves the sliders and the timeline to the engine's pose (except the one being dragged). */
 function syncControls(f: Frame): void {
+  wristSliderValues(f.header.wrist, _wrist);
+  wristInputs.forEach((input, i) => showValue(input, _wrist[i]));
   if (!hello || f.angles.length !== hello.dofs.length) return;
-  dofInputs.forEach((input, i) => {
-    if (!input || input === dragging) return;
-    const deg = Math.round((f.angles[i] * 180) / Math.PI);
-    if (input.value !== String(deg)) {
-      input.value = String(deg);
-      input.nextElementSibling!.textContent = String(deg);
-    }
-  });
+  dofInputs.forEach((input, i) => showValue(input, Math.round((f.angles[i] * 180) / Math.PI)));
   const t = $<HTMLInputElement>('timeline');
   if (t !== dragging) t.value = String(f.header.time);
   $('time').textContent = `${f.header.time.toFixed(1)} / ${f.header.duration.toFixed(1)} s`;
@@ -202,11 +209,13 @@ window.dqhand = {
     joints: hello ? [...hello.joints] : [],
     pageFps,
     visible: scene.visibleMethods(),
+    geometries: scene.renderer.info.memory.geometries,
     frame: frame && {
       sequence: frame.header.sequence,
       methods: frame.header.methods,
       anglesDeg: Array.from(frame.angles, (a) => (a * 180) / Math.PI),
       joints: Array.from(frame.joints),
+      wrist: Array.from(frame.header.wrist),
       playing: frame.header.playing,
       time: frame.header.time,
       engineFps: frame.header.engineFps,

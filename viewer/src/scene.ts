@@ -29,9 +29,12 @@ class HandView {
   readonly group = new THREE.Group();
   /** Engine coordinates inside. */
   readonly oriented = new THREE.Group();
+  /** The skin, its vertex arrays rewritten by each frame. */
   readonly mesh: THREE.Mesh<THREE.BufferGeometry, THREE.MeshPhysicalMaterial>;
-  readonly bones: THREE.LineSegments;
-  readonly jointDots: THREE.Points;
+  /** The skeleton overlay: one segment from each joint to its parent. */
+  readonly bones: THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial>;
+  /** The skeleton overlay: a dot on each joint. */
+  readonly jointDots: THREE.Points<THREE.BufferGeometry, THREE.PointsMaterial>;
   method: Method | null = null;
 
   constructor(topology: Topology) {
@@ -110,6 +113,14 @@ class HandView {
     (dots.array as Float32Array).set(frame.joints);
     dots.needsUpdate = true;
   }
+
+  /** Frees the GPU buffers of the skin, bones and joint dots (their geometries and materials). */
+  dispose(): void {
+    for (const o of [this.mesh, this.bones, this.jointDots]) {
+      o.geometry.dispose();
+      o.material.dispose();
+    }
+  }
 }
 
 export class HandScene {
@@ -162,8 +173,7 @@ export class HandScene {
   setTopology(topology: Topology): void {
     for (const v of this.views) {
       this.scene.remove(v.group);
-      v.mesh.geometry.dispose();
-      v.mesh.material.dispose();
+      v.dispose();
     }
     this.views = [0, 1, 2].map(() => new HandView(topology));
     for (const v of this.views) this.scene.add(v.group);

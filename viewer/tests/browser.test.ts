@@ -2,7 +2,7 @@
 // controls reach the engine and come back as the right change on screen, and it survives a
 // server restart.
 
-import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import { afterAll, beforeAll, describe, expect, onTestFinished, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
 import { canvasStats, countColour, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
@@ -17,7 +17,10 @@ interface State {
   dofs: string[];
   joints: string[];
   visible: string[];
-  frame: { methods: string[]; anglesDeg: number[]; joints: number[]; playing: boolean } | null;
+  /** Geometries the renderer holds on the GPU. */
+  geometries: number;
+  /** `wrist`: translation xyz (m), rotation xyzw, as the engine reports it. */
+  frame: { methods: string[]; anglesDeg: number[]; joints: number[]; wrist: number[]; playing: boolean } | null;
 }
 const state = (): Promise<State> => page.evaluate(() => (window as unknown as { dqhand: { state(): State } }).dqhand.state());
 const send = (command: object) => page.evaluate((c) => (window as unknown as { dqhand: { send(c: object): void } }).dqhand.send(c), command);
@@ -29,6 +32,27 @@ const tip = (s: State, finger: string) => {
   return s.frame!.joints.slice(3 * j, 3 * j + 3);
 };
 const distance = (a: number[], b: number[]) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+const wristSlider = (i: number) => page.locator(`input[data-wrist="${i}"]`);
+const wristSliders = () => page.locator('input[data-wrist]').evaluateAll((inputs) => inputs.map((i) => (i as HTMLInputElement).value));
+/** Predicate: the engine reports the rest wrist (the built-in hand's: at the origin, unrotated). */
+const REST_WRIST = 's.frame.wrist.every((v, i) => Math.abs(v - (i === 6 ? 1 : 0)) < 1e-6)';
+/** Puts the wrist back at rest after the current test, passed or failed (the later tests' pixels expect it). */
+const restWristAfterTest = () =>
+  onTestFinished(async () => {
+    await send({ type: 'rest' });
+    await waitState(page, REST_WRIST);
+  });
+
+/** Stops the server, runs `whileDown` once the page has noticed, restarts it on the same port and waits for the new session's frames. */
+async function restartServer(whileDown = async () => {}) {
+  const port = server.port;
+  await server.stop();
+  await waitState(page, '!s.connected');
+  await whileDown();
+  server = await startServer({ port });
+  const before = (await state()).framesReceived;
+  await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
+}
 
 beforeAll(async () => {
   server = await startServer();
@@ -78,6 +102,32 @@ describe('the viewer page', () => {
     for (const f of ['thumb', 'middle-finger', 'ring-finger', 'pinky-finger']) {
       expect(distance(tip(before, f), tip(after, f))).toBeLessThan(1e-5);
     }
+  });
+
+  test('the wrist sliders show the engine\'s wrist, in its Euler convention', async () => {
+    restWristAfterTest();
+    await send({ type: 'wrist', translation: [0.02, -0.035, 0.1], rotation_deg: [20, -30, 40] });
+    await waitState(page, 'Math.abs(s.frame.wrist[2] - 0.1) < 1e-4');
+    await settle(page); // the page moves its sliders on its next animation frame
+    expect(await wristSliders()).toEqual(['2', '-3.5', '10', '20', '-30', '40']);
+  });
+
+  test('after Rest, touching a wrist slider does not bring the old wrist back', async () => {
+    restWristAfterTest();
+    await wristSlider(0).fill('5');
+    await waitState(page, 'Math.abs(s.frame.wrist[0] - 0.05) < 1e-4');
+    await settle(page);
+    await wristSlider(5).fill('40');
+    await waitState(page, 'Math.abs(s.frame.wrist[5]) > 0.3');
+    await page.click('#rest');
+    await waitState(page, REST_WRIST);
+    await settle(page);
+    await wristSlider(1).fill('3');
+    await waitState(page, 'Math.abs(s.frame.wrist[1] - 0.03) < 1e-4');
+    const rest = [0, 0.03, 0, 0, 0, 0, 1]; // the rest wrist, moved by the touched slider only
+    expect((await state()).frame!.wrist).toEqual(rest.map((v) => expect.closeTo(v, 5)));
+    await settle(page);
+    expect(await wristSliders()).toEqual(['0', '3', '0', '0', '0', '0']);
   });
 
   test('switching the method changes the rendered hand', async () => {
@@ -138,12 +188,16 @@ describe('the viewer page', () => {
   });
 
   test('the page reconnects after the server restarts, with its settings', async () => {
-    const port = server.port;
-    await server.stop();
-    await waitState(page, '!s.connected');
-    expect(await page.locator('#status').textContent()).toMatch(/reconnecting/);
-    server = await startServer({ port });
-    const before = (await state()).framesReceived;
-    await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
+    await restartServer(async () => expect(await page.locator('#status').textContent()).toMatch(/reconnecting/));
+  });
+
+  test('reconnecting frees the previous session\'s hand geometries', async () => {
+    await page.check('#skeleton'); // bones and joint dots reach the GPU only once drawn
+    await settle(page);
+    const before = (await state()).geometries;
+    for (let k = 0; k < 3; k++) await restartServer();
+    await settle(page);
+    expect((await state()).geometries).toBe(before);
+    await page.uncheck('#skeleton');
   });
 });
