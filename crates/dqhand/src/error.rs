@@ -99,15 +99,6 @@ impl Error {
             other => Error::File { path: path.into(), problem: Box::new(other) },
         }
     }
-
-    /// The error itself, or for [`Error::File`] the problem in the file.
-    #[must_use]
-    pub fn problem(&self) -> &Error {
-        match self {
-            Error::File { problem, .. } => problem.problem(),
-            other => other,
-        }
-    }
 }
 
 /// The library's result type.

@@ -12,7 +12,8 @@
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
 //! * [`gesture`] — the gesture library and pose sequences;
-//! * [`engine`] — one step of Figure 1: pose → kinematics → skin (→ collision → interaction);
+//! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
+//!   join in later issues);
 //! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
 //! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!

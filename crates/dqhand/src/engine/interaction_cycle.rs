@@ -1,6 +1,6 @@
 //! One interaction cycle of the paper's Figure 1: a pose drives the kinematics layer, whose
-//! bone transforms drive the skin layer (and, with the manipulation loop, the collision
-//! layer).
+//! bone transforms drive the skin layer (the collision layer and the interaction loops join
+//! here in later issues).
 
 use std::sync::Arc;
 
@@ -17,7 +17,8 @@ use crate::Result;
 /// [`Self::step`] is Figure 1 in code: pose → kinematics (local transforms, forward
 /// kinematics, one skinning transform per bone, each computed once) → skin (each method in
 /// [`Self::methods`]). The two stages are also public, [`Self::pose`] and [`Self::skin`], for
-/// callers that time or measure one of them. Nothing here allocates after construction.
+/// callers that time or measure one of them. `step`, `pose`, `pose_locals` and `skin`
+/// allocate nothing; a new engine holds the rest pose.
 #[derive(Clone, Debug)]
 pub struct Engine {
     model: Arc<Model>,
@@ -41,7 +42,7 @@ impl Engine {
     pub fn new(model: Arc<Model>) -> Self {
         let skeleton = &model.skeleton;
         let n = skeleton.len();
-        Self {
+        let mut engine = Self {
             rig: None,
             limits: Limits::Anatomical,
             methods: MethodSet::DQB,
@@ -51,7 +52,9 @@ impl Engine {
             deformers: Method::ALL.map(|m| Deformer::new(m, &model.mesh)),
             deformed: Method::ALL.map(|_| Deformed::new(&model.mesh)),
             model,
-        }
+        };
+        engine.forward();
+        engine
     }
 
     /// An engine that poses joint angles of `joint_model` ([`Self::pose`]) on the anatomical
@@ -83,7 +86,10 @@ impl Engine {
     /// # Errors
     /// As [`HandRig::new`]; the engine is unchanged then.
     pub fn set_joint_model(&mut self, joint_model: JointModel) -> Result<()> {
-        self.rig = Some(HandRig::new(&self.model.skeleton, joint_model)?);
+        let rig = HandRig::new(&self.model.skeleton, joint_model)?;
+        self.locals = rig.skeleton().rest_locals();
+        self.rig = Some(rig);
+        self.forward();
         Ok(())
     }
 
@@ -188,6 +194,7 @@ impl Engine {
                 warnings
             }
             PoseTarget::LocalRotations(rotations) => {
+                assert!(self.rig.is_none(), "local rotations pose the model's own skeleton: an engine without a joint model");
                 let mut locals = self.model.skeleton.rest_locals();
                 for &(j, q) in rotations {
                     locals[j].rotation = q;

@@ -24,7 +24,7 @@ pub struct Sequence {
     keys: Vec<Keyframe>,
 }
 
-/// How long the bundled tour holds each gesture, and how long it takes to reach the next.
+/// How long the bundled gesture sequence holds each gesture, and how long it takes to reach the next.
 const HOLD_SECONDS: f32 = 0.8;
 const MOVE_SECONDS: f32 = 0.7;
 

@@ -116,15 +116,21 @@ fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
 
     // Joints outside the skin (ancestors of its joints) deform nothing, but the bind pose
     // must place them too: they keep their rest offset from their parent's bind pose.
+    let mut in_skin = vec![false; skeleton.len()];
+    skin_joints.iter().for_each(|&j| in_skin[j] = true);
     let mut bind_world = vec![Affine3A::IDENTITY; skeleton.len()];
     for &j in skeleton.order() {
         let joint = &skeleton.joints()[j];
-        bind_world[j] = if skin_joints.contains(&j) {
-            inverse_bind[j].inverse()
+        if in_skin[j] {
+            let det = inverse_bind[j].matrix3.determinant();
+            if !inverse_bind[j].is_finite() || det.abs() < 1e-12 {
+                return Err(bad(format!("inverse bind matrix of joint {:?} is not invertible (determinant {det})", joint.name)));
+            }
+            bind_world[j] = inverse_bind[j].inverse();
         } else {
-            joint.parent.map_or(Affine3A::IDENTITY, |p| bind_world[p]) * joint.rest.to_affine()
-        };
-        inverse_bind[j] = bind_world[j].inverse();
+            bind_world[j] = joint.parent.map_or(Affine3A::IDENTITY, |p| bind_world[p]) * joint.rest.to_affine();
+            inverse_bind[j] = bind_world[j].inverse();
+        }
     }
     let mut data = MeshData { inverse_bind, ..MeshData::default() };
     let mut stride = 0;

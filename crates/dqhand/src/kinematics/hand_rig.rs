@@ -35,6 +35,8 @@ pub struct HandRig {
     model: JointModel,
     dofs: Vec<RigDof>,
     wrist: usize,
+    /// The wrist's rest world pose.
+    rest_wrist: DualQuat,
     /// Inverse rest world transform of the wrist's parent (fixed: only the wrist and below
     /// move), which turns a world wrist pose into a local one.
     wrist_parent_inverse: Affine3A,
@@ -52,7 +54,8 @@ impl HandRig {
     ///
     /// # Errors
     /// [`Error::MissingJoint`] if a joint the model needs is missing, [`Error::JointFrame`]
-    /// if a moving joint's −Z axis is more than 45° from its bone.
+    /// if a moving joint's −Z axis is more than 45° from its bone, [`Error::Skeleton`] if
+    /// re-parenting makes a cycle.
     pub fn new(skeleton: &Skeleton, model: JointModel) -> Result<Self> {
         let nearest_parent = |name: &str| {
             let mut parent = webxr::anatomical_parent(name);
@@ -89,7 +92,9 @@ impl HandRig {
             dofs.push(RigDof { joint, axis, min: d.min_deg.to_radians(), max: d.max_deg.to_radians() });
         }
         let wrist_parent_inverse = skeleton.joints()[wrist].parent.map_or(Affine3A::IDENTITY, |p| world[p].inverse());
-        Ok(Self { skeleton, model, dofs, wrist, wrist_parent_inverse })
+        let (_, rotation, translation) = world[wrist].to_scale_rotation_translation();
+        let rest_wrist = DualQuat::from_rotation_translation(rotation.normalize(), translation);
+        Ok(Self { skeleton, model, dofs, wrist, rest_wrist, wrist_parent_inverse })
     }
 
     /// The anatomical skeleton the rig poses (same joint indices as the input skeleton).
@@ -107,8 +112,7 @@ impl HandRig {
     /// The wrist's world pose at rest: what a pose without a wrist is posed with.
     #[must_use]
     pub fn rest_wrist(&self) -> DualQuat {
-        let (_, rotation, translation) = self.skeleton.rest_world()[self.wrist].to_scale_rotation_translation();
-        DualQuat::from_rotation_translation(rotation.normalize(), translation)
+        self.rest_wrist
     }
 
     /// Clamps the pose's angles to the anatomical ranges; returns the indices of the DOFs that

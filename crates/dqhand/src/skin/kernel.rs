@@ -119,7 +119,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
         let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
         let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
         let ps: &[[u32; K]; LANES] = all_ps[base..base + LANES].try_into().unwrap();
-        blend::<W, K, AVX>(frame, B::SIGNED, usize::from(kc), Slots { js, ws, ps }, &mut b);
+        blend::<W, K, B, AVX>(frame, usize::from(kc), Slots { js, ws, ps }, &mut b);
         for c in 0..3 {
             rest.p[c] = lanes(&mesh.pos[c], base);
             rest.n[c] = lanes(&mesh.nrm[c], base);
@@ -142,20 +142,21 @@ pub(crate) struct Slots<'a, const K: usize> {
 
 /// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]` over the
 /// first `kc` influence slots (the chunk's largest influence count), the sign `sₗₖ` applied
-/// to the first `signed` components only (1 for the rest).
+/// to the first `B::SIGNED` components only (1 for the rest), a constant of each method.
 ///
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, const AVX: bool>(frame: &Frame<'_, W>, signed: usize, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
+fn blend<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
         // joint indices are in bounds (see `chunks`).
-        unsafe { avx2::blend::<W, K>(frame, signed, kc, slots, b) };
+        unsafe { avx2::blend::<W, K, B>(frame, kc, slots, b) };
         return;
     }
     let Slots { js, ws, ps } = slots;
+    let signed = B::SIGNED;
     let mut acc = [[0.0f32; W]; LANES];
     for (l, acc) in acc.iter_mut().enumerate() {
         for k in 0..kc.min(K) {
@@ -209,19 +210,19 @@ mod avx2 {
 
     use core::arch::x86_64::*;
 
-    use super::{Frame, Lanes, Slots, LANES};
+    use super::{Blend, Frame, Lanes, Slots, LANES};
 
     /// As the portable `blend`, for `W` = 8 or 16.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn blend<const W: usize, const K: usize>(
+    pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         frame: &Frame<'_, W>,
-        signed: usize,
         kc: usize,
         slots: Slots<'_, K>,
         b: &mut [Lanes; W],
     ) {
         const { assert!(W == 8 || W == 16) };
         let Slots { js, ws, ps } = slots;
+        let signed = B::SIGNED;
         let mut rows = [[_mm256_setzero_ps(); LANES]; 2];
         // Per block of eight parameters, which take the signed weight: all, none, or the
         // first few (QB's rotation), picked by a lane mask.

@@ -59,7 +59,8 @@ impl Session {
     /// bundled gesture sequence.
     ///
     /// # Errors
-    /// [`Error::MissingJoint`] if the model's skeleton lacks the WebXR hand joints.
+    /// As [`Engine::with_joint_model`]: [`Error::MissingJoint`] if the model's skeleton lacks
+    /// the WebXR hand joints, [`Error::JointFrame`] if its joint frames are not WebXR's.
     pub fn new(model: Arc<Model>, joint_model: JointModel) -> Result<Self> {
         let mesh = &model.mesh;
         let n = mesh.vertex_count();
