@@ -111,7 +111,7 @@ function slider(label: string, min: number, max: number, step: number, onInput: 
 let dofInputs: (HTMLInputElement | null)[] = [];
 /** The wrist sliders, in `WRIST_SLIDERS`' order (built once, with the first hello). */
 let wristInputs: HTMLInputElement[] = [];
-/** The wrist slider values of the latest frame (scratch, per animation frame). */
+/** The wrist of the latest frame as slider values, exactly (updated per animation frame). */
 const _wrist = [0, 0, 0, 0, 0, 0];
 
 function buildSliders(h: Hello): void {
@@ -132,9 +132,14 @@ function buildSliders(h: Hello): void {
   $('sliders').replaceChildren(...groups);
   dofInputs = h.dofs.map((d) => $('sliders').querySelector<HTMLInputElement>(`input[data-dof="${d.name}"]`));
   if (wristInputs.length === 0) {
-    // All six as shown: the others show the engine's wrist (a Rest, a gesture, another page).
-    const send = () => connection.send(wristCommand(wristInputs.map((input) => Number(input.value))));
-    $('wrist').append(...WRIST_SLIDERS.map(({ label, min, max, step }, i) => slider(label, min, max, step, send, { wrist: String(i) })));
+    // The touched slider's value, and the engine's own wrist (the latest frame's, exactly, not
+    // as the other sliders round or clamp it) for the other five.
+    const send = (i: number) => (value: number) => {
+      const values = [..._wrist];
+      values[i] = value;
+      connection.send(wristCommand(values));
+    };
+    $('wrist').append(...WRIST_SLIDERS.map(({ label, min, max, step }, i) => slider(label, min, max, step, send(i), { wrist: String(i) })));
     wristInputs = Array.from($('wrist').querySelectorAll('input'));
   }
 }

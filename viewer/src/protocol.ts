@@ -28,7 +28,7 @@ export interface FrameHeader {
   duration: number;
   playing: boolean;
   limits: boolean;
-  /** Translation xyz (m), rotation xyzw. */
+  /** World translation xyz (m), rotation xyzw: the pose's wrist, or the rig's rest wrist when none is set. */
   wrist: Float32Array;
 }
 

@@ -23,8 +23,8 @@ const _quaternion = new THREE.Quaternion();
 const _euler = new THREE.Euler();
 
 /**
- * The slider values of a frame's wrist (translation xyz in m, rotation quaternion xyzw), each
- * rounded to its slider's step, written into `out`.
+ * The slider values of a frame's wrist (translation xyz in m, rotation quaternion xyzw),
+ * exactly (a slider snaps what it shows to its step), written into `out`.
  */
 export function wristSliderValues(wrist: Float32Array, out: number[]): number[] {
   _euler.setFromQuaternion(_quaternion.fromArray(wrist, 3), ORDER);
@@ -34,7 +34,6 @@ export function wristSliderValues(wrist: Float32Array, out: number[]): number[] 
   out[3] = THREE.MathUtils.radToDeg(_euler.x);
   out[4] = THREE.MathUtils.radToDeg(_euler.y);
   out[5] = THREE.MathUtils.radToDeg(_euler.z);
-  for (let i = 0; i < WRIST_SLIDERS.length; i++) out[i] = Math.round(out[i] / WRIST_SLIDERS[i].step) * WRIST_SLIDERS[i].step;
   return out;
 }
 

@@ -66,7 +66,10 @@ pub enum Error {
     /// No skin lies around a joint whose region is measured.
     #[error("joint {0:?}: no skin around it to measure")]
     NoSkin(String),
-    /// A viewer command has a value out of range or a repeated method.
+    /// A list of skinning methods is empty, longer than three, or repeats one.
+    #[error("{0}")]
+    Methods(String),
+    /// A viewer command has a value out of range.
     #[error("{0}")]
     Command(String),
     /// A message of the viewer stream's binary format is malformed.

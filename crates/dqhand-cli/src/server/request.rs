@@ -65,8 +65,8 @@ impl Request {
         }
     }
 
-    /// Checks that the `Host` header names this machine when the server listens on loopback
-    /// only: a page of another site whose name an attacker re-points at 127.0.0.1 (DNS
+    /// Checks that there is a `Host` header (HTTP/1.1 requires one: 400 otherwise) and that
+    /// it names this machine when the server listens on loopback only: a page of another site whose name an attacker re-points at 127.0.0.1 (DNS
     /// rebinding) sends its own name as `Host`, and is refused here, beside the `Origin`
     /// check of the WebSocket upgrade.
     pub fn check_host(&self, loopback_only: bool) -> Result<(), Refusal> {
@@ -99,7 +99,7 @@ impl Request {
             return Err(refuse(426, "WebSocket version 13 is required"));
         }
         if let Some(origin) = self.header("origin") {
-            let host = self.header("host").unwrap_or("");
+            let host = self.header("host").unwrap_or_default();
             let origin_host = origin.split_once("://").map_or(origin, |(_, h)| h);
             if !origin_host.eq_ignore_ascii_case(host) {
                 return Err(refuse(403, format!("origin {origin} is not this server ({host})")));
@@ -138,9 +138,18 @@ pub fn respond(mut stream: &TcpStream, status: u16, content_type: &str, body: &[
 
 /// Whether a `Host` value (`name[:port]`, `[v6][:port]`) names a loopback address.
 fn is_loopback_host(host: &str) -> bool {
+    let port = |p: &str| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit());
     let name = match host.strip_prefix('[') {
-        Some(v6) => v6.split_once(']').map_or("", |(a, _)| a),
-        None => host.rsplit_once(':').filter(|(_, port)| port.bytes().all(|b| b.is_ascii_digit())).map_or(host, |(n, _)| n),
+        Some(v6) => match v6.split_once(']') {
+            Some((address, "")) => address,
+            Some((address, rest)) if rest.strip_prefix(':').is_some_and(port) => address,
+            _ => return false,
+        },
+        None => match host.rsplit_once(':') {
+            Some((name, p)) if port(p) => name,
+            Some(_) => return false,
+            None => host,
+        },
     };
     name.eq_ignore_ascii_case("localhost") || name.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback())
 }
@@ -154,7 +163,7 @@ mod tests {
         for ok in ["127.0.0.1:8080", "127.0.0.1", "localhost:8080", "LOCALHOST", "[::1]:8080", "[::1]", "127.1.2.3:1"] {
             assert!(is_loopback_host(ok), "{ok}");
         }
-        for bad in ["evil.example:8080", "evil.example", "10.0.0.1:8080", "[::2]:80", "localhost.evil.example", "127.0.0.1.evil.example", "", "[::1"] {
+        for bad in ["evil.example:8080", "evil.example", "10.0.0.1:8080", "[::2]:80", "localhost.evil.example", "127.0.0.1.evil.example", "", "[::1", "[::1]junk", "[::1]:", "localhost:80x"] {
             assert!(!is_loopback_host(bad), "{bad}");
         }
     }

@@ -18,7 +18,7 @@ use crate::Result;
 /// kinematics, one skinning transform per bone, each computed once) → skin (each method in
 /// [`Self::methods`]). The two stages are also public, [`Self::pose`] and [`Self::skin`], for
 /// callers that time or measure one of them. `step`, `pose`, `pose_locals` and `skin`
-/// allocate nothing; a new engine holds the rest pose.
+/// allocate nothing; a new engine holds the rest pose, skinned with every method.
 #[derive(Clone, Debug)]
 pub struct Engine {
     model: Arc<Model>,
@@ -54,6 +54,9 @@ impl Engine {
             model,
         };
         engine.forward();
+        for m in Method::ALL {
+            engine.skin(m);
+        }
         engine
     }
 

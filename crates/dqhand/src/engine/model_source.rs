@@ -40,7 +40,8 @@ impl core::str::FromStr for ModelSource {
 impl core::fmt::Display for ModelSource {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            ModelSource::Builtin(_) => f.write_str("builtin"),
+            ModelSource::Builtin(p) if *p == HandParams::default() => f.write_str("builtin"),
+            ModelSource::Builtin(p) => write!(f, "builtin ({} hand, {} m by {} m, {} vertices)", p.side.name(), p.length, p.breadth, p.vertices),
             ModelSource::File(path) => write!(f, "{}", path.display()),
         }
     }

@@ -21,6 +21,7 @@ impl Gesture {
     /// (every name is a DOF of the `full` model: [`Self::check`]).
     #[must_use]
     pub fn pose(&self, model: JointModel) -> Pose {
+        debug_assert!(self.check().is_ok(), "gesture {:?} names a DOF no joint model has", self.name);
         let mut pose = Pose::rest(model.dof_count());
         for &(name, deg) in self.angles_deg.iter().copied().flatten() {
             if let Ok(i) = model.dof_index(name) {

@@ -7,7 +7,7 @@ use crate::{Error, Result};
 ///
 /// A gap or a repeat cannot be represented, so whatever holds one (a viewer's view, a frame
 /// header) always describes 1–3 meshes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug)]
 pub struct MethodSet {
     methods: [Method; 3],
     len: u8,
@@ -22,15 +22,15 @@ impl MethodSet {
     /// The methods given, in that order.
     ///
     /// # Errors
-    /// [`Error::Command`] if there are none, more than three, or one is repeated.
+    /// [`Error::Methods`] if there are none, more than three, or one is repeated.
     pub fn new(methods: &[Method]) -> Result<Self> {
         if methods.is_empty() || methods.len() > 3 {
-            return Err(Error::Command(format!("view: {} methods (1 to 3)", methods.len())));
+            return Err(Error::Methods(format!("{} methods (1 to 3)", methods.len())));
         }
         let mut set = Self { methods: [methods[0]; 3], len: 0 };
         for &m in methods {
             if set.contains(m) {
-                return Err(Error::Command(format!("view: method {:?} given twice", m.as_str())));
+                return Err(Error::Methods(format!("method {:?} given twice", m.as_str())));
             }
             set.methods[usize::from(set.len)] = m;
             set.len += 1;
@@ -43,14 +43,8 @@ impl MethodSet {
     /// # Errors
     /// [`Error::UnknownName`] for a name that is no method, else as [`Self::new`].
     pub fn parse<S: AsRef<str>>(names: &[S]) -> Result<Self> {
-        let mut methods = [Method::Dqb; 3];
-        if names.len() > 3 {
-            return Err(Error::Command(format!("view: {} methods (1 to 3)", names.len())));
-        }
-        for (m, name) in methods.iter_mut().zip(names) {
-            *m = name.as_ref().parse()?;
-        }
-        Self::new(&methods[..names.len()])
+        let methods: Vec<Method> = names.iter().map(|n| n.as_ref().parse()).collect::<Result<_>>()?;
+        Self::new(&methods)
     }
 
     /// The methods, in order.
@@ -75,6 +69,21 @@ impl MethodSet {
     #[must_use]
     pub fn contains(&self, method: Method) -> bool {
         self.as_slice().contains(&method)
+    }
+}
+
+/// Two sets are equal when they list the same methods in the same order.
+impl PartialEq for MethodSet {
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
+    }
+}
+
+impl Eq for MethodSet {}
+
+impl core::hash::Hash for MethodSet {
+    fn hash<H: core::hash::Hasher>(&self, state: &mut H) {
+        self.as_slice().hash(state);
     }
 }
 

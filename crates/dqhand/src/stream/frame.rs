@@ -16,7 +16,7 @@
 //! 28 f32 engine time of this frame (pose + skin + distortion), µs
 //! 32 f32 frames per second the engine is sending   36 f32 timeline time, s
 //! 40 f32 timeline duration, s (0: no timeline)     44 u32 state (bit 0: playing; bit 1: limits on)
-//! 48 f32 wrist translation xyz, rotation xyzw
+//! 48 f32 wrist translation xyz, rotation xyzw (world; the rig's rest wrist when none is set)
 //! 76 f32 angles[DOF count] (radians)   then f32 joint positions[3 · joint count] (world)
 //!    then per mesh: f32 positions[3 · vertex count], f32 normals[3 · vertex count],
 //!                   (flag 0) f32 distortion[vertex count]
@@ -69,7 +69,8 @@ pub struct FrameHeader {
     pub duration: f32,
     /// [`STATE_PLAYING`] | [`STATE_LIMITS`].
     pub state: u32,
-    /// Wrist translation (m) and rotation `[x, y, z, w]`.
+    /// Wrist translation (m) and rotation `[x, y, z, w]` in world space: the pose's wrist,
+    /// or the rig's rest wrist when the pose has none.
     pub wrist: [f32; 7],
 }
 

@@ -84,15 +84,11 @@ impl Session {
         })
     }
 
-    fn joint_model_now(&self) -> JointModel {
-        self.engine.rig().expect("a session's engine has a joint model").model()
-    }
-
     /// The JSON greeting: the model, the DOFs with their ranges, the gestures, sequences and
     /// methods the page can ask for.
     #[must_use]
     pub fn hello(&self, max_message_bytes: usize) -> String {
-        let model = self.joint_model_now();
+        let model = self.joint_model();
         let (description, mesh) = (&self.engine.model().description, &self.engine.model().mesh);
         let dofs: Vec<_> = model
             .dofs()
@@ -136,7 +132,7 @@ impl Session {
     /// The joint model of the pose.
     #[must_use]
     pub fn joint_model(&self) -> JointModel {
-        self.joint_model_now()
+        self.engine.rig().expect("a session's engine has a joint model").model()
     }
 
     /// Applies one command from the page. Acks are the transport's business and change
@@ -148,17 +144,23 @@ impl Session {
     pub fn apply(&mut self, command: &Command) -> Result<Applied> {
         match command {
             Command::Ack { .. } => {}
-            Command::View { methods } => self.engine.set_methods(MethodSet::parse(methods)?),
+            Command::View { methods } => {
+                let set = MethodSet::parse(methods).map_err(|e| match e {
+                    Error::Methods(why) => Error::Command(format!("view: {why}")),
+                    other => other,
+                })?;
+                self.engine.set_methods(set);
+            }
             Command::JointModel { name } => {
                 let model: JointModel = name.parse()?;
-                if model != self.joint_model_now() {
+                if model != self.joint_model() {
                     self.set_joint_model(model)?;
                     return Ok(Applied::Hello);
                 }
             }
             Command::Angle { dof, deg } => {
-                let i = self.joint_model_now().dof_index(dof)?;
-                let d = self.joint_model_now().dofs().nth(i).expect("index from the model");
+                let i = self.joint_model().dof_index(dof)?;
+                let d = self.joint_model().dofs().nth(i).expect("index from the model");
                 let (lo, hi) = match self.engine.limits() {
                     Limits::Anatomical => (d.min_deg, d.max_deg),
                     Limits::Off => (-180.0, 180.0),
@@ -183,7 +185,7 @@ impl Session {
                     return Err(Error::Command(format!("gesture: {seconds} seconds (0 to 10)")));
                 }
                 self.stop();
-                let model = self.joint_model_now();
+                let model = self.joint_model();
                 let mut to = g.pose(model);
                 to.wrist = self.wrist;
                 self.transition = Some((Sequence::transition(model, &self.pose, to, seconds), 0.0));
@@ -207,7 +209,7 @@ impl Session {
             Command::Rest => {
                 self.stop();
                 self.wrist = None;
-                self.pose = Pose::rest(self.joint_model_now().dof_count());
+                self.pose = Pose::rest(self.joint_model().dof_count());
             }
         }
         Ok(Applied::Frame)
@@ -219,7 +221,7 @@ impl Session {
     }
 
     fn set_joint_model(&mut self, model: JointModel) -> Result<()> {
-        let old = self.joint_model_now();
+        let old = self.joint_model();
         self.engine.set_joint_model(model)?;
         let mut pose = Pose::rest(model.dof_count());
         for (d, a) in old.dofs().zip(&self.pose.angles) {
