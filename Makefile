@@ -10,7 +10,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench clean
+.PHONY: demo test build viewer assets chromium figures bench fuzz clean
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -53,6 +53,23 @@ test: assets viewer chromium
 # docs/figures/*.png: the paper's Figures 5-7 on our hand, rendered by the real page.
 figures: build viewer chromium
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/release/dqhand CHROMIUM=$(CHROMIUM) node scripts/figures.mjs
+
+# Coverage-guided fuzzing of every parser (nightly toolchain + cargo-fuzz), FUZZ_SECONDS each:
+# the stream's frame and topology readers, viewer commands on a live session, pose files, glTF
+# import. Seeds: fuzz/seeds, the wire-format golden vectors, the WebXR generic hand. Without a
+# sanitizer: the library is safe Rust apart from the AVX2 kernel (checked against a reference
+# by the tests), and AddressSanitizer makes building the hand the targets pose too slow.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := frame command pose_file gltf
+
+fuzz: assets
+	command -v cargo-fuzz >/dev/null || $(CARGO) install cargo-fuzz --locked
+	for t in $(FUZZ_TARGETS); do mkdir -p fuzz/corpus/$$t; done
+	cp viewer/tests/fixtures/*.bin fuzz/corpus/frame/
+	cp fuzz/seeds/command/* fuzz/corpus/command/
+	cp fuzz/seeds/pose_file/* fuzz/corpus/pose_file/
+	cp $(WEBXR_HAND) fuzz/corpus/gltf/
+	for t in $(FUZZ_TARGETS); do $(CARGO) +nightly fuzz run --sanitizer none $$t fuzz/corpus/$$t -- -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=4096 || exit 1; done
 
 bench: build
 	./target/release/dqhand bench

@@ -90,11 +90,14 @@ export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
   return magic === FRAME_MAGIC ? 'frame' : magic === TOPOLOGY_MAGIC ? 'topology' : null;
 }
 
-function checkStart(view: DataView, magic: number, what: string): number {
+/** Checks magic and version and returns the flags; bits other than `known` are refused (a later version may use them to change the layout). */
+function checkStart(view: DataView, magic: number, what: string, known: number): number {
   if (view.byteLength < 8 || view.getUint32(0, true) !== magic) throw new ProtocolError(`not a ${what} (wrong magic)`);
   const version = view.getUint16(4, true);
   if (version !== VERSION) throw new ProtocolError(`${what} version ${version}, this page knows ${VERSION}`);
-  return view.getUint16(6, true);
+  const flags = view.getUint16(6, true);
+  if ((flags & ~known) !== 0) throw new ProtocolError(`${what} flags ${flags}: bits ${flags & ~known} are unknown to version ${VERSION}`);
+  return flags;
 }
 
 /** Bytes a frame with this header occupies. */
@@ -103,10 +106,13 @@ export function frameByteLength(h: Pick<FrameHeader, 'vertexCount' | 'jointCount
   return FRAME_HEADER_BYTES + 4 * (h.dofCount + 3 * h.jointCount + h.methods.length * perMesh);
 }
 
+/** Method code of a mesh slot a frame does not use. */
+const UNUSED_METHOD = 255;
+
 export function decodeFrame(buffer: ArrayBuffer): Frame {
   const view = new DataView(buffer);
   if (buffer.byteLength < FRAME_HEADER_BYTES) throw new ProtocolError(`frame of ${buffer.byteLength} bytes is truncated`);
-  const flags = checkStart(view, FRAME_MAGIC, 'frame');
+  const flags = checkStart(view, FRAME_MAGIC, 'frame', FLAG_DISTORTION);
   const meshCount = view.getUint8(24);
   if (meshCount < 1 || meshCount > 3) throw new ProtocolError(`${meshCount} meshes (1 to 3)`);
   const methods: Method[] = [];
@@ -114,7 +120,12 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
     const code = view.getUint8(25 + i);
     const m = METHODS[code];
     if (m === undefined) throw new ProtocolError(`mesh ${i}: method code ${code}`);
+    if (methods.includes(m)) throw new ProtocolError(`method "${m}" given twice`);
     methods.push(m);
+  }
+  for (let i = meshCount; i < 3; i++) {
+    const code = view.getUint8(25 + i);
+    if (code !== UNUSED_METHOD) throw new ProtocolError(`mesh ${i}: method code ${code} with ${meshCount} meshes`);
   }
   const state = view.getUint32(44, true);
   const header: FrameHeader = {
@@ -154,7 +165,7 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
 
 export function decodeTopology(buffer: ArrayBuffer): Topology {
   const view = new DataView(buffer);
-  checkStart(view, TOPOLOGY_MAGIC, 'topology');
+  checkStart(view, TOPOLOGY_MAGIC, 'topology', 0);
   if (buffer.byteLength < TOPOLOGY_HEADER_BYTES) throw new ProtocolError('topology truncated');
   const vertexCount = view.getUint32(8, true);
   const indexCount = view.getUint32(12, true);

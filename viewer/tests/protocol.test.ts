@@ -41,6 +41,9 @@ describe('frame', () => {
       [variant((b) => ((b[4] = 9), b)), /version 9/],
       [variant((b) => ((b[26] = 7), b)), /method code 7/],
       [variant((b) => ((b[24] = 0), b)), /0 meshes/],
+      [variant((b) => ((b[7] = 1), b)), /unknown to version 1/],
+      [variant((b) => ((b[26] = b[25]), b)), /given twice/],
+      [variant((b) => ((b[27] = 0), b)), /method code 0 with 2 meshes/],
     ];
     for (const [b, message] of cases) expect(() => decodeFrame(b)).toThrow(message);
     expect(() => decodeFrame(buffer.slice(0, 20))).toThrow(ProtocolError);

@@ -837,3 +837,28 @@ fn proxies_and_joint_regions_are_fitted_in_bind_space_when_the_node_pose_differs
     assert_eq!(a.vertices, b.vertices);
     assert_close!(a.radius, b.radius, 1e-5);
 }
+
+/// Found by fuzzing: a primitive whose POSITION names a missing accessor made the `gltf`
+/// crate's validation index out of bounds and panic; it is an error naming the file.
+#[test]
+fn a_primitive_with_a_missing_accessor_is_an_error_not_a_panic() {
+    for (name, json) in [
+        ("position", r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5}}]}],"nodes":[{"mesh":0}]}"#),
+        ("indices", r#"{"asset":{"version":"2.0"},"accessors":[],"meshes":[{"primitives":[{"attributes":{},"indices":0}]}]}"#),
+    ] {
+        let e = io::load_gltf_slice(json.as_bytes(), Path::new("broken.gltf")).unwrap_err().to_string();
+        assert!(e.starts_with("broken.gltf: mesh 0 primitive 0: ") && e.contains("uses accessor"), "{name}: {e}");
+    }
+}
+
+/// Found by fuzzing: a GLB header declaring fewer bytes than the header itself overflowed a
+/// subtraction in the `gltf` crate (a panic in debug builds); it is an error naming the file.
+#[test]
+fn a_glb_declaring_less_than_its_header_is_an_error_not_a_panic() {
+    let mut glb = b"glTF".to_vec();
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(0u32.to_le_bytes());
+    glb.extend(b"\x10\0\0\0JSON{\"asset\":{}}  ");
+    let e = io::load_gltf_slice(&glb, Path::new("short.glb")).unwrap_err().to_string();
+    assert!(e.starts_with("short.glb: GLB header declares 0 bytes"), "{e}");
+}

@@ -113,6 +113,10 @@ fn malformed_messages_are_refused_with_the_reason() {
     let mut repeated = frame.clone();
     repeated[26] = repeated[25];
     refuse(&repeated, "given twice");
+    // Found by fuzzing: flag bits a v1 reader does not know could change the layout.
+    let mut flags = frame.clone();
+    flags[7] = 1;
+    refuse(&flags, "unknown to version 1");
     let mut gap = frame.clone();
     gap[25] = 255;
     refuse(&gap, "method code 255");

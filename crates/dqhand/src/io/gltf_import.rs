@@ -26,17 +26,58 @@ use crate::{Error, Result};
 /// for anything malformed or unsupported (see the module docs).
 pub fn load_gltf(path: &Path) -> Result<Model> {
     let bytes = std::fs::read(path).map_err(Error::io(path))?;
-    load_gltf_bytes(&bytes, path).map_err(|e| e.in_file(path))
+    load_gltf_slice(&bytes, path)
 }
 
-fn load_gltf_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
+/// Loads the first skinned mesh of a glTF 2.0 file already in memory (`.glb` bytes, or
+/// `.gltf` JSON). `path` names the input in errors and is where relative buffer URIs of a
+/// `.gltf` are looked up.
+///
+/// # Errors
+/// As [`load_gltf`], except that reading `path` itself is not attempted.
+pub fn load_gltf_slice(bytes: &[u8], path: &Path) -> Result<Model> {
+    parse(bytes, path).map_err(|e| e.in_file(path))
+}
+
+/// Refuses a mesh primitive whose attribute or index accessor does not exist, before the `gltf`
+/// crate validates the file: gltf-json 1.4 indexes the POSITION accessor unchecked while
+/// validating and would panic (found by fuzzing). JSON that does not parse is left to `gltf`'s
+/// own error.
+fn check_primitive_accessors(bytes: &[u8]) -> Result<()> {
+    let json = match gltf::Glb::from_slice(bytes) {
+        Ok(glb) => glb.json,
+        Err(_) => bytes.into(),
+    };
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(&json) else { return Ok(()) };
+    let accessors = root["accessors"].as_array().map_or(0, Vec::len);
+    for (m, mesh) in root["meshes"].as_array().into_iter().flatten().enumerate() {
+        for (p, primitive) in mesh["primitives"].as_array().into_iter().flatten().enumerate() {
+            let attributes = primitive["attributes"].as_object().into_iter().flatten();
+            let used = attributes.map(|(name, a)| (name.as_str(), a)).chain(primitive.get("indices").map(|i| ("indices", i)));
+            for (name, index) in used {
+                if index.as_u64().is_some_and(|i| i >= accessors as u64) {
+                    return Err(Error::Gltf(format!("mesh {m} primitive {p}: {name} uses accessor {index}, but there are {accessors}")));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     let bad = |m: String| Error::Gltf(m);
     if bytes.len() >= 12 && &bytes[..4] == b"glTF" {
         let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
         if declared > bytes.len() {
             return Err(bad(format!("truncated GLB: {} bytes of the declared {declared}", bytes.len())));
         }
+        // The `gltf` crate subtracts the header from the declared length unchecked (found by
+        // fuzzing: an overflow panic in debug builds).
+        if declared < 12 {
+            return Err(bad(format!("GLB header declares {declared} bytes, less than the 12-byte header itself")));
+        }
     }
+    check_primitive_accessors(bytes)?;
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(&gltf, path)?;
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);

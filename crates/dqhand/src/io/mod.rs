@@ -9,7 +9,7 @@ mod pose_file;
 use std::path::Path;
 
 pub use gltf_export::{write_posed_glb, write_skinned_glb};
-pub use gltf_import::load_gltf;
+pub use gltf_import::{load_gltf, load_gltf_slice};
 pub use obj::write_obj;
 pub use ply::write_ply;
 pub use pose_file::{PoseFile, WristPose};

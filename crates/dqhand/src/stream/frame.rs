@@ -186,7 +186,9 @@ impl Reader<'_> {
         let bytes = self.take(n.checked_mul(4).ok_or_else(|| bad("array too long"))?)?;
         Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect())
     }
-    fn start(&mut self, magic: u32, what: &str) -> Result<u16> {
+    /// Reads magic, version and flags; flag bits other than `known` are refused, since a
+    /// later version may use them to change the layout.
+    fn start(&mut self, magic: u32, what: &str, known: u16) -> Result<u16> {
         if self.u32()? != magic {
             return Err(bad(format!("not a {what} (wrong magic)")));
         }
@@ -194,7 +196,11 @@ impl Reader<'_> {
         if version != VERSION {
             return Err(bad(format!("{what} version {version}, this reader knows {VERSION}")));
         }
-        self.u16()
+        let flags = self.u16()?;
+        if flags & !known != 0 {
+            return Err(bad(format!("{what} flags {flags:#06x}: bits {:#06x} are unknown to version {VERSION}", flags & !known)));
+        }
+        Ok(flags)
     }
     fn end(&self) -> Result<()> {
         if self.at == self.bytes.len() {
@@ -213,7 +219,7 @@ impl FrameView {
     /// does not match the header.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };
-        let flags = r.start(FRAME_MAGIC, "frame")?;
+        let flags = r.start(FRAME_MAGIC, "frame", FLAG_DISTORTION)?;
         let (sequence, vertex_count, joint_count, dof_count) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
         let codes = r.take(4)?;
         let mesh_count = usize::from(codes[0]);
@@ -296,7 +302,7 @@ impl Topology {
     /// range or a parent that is not another joint.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };
-        r.start(TOPOLOGY_MAGIC, "topology")?;
+        r.start(TOPOLOGY_MAGIC, "topology", 0)?;
         let (vertex_count, index_count, joint_count) = (r.u32()?, r.u32()? as usize, r.u32()? as usize);
         let indices = (0..index_count).map(|_| r.u32()).collect::<Result<Vec<_>>>()?;
         if let Some(i) = indices.iter().find(|&&i| i >= vertex_count) {

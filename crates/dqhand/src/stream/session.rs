@@ -14,7 +14,7 @@ use super::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYI
 use super::Command;
 use crate::engine::Engine;
 use crate::gesture::{gesture, Sequence, GESTURES};
-use crate::kinematics::{JointModel, Limits, Pose};
+use crate::kinematics::{HandRig, JointModel, Limits, Pose};
 use crate::math::DualQuat;
 use crate::metrics::VertexDistortion;
 use crate::model::Model;
@@ -40,8 +40,6 @@ pub struct Session {
     pose: Pose,
     /// The wrist set by the user, kept over sequence playback (which leaves the wrist alone).
     wrist: Option<DualQuat>,
-    /// The rig's rest wrist, which a pose without a wrist stands for.
-    rest_wrist: DualQuat,
     heatmap: bool,
     /// One distortion buffer per method, in [`Method::ALL`] order.
     distortion: [Vec<f32>; 3],
@@ -66,11 +64,9 @@ impl Session {
         let n = mesh.vertex_count();
         let vertex_distortion = VertexDistortion::new(&mesh.positions(), mesh.indices());
         let engine = Engine::with_joint_model(model, joint_model)?;
-        let rig = engine.rig().expect("made with a joint model");
         Ok(Self {
             pose: Pose::rest(joint_model.dof_count()),
             wrist: None,
-            rest_wrist: rig.rest_wrist(),
             heatmap: false,
             distortion: Method::ALL.map(|_| vec![0.0; n]),
             vertex_distortion,
@@ -132,7 +128,16 @@ impl Session {
     /// The joint model of the pose.
     #[must_use]
     pub fn joint_model(&self) -> JointModel {
-        self.engine.rig().expect("a session's engine has a joint model").model()
+        self.rig().model()
+    }
+
+    fn rig(&self) -> &HandRig {
+        self.engine.rig().expect("a session's engine has a joint model")
+    }
+
+    /// What a pose without a wrist stands for.
+    fn rest_wrist(&self) -> DualQuat {
+        self.rig().rest_wrist()
     }
 
     /// Applies one command from the page. Acks are the transport's business and change
@@ -238,15 +243,16 @@ impl Session {
     }
 
     fn sample_timeline(&mut self) {
-        self.timeline.sample(self.time, self.rest_wrist, &mut self.pose);
+        self.timeline.sample(self.time, self.rest_wrist(), &mut self.pose);
         self.pose.wrist = self.wrist;
     }
 
     /// Advances the timeline (looping) or the move to a gesture by `dt` seconds.
     pub fn advance(&mut self, dt: f32) {
+        let rest_wrist = self.rest_wrist();
         if let Some((sequence, elapsed)) = &mut self.transition {
             *elapsed += dt;
-            sequence.sample(*elapsed, self.rest_wrist, &mut self.pose);
+            sequence.sample(*elapsed, rest_wrist, &mut self.pose);
             if *elapsed >= sequence.duration() {
                 self.transition = None;
             }
@@ -274,7 +280,7 @@ impl Session {
             *j = w.translation.into();
         }
         let engine_us = start.elapsed().as_secs_f32() * 1e6;
-        let (rotation, translation) = self.pose.wrist.unwrap_or(self.rest_wrist).to_rotation_translation();
+        let (rotation, translation) = self.pose.wrist.unwrap_or(self.rest_wrist()).to_rotation_translation();
         let mut wrist = [0.0; 7];
         wrist[..3].copy_from_slice(&translation.to_array());
         wrist[3..].copy_from_slice(&rotation.to_array());
