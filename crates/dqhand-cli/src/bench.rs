@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::Sequence;
-use dqhand::kinematics::{JointModel, Pose};
+use dqhand::kinematics::{JointModel, Pose, Transform};
 use dqhand::model::Model;
 use dqhand::skin::Method;
 use glam::Quat;
@@ -127,41 +127,47 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 struct Animation {
     engine: Engine,
     name: &'static str,
-    sequence: Option<(Sequence, Pose)>,
-    rest: Vec<dqhand::kinematics::Transform>,
-    locals: Vec<dqhand::kinematics::Transform>,
+    motion: Motion,
+}
+
+/// What moves the hand from frame to frame.
+enum Motion {
+    /// The gesture sequence and the pose sampled from it.
+    Sequence(Sequence, Pose),
+    /// Every joint's rest transform, and the swung transforms written each frame.
+    Swings { rest: Vec<Transform>, locals: Vec<Transform> },
 }
 
 impl Animation {
     fn new(model: Arc<Model>) -> Self {
-        let rest = model.skeleton.rest_locals();
         match Engine::with_joint_model(model.clone(), JointModel::Full) {
             Ok(engine) => Self {
                 engine,
                 name: "the gesture sequence",
-                sequence: Some((Sequence::gestures(JointModel::Full), Pose::rest(JointModel::Full.dof_count()))),
-                locals: rest.clone(),
-                rest,
+                motion: Motion::Sequence(Sequence::gestures(JointModel::Full), Pose::rest(JointModel::Full.dof_count())),
             },
-            Err(_) => Self { engine: Engine::new(model), name: "joint swings", sequence: None, locals: rest.clone(), rest },
+            Err(_) => {
+                let rest = model.skeleton.rest_locals();
+                Self { engine: Engine::new(model), name: "joint swings", motion: Motion::Swings { locals: rest.clone(), rest } }
+            }
         }
     }
 
     /// Poses frame `f` (the kinematics stage, untimed).
     fn pose(&mut self, f: usize) {
-        match &mut self.sequence {
-            Some((sequence, pose)) => {
+        match &mut self.motion {
+            Motion::Sequence(sequence, pose) => {
                 let rest_wrist = self.engine.rig().expect("a joint model").rest_wrist();
                 let time = (f as f32 / 60.0) % sequence.duration();
                 sequence.sample(time, rest_wrist, pose);
                 self.engine.pose(pose);
             }
-            None => {
+            Motion::Swings { rest, locals } => {
                 let a = (f as f32 / 240.0 * std::f32::consts::TAU).sin() * 30f32.to_radians();
-                for (l, r) in self.locals.iter_mut().zip(&self.rest) {
+                for (l, r) in locals.iter_mut().zip(rest.iter()) {
                     l.rotation = r.rotation * Quat::from_rotation_x(a);
                 }
-                self.engine.pose_locals(&self.locals);
+                self.engine.pose_locals(locals);
             }
         }
     }
