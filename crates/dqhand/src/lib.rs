@@ -11,6 +11,7 @@
 //! * [`collision`] — collision proxies per bone (paper 4.2);
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
+//! * [`input`] — records from gloves, trackers and hand tracking, turned into poses;
 //! * [`gesture`] — the gesture library and pose sequences;
 //! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
 //!   join in later issues);
@@ -26,6 +27,7 @@ pub mod engine;
 pub mod geometry;
 pub mod gesture;
 pub mod hand;
+pub mod input;
 pub mod io;
 pub mod kinematics;
 pub mod math;
