@@ -9,13 +9,28 @@ use super::{webxr, JointModel, Motion, Pose, Skeleton, Transform};
 use crate::math::DualQuat;
 use crate::{Error, Result};
 
-/// One resolved degree of freedom.
+/// One degree of freedom resolved on a skeleton: the joint it turns and the axis, in that
+/// joint's frame, it turns about.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct RigDof {
-    joint: usize,
-    axis: Vec3,
-    min: f32,
-    max: f32,
+pub struct RigDof {
+    /// Index of the joint in the rig's skeleton.
+    pub joint: usize,
+    /// Unit rotation axis in the joint's rest frame.
+    pub axis: Vec3,
+    /// Lower limit, radians.
+    pub min: f32,
+    /// Upper limit, radians.
+    pub max: f32,
+}
+
+impl RigDof {
+    /// `rotation` turned by `angle` about this DOF's axis, after the turns before it: the
+    /// one composition rule of posing (`rest · R(abd) · R(flex)`), shared by
+    /// [`HandRig::locals`] and whoever solves angles for a rig.
+    #[must_use]
+    pub fn turn(&self, rotation: Quat, angle: f32) -> Quat {
+        (rotation * Quat::from_axis_angle(self.axis, angle)).normalize()
+    }
 }
 
 /// Whether joint limits are applied when posing.
@@ -115,6 +130,18 @@ impl HandRig {
         self.rest_wrist
     }
 
+    /// The degrees of freedom in the joint model's order, resolved on the skeleton.
+    #[must_use]
+    pub fn dofs(&self) -> &[RigDof] {
+        &self.dofs
+    }
+
+    /// Index of the wrist joint.
+    #[must_use]
+    pub fn wrist(&self) -> usize {
+        self.wrist
+    }
+
     /// Clamps the pose's angles to the anatomical ranges; returns the indices of the DOFs that
     /// were out of range.
     ///
@@ -157,7 +184,7 @@ impl HandRig {
                 Limits::Off => a,
             };
             let l = &mut locals[d.joint];
-            l.rotation = (l.rotation * Quat::from_axis_angle(d.axis, angle)).normalize();
+            l.rotation = d.turn(l.rotation, angle);
         }
     }
 }

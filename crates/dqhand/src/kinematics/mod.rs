@@ -10,7 +10,7 @@ mod transform;
 pub mod webxr;
 
 pub use forward_kinematics::forward_kinematics;
-pub use hand_rig::{HandRig, Limits};
+pub use hand_rig::{HandRig, Limits, RigDof};
 pub use joint_model::{Dof, JointModel, Motion};
 pub use pose::Pose;
 pub use pose_target::PoseTarget;
