@@ -3,8 +3,18 @@
 //! and records turned into poses of the engine step (calibration, retargeting, filtering,
 //! dropouts). One file per format or step.
 
+mod glove_calibration;
+mod glove_csv;
+mod glove_layout;
+mod glove_mapper;
+mod glove_mapping;
 mod record;
 mod rejection;
 
+pub use glove_calibration::{Calibration, SensorCalibration, MIN_HOLD_FRAMES, MIN_MOVEMENT};
+pub use glove_csv::{GloveCsvReader, GloveCsvWriter};
+pub use glove_layout::{GloveLayout, Sensor, SensorKind, RAW_MAX};
+pub use glove_mapper::GloveMapper;
+pub use glove_mapping::{Coupling, MappingEntry, MappingTable};
 pub use record::{GloveSample, HandData, JointSet, Record, RigidPose, TrackedJoint, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 pub use rejection::{RejectKind, Rejection, Rejections};
