@@ -75,6 +75,22 @@ pub enum Error {
     /// A message of the viewer stream's binary format is malformed.
     #[error("stream message: {0}")]
     Frame(String),
+    /// A glove mapping table is invalid: the table's name, then what ([`Error::Glove`] or
+    /// [`Error::UnknownName`] for a DOF or sensor it does not have).
+    #[error("glove table {table:?}: {problem}")]
+    GloveTable {
+        /// The table's name (`glove` field).
+        table: String,
+        /// What is wrong in it; match on it to tell the kinds apart.
+        problem: Box<Error>,
+    },
+    /// Glove data do not fit together: a table's sensors and entries, a glove CSV header.
+    #[error("{0}")]
+    Glove(String),
+    /// A glove calibration is unusable: missing or degenerate sensor extremes, or a
+    /// calibration recording in which sensors never moved.
+    #[error("{0}")]
+    Calibration(String),
     /// A name (joint, DOF, node, method, joint model, gesture) is not known; lists the valid ones.
     #[error("unknown {kind} {name:?}; valid: {valid}")]
     UnknownName {

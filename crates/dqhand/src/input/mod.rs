@@ -3,6 +3,11 @@
 //! and records turned into poses of the engine step (calibration, retargeting, filtering,
 //! dropouts). One file per format or step.
 
+mod glove_calibration;
+mod glove_csv;
+mod glove_layout;
+mod glove_mapper;
+mod glove_mapping;
 pub mod json_record;
 pub mod mediapipe;
 mod one_euro;
@@ -12,6 +17,11 @@ mod rejection;
 mod retarget;
 mod tracker_mount;
 
+pub use glove_calibration::{Calibration, SensorCalibration, MIN_HOLD_FRAMES, MIN_MOVEMENT};
+pub use glove_csv::{GloveCsvReader, GloveCsvWriter};
+pub use glove_layout::{GloveLayout, Sensor, SensorKind, RAW_MAX};
+pub use glove_mapper::GloveMapper;
+pub use glove_mapping::{Coupling, MappingEntry, MappingTable};
 pub use one_euro::{OneEuro, OneEuroParams, OneEuroRotation, OneEuroVec3};
 pub use record::{GloveSample, HandData, JointSet, Record, RigidPose, TrackedJoint, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 pub use rejection::{RejectKind, Rejection, Rejections};
