@@ -69,6 +69,9 @@ pub enum Error {
     /// A list of skinning methods is empty, longer than three, or repeats one.
     #[error("{0}")]
     Methods(String),
+    /// An input configuration (filters, dropouts, tracker mount, gesture commands) is invalid.
+    #[error("input configuration: {0}")]
+    Config(String),
     /// A viewer command has a value out of range.
     #[error("{0}")]
     Command(String),

@@ -1,0 +1,142 @@
+//! The input configuration: filters, dropout handling, the tracker's mounting offset and the
+//! table of gesture commands, one JSON file (`--config`), every field optional.
+//!
+//! ```json
+//! {
+//!   "angle_filter": {"min_cutoff": 1.5, "beta": 1.0, "d_cutoff": 1.0},
+//!   "grace_s": 0.25,
+//!   "actions": [{"gesture": "thumbs_up", "hold_s": 0.5, "action": "next_method"}]
+//! }
+//! ```
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::{MountingOffset, OneEuroParams};
+use crate::{Error, Result};
+
+/// Settings of the input pipeline and of the gesture commands.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct InputConfig {
+    /// Whether records are filtered at all (off: raw retargeted poses).
+    pub filter: bool,
+    /// One Euro filter on each joint angle (radians).
+    pub angle_filter: OneEuroParams,
+    /// One Euro filter on the wrist position (metres).
+    pub position_filter: OneEuroParams,
+    /// One Euro filter on the wrist orientation (on the sphere, radians).
+    pub rotation_filter: OneEuroParams,
+    /// Seconds without a good record before the hand is marked "tracking lost" (it holds its
+    /// last good pose meanwhile).
+    pub grace_s: f64,
+    /// Seconds over which the hand blends from the held pose back to the tracked one.
+    pub recover_s: f32,
+    /// A live record arriving more than this after its capture time (relative to the
+    /// stream's fastest delivery) is late and refused, seconds.
+    pub max_latency_s: f64,
+    /// Records closer together than 1 / this are a flood and refused, per second.
+    pub max_rate_hz: f64,
+    /// The wrist tracker's mounting offset.
+    pub tracker_mount: MountingOffset,
+    /// Gestures as commands: which held gesture triggers which viewer action.
+    pub actions: Vec<GestureAction>,
+}
+
+/// One row of the command table: holding `gesture` for `hold_s` triggers `action` once.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GestureAction {
+    /// The gesture's name (as in the gesture definitions).
+    pub gesture: String,
+    /// How long the gesture must be held, seconds from its start event.
+    #[serde(default)]
+    pub hold_s: f32,
+    /// The action: `next_method` (cycle LB → QB → DQB in the single view), `split_view`
+    /// (LB, QB, DQB side by side), `toggle_heatmap`.
+    pub action: Action,
+}
+
+/// What a gesture command does in the viewer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Action {
+    /// Show the next skinning method alone.
+    NextMethod,
+    /// Show LB, QB and DQB side by side.
+    SplitView,
+    /// Toggle the distortion heat map.
+    ToggleHeatmap,
+}
+
+impl Default for InputConfig {
+    fn default() -> Self {
+        Self {
+            filter: true,
+            angle_filter: OneEuroParams::ANGLE,
+            position_filter: OneEuroParams::POSITION,
+            rotation_filter: OneEuroParams::ROTATION,
+            grace_s: 0.25,
+            recover_s: 0.3,
+            max_latency_s: 0.25,
+            max_rate_hz: 1_000.0,
+            tracker_mount: MountingOffset::default(),
+            actions: vec![
+                GestureAction { gesture: "thumbs_up".into(), hold_s: 0.5, action: Action::NextMethod },
+                GestureAction { gesture: "victory".into(), hold_s: 0.5, action: Action::SplitView },
+                GestureAction { gesture: "rock".into(), hold_s: 0.8, action: Action::ToggleHeatmap },
+            ],
+        }
+    }
+}
+
+impl InputConfig {
+    /// Reads and checks a configuration file.
+    ///
+    /// # Errors
+    /// [`Error::Io`], or [`Error::File`] around [`Error::Config`] for JSON errors and values
+    /// out of range.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(Error::io(path))?;
+        Self::from_json(&text).map_err(|e| e.in_file(path))
+    }
+
+    /// Parses and checks a configuration.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming the bad field.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let config: Self = serde_json::from_str(text).map_err(|e| Error::Config(e.to_string()))?;
+        config.check()?;
+        Ok(config)
+    }
+
+    fn check(&self) -> Result<()> {
+        let bad = |what: &str| Err(Error::Config(what.to_owned()));
+        for (name, p) in [("angle_filter", &self.angle_filter), ("position_filter", &self.position_filter), ("rotation_filter", &self.rotation_filter)] {
+            if !p.is_valid() {
+                return bad(&format!("{name}: cutoffs must be positive and beta not negative"));
+            }
+        }
+        if !(self.grace_s.is_finite() && self.grace_s > 0.0) {
+            return bad("grace_s: must be a positive number of seconds");
+        }
+        if !(self.recover_s.is_finite() && self.recover_s >= 0.0) {
+            return bad("recover_s: must be a number of seconds, 0 or more");
+        }
+        if !(self.max_latency_s.is_finite() && self.max_latency_s > 0.0) {
+            return bad("max_latency_s: must be a positive number of seconds");
+        }
+        if !(self.max_rate_hz.is_finite() && self.max_rate_hz > 0.0) {
+            return bad("max_rate_hz: must be a positive rate");
+        }
+        if !self.tracker_mount.is_valid() {
+            return bad("tracker_mount: p must be finite and q a unit quaternion");
+        }
+        if let Some(a) = self.actions.iter().find(|a| !(a.hold_s.is_finite() && a.hold_s >= 0.0)) {
+            return bad(&format!("actions: {}: hold_s must be 0 or more seconds", a.gesture));
+        }
+        Ok(())
+    }
+}

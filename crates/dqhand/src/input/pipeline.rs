@@ -1,0 +1,271 @@
+//! The input pipeline: records in, poses of the engine step out. Each record is checked
+//! (time order, rate, latency), turned into a pose (glove mapping and tracker, or
+//! retargeting of tracked joints or landmarks), filtered, and shown; when good records stop
+//! the hand holds its last pose, is marked "tracking lost" after the grace time, and blends
+//! back smoothly when they return.
+//!
+//! Every per-record buffer is made up front: [`InputPipeline::push`] allocates nothing.
+
+use glam::Vec3;
+
+use super::record::JOINT_COUNT;
+use super::{GloveMapper, HandData, InputConfig, OneEuro, OneEuroRotation, OneEuroVec3, Record, RejectKind, Rejection, Rejections, Retargeter};
+use crate::kinematics::{HandRig, Pose};
+use crate::math::DualQuat;
+
+/// Whether the hand follows the user.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tracking {
+    /// No good record yet: the hand is at rest.
+    Waiting,
+    /// Good records are arriving.
+    Tracking,
+    /// No good record for longer than the grace time: the hand holds its last pose.
+    Lost,
+}
+
+impl Tracking {
+    /// `waiting`, `tracking` or `lost`.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Tracking::Waiting => "waiting",
+            Tracking::Tracking => "tracking",
+            Tracking::Lost => "lost",
+        }
+    }
+}
+
+/// Records → poses for one rig (see the module docs).
+#[derive(Clone, Debug)]
+pub struct InputPipeline {
+    config: InputConfig,
+    retargeter: Retargeter,
+    glove: Option<GloveMapper>,
+    angle_filters: Vec<OneEuro>,
+    position_filter: OneEuroVec3,
+    rotation_filter: OneEuroRotation,
+    /// Time of the last good record.
+    last_time: Option<f64>,
+    /// Smallest `arrival − capture time` seen on a live stream: the stream's clock offset.
+    clock_offset: Option<f64>,
+    state: Tracking,
+    /// When the hand started blending back from a held pose, and that pose.
+    recovering: Option<f64>,
+    held: Pose,
+    solved: Pose,
+    filtered: Pose,
+    output: Pose,
+    positions: [Vec3; JOINT_COUNT],
+    rejections: Rejections,
+    accepted: u64,
+}
+
+impl InputPipeline {
+    /// A pipeline posing `rig`, with a glove mapper when glove records are expected.
+    ///
+    /// # Errors
+    /// As [`Retargeter::new`]; [`crate::Error::Config`] if the glove mapper is for another
+    /// joint model than the rig's.
+    pub fn new(rig: &HandRig, glove: Option<GloveMapper>, config: InputConfig) -> crate::Result<Self> {
+        if let Some(g) = &glove {
+            if g.joint_model() != rig.model() {
+                return Err(crate::Error::Config(format!("the glove maps to the {} joint model, the hand is posed with {}", g.joint_model(), rig.model())));
+            }
+        }
+        let n = rig.dofs().len();
+        let rest = Pose::rest(n);
+        Ok(Self {
+            retargeter: Retargeter::new(rig)?,
+            glove,
+            angle_filters: vec![OneEuro::new(config.angle_filter); n],
+            position_filter: OneEuroVec3::new(config.position_filter),
+            rotation_filter: OneEuroRotation::new(config.rotation_filter),
+            last_time: None,
+            clock_offset: None,
+            state: Tracking::Waiting,
+            recovering: None,
+            held: rest.clone(),
+            solved: rest.clone(),
+            filtered: rest.clone(),
+            output: rest,
+            positions: [Vec3::ZERO; JOINT_COUNT],
+            rejections: Rejections::default(),
+            accepted: 0,
+            config,
+        })
+    }
+
+    /// The pose to show now.
+    #[must_use]
+    pub fn pose(&self) -> &Pose {
+        &self.output
+    }
+
+    /// Whether the hand follows the user.
+    #[must_use]
+    pub fn tracking(&self) -> Tracking {
+        self.state
+    }
+
+    /// The refused records so far, by kind.
+    #[must_use]
+    pub fn rejections(&self) -> &Rejections {
+        &self.rejections
+    }
+
+    /// Records taken so far.
+    #[must_use]
+    pub fn accepted(&self) -> u64 {
+        self.accepted
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &InputConfig {
+        &self.config
+    }
+
+    /// The retargeter (its rig, side, and the tracked positions of the last joints record).
+    #[must_use]
+    pub fn retargeter(&self) -> &Retargeter {
+        &self.retargeter
+    }
+
+    /// The tracked joint positions of the last good joints or landmarks record (WebXR order).
+    #[must_use]
+    pub fn tracked_positions(&self) -> &[Vec3; JOINT_COUNT] {
+        &self.positions
+    }
+
+    /// Counts a record refused before it got here (by a reader or a transport).
+    pub fn reject(&mut self, rejection: Rejection) {
+        self.rejections.add(rejection);
+    }
+
+    /// Marks the hand lost if no good record came for the grace time before `now` (in the
+    /// records' clock; for a live stream, [`Self::stream_time`] of the arrival time).
+    pub fn advance(&mut self, now: f64) {
+        if let (Tracking::Tracking, Some(last)) = (self.state, self.last_time) {
+            if now - last > self.config.grace_s {
+                self.state = Tracking::Lost;
+            }
+        }
+    }
+
+    /// The records' clock at local `arrival` time (seconds), from the stream's clock offset;
+    /// `arrival` itself before any live record.
+    #[must_use]
+    pub fn stream_time(&self, arrival: f64) -> f64 {
+        arrival - self.clock_offset.unwrap_or(0.0)
+    }
+
+    /// Takes one record: from a file with `arrival` `None`, live with its local arrival time
+    /// (seconds, any origin, monotonic).
+    ///
+    /// # Errors
+    /// The record's refusal (also counted in [`Self::rejections`]); the shown pose is kept.
+    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
+        let result = self.take(record, arrival);
+        if let Err(r) = &result {
+            self.rejections.add(r.clone());
+        }
+        result
+    }
+
+    fn take(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
+        let t = record.time;
+        let at = |kind, what: String| Rejection::new(kind, format!("record at t = {t} s: {what}"));
+        if let Some(last) = self.last_time {
+            if t <= last {
+                return Err(at(RejectKind::OutOfOrder, format!("not after the previous record ({last} s)")));
+            }
+            if t - last < 1.0 / self.config.max_rate_hz {
+                return Err(at(RejectKind::Flood, format!("{:.2} ms after the previous record (at most {} per second)", (t - last) * 1e3, self.config.max_rate_hz)));
+            }
+        }
+        if let Some(arrival) = arrival {
+            let offset = arrival - t;
+            let fastest = self.clock_offset.map_or(offset, |o| o.min(offset));
+            if offset - fastest > self.config.max_latency_s {
+                return Err(at(RejectKind::Late, format!("arrived {:.0} ms late", (offset - fastest) * 1e3)));
+            }
+            self.clock_offset = Some(fastest);
+        }
+        self.solve(record)?;
+        let dt = self.last_time.map_or(0.0, |last| (t - last) as f32);
+        let resume = self.state != Tracking::Tracking;
+        self.filter(dt, resume);
+        if self.state == Tracking::Lost {
+            self.held.clone_from(&self.output);
+            self.recovering = Some(t);
+        }
+        match self.recovering {
+            Some(start) if t - start < f64::from(self.config.recover_s) => {
+                let s = ((t - start) as f32 / self.config.recover_s).clamp(0.0, 1.0);
+                let rest_wrist = self.retargeter.rig().rest_wrist();
+                self.held.interpolate_into(&self.filtered, s * s * (3.0 - 2.0 * s), rest_wrist, &mut self.output);
+            }
+            _ => {
+                self.recovering = None;
+                self.output.clone_from(&self.filtered);
+            }
+        }
+        self.state = Tracking::Tracking;
+        self.last_time = Some(t);
+        self.accepted += 1;
+        Ok(())
+    }
+
+    /// The record's pose into `self.solved` (angles untouched by a tracker-only record).
+    fn solve(&mut self, record: &Record) -> Result<(), Rejection> {
+        match &record.hand {
+            Some(HandData::Joints(set)) => {
+                let mut p = [Vec3::ZERO; JOINT_COUNT];
+                for (i, q) in p.iter_mut().enumerate() {
+                    *q = set.get(i).ok_or_else(|| Rejection::new(RejectKind::Malformed, "joints: not all 25 joints"))?.position;
+                }
+                self.retargeter.solve(&p, record.side, &mut self.solved)?;
+                self.positions = p;
+            }
+            Some(HandData::Landmarks(landmarks)) => {
+                let mut p = [Vec3::ZERO; JOINT_COUNT];
+                self.retargeter.landmark_joints(landmarks, &mut p)?;
+                self.retargeter.solve(&p, record.side, &mut self.solved)?;
+                self.positions = p;
+            }
+            Some(HandData::Glove(sample)) => {
+                let glove = self.glove.as_ref().ok_or_else(|| Rejection::new(RejectKind::Malformed, "glove record, but no glove is configured"))?;
+                glove.map(sample, &mut self.solved.angles)?;
+            }
+            None => {}
+        }
+        // A wrist tracker drives the wrist of glove and tracker-only records; tracked joints
+        // carry their own wrist.
+        if let (Some(tracker), None | Some(HandData::Glove(_))) = (record.tracker, &record.hand) {
+            self.solved.wrist = Some(self.config.tracker_mount.wrist(tracker));
+        }
+        Ok(())
+    }
+
+    /// Filters `self.solved` into `self.filtered`; `resume` restarts the filters (after a
+    /// dropout the old state would drag the hand from where it was).
+    fn filter(&mut self, dt: f32, resume: bool) {
+        if !self.config.filter {
+            self.filtered.clone_from(&self.solved);
+            return;
+        }
+        if resume {
+            self.angle_filters.iter_mut().for_each(OneEuro::reset);
+            self.position_filter.reset();
+            self.rotation_filter.reset();
+        }
+        for ((out, a), f) in self.filtered.angles.iter_mut().zip(&self.solved.angles).zip(&mut self.angle_filters) {
+            *out = f.filter(*a, dt);
+        }
+        self.filtered.wrist = self.solved.wrist.map(|w| {
+            let (rotation, translation) = w.to_rotation_translation();
+            DualQuat::from_rotation_translation(self.rotation_filter.filter(rotation, dt), self.position_filter.filter(translation, dt))
+        });
+    }
+}

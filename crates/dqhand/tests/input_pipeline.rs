@@ -1,0 +1,183 @@
+//! The input pipeline: records refused by kind, the hand held and marked lost on dropouts,
+//! a smooth return, filtering, the glove and tracker path.
+
+mod support;
+
+use std::sync::OnceLock;
+
+use dqhand::gesture::gesture;
+use dqhand::hand::{HandParams, Side};
+use dqhand::input::{Calibration, GloveMapper, GloveSample, HandData, InputConfig, InputPipeline, JointSet, MappingTable, Record, RejectKind, RigidPose, TrackedJoint, Tracking};
+use dqhand::kinematics::{webxr, HandRig, JointModel, Limits, Pose};
+use dqhand::model::Model;
+use glam::{Quat, Vec3};
+
+fn ours() -> &'static Model {
+    static M: OnceLock<Model> = OnceLock::new();
+    M.get_or_init(|| dqhand::hand::build(&HandParams { vertices: 1_000, ..HandParams::default() }).unwrap())
+}
+
+fn rig() -> HandRig {
+    HandRig::new(&ours().skeleton, JointModel::Full).unwrap()
+}
+
+fn joints_record(time: f64, pose: &Pose) -> Record {
+    let rig = rig();
+    let world = support::world_of(&rig, pose, Limits::Anatomical);
+    let mut set = JointSet::new();
+    for (i, name) in webxr::JOINT_NAMES.iter().enumerate() {
+        let p: Vec3 = world[rig.skeleton().find(name).unwrap()].translation.into();
+        set.set(i, TrackedJoint { position: p, orientation: None, radius: 0.0 });
+    }
+    Record { time, side: Side::Right, hand: Some(HandData::Joints(set)), tracker: None }
+}
+
+fn unfiltered() -> InputConfig {
+    InputConfig { filter: false, ..InputConfig::default() }
+}
+
+fn max_diff_deg(a: &Pose, b: &Pose) -> f32 {
+    a.angles.iter().zip(&b.angles).map(|(x, y)| (x - y).abs().to_degrees()).fold(0.0, f32::max)
+}
+
+#[test]
+fn out_of_order_flood_and_late_records_are_refused_and_counted() {
+    let mut p = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
+    let fist = gesture("fist").unwrap().pose(JointModel::Full);
+    let point = gesture("point").unwrap().pose(JointModel::Full);
+    assert_eq!(p.tracking(), Tracking::Waiting);
+    p.push(&joints_record(1.0, &fist), None).unwrap();
+    assert_eq!(p.tracking(), Tracking::Tracking);
+    for (record, kind) in [
+        (joints_record(0.5, &point), RejectKind::OutOfOrder),
+        (joints_record(1.0, &point), RejectKind::OutOfOrder),
+        (joints_record(1.0002, &point), RejectKind::Flood),
+    ] {
+        assert_eq!(p.push(&record, None).unwrap_err().kind, kind);
+        assert!(max_diff_deg(p.pose(), &fist) < 0.5, "a refused record leaves the pose alone");
+    }
+    // Live: the clock offset is the fastest delivery; 0.3 s slower than that is late.
+    p.push(&joints_record(2.0, &fist), Some(102.01)).unwrap();
+    p.push(&joints_record(2.1, &fist), Some(102.10)).unwrap();
+    assert_eq!(p.push(&joints_record(2.2, &point), Some(102.55)).unwrap_err().kind, RejectKind::Late);
+    p.push(&joints_record(2.3, &point), Some(102.31)).unwrap();
+    let r = p.rejections();
+    assert_eq!((r.count(RejectKind::OutOfOrder), r.count(RejectKind::Flood), r.count(RejectKind::Late), r.total()), (2, 1, 1, 4));
+    assert_eq!(r.summary().count(), 3, "one line per kind");
+    assert_eq!(p.accepted(), 4);
+}
+
+#[test]
+fn a_dropout_holds_the_pose_marks_it_lost_and_recovers_smoothly() {
+    let config = unfiltered();
+    let (grace, recover) = (config.grace_s, f64::from(config.recover_s));
+    let mut p = InputPipeline::new(&rig(), None, config).unwrap();
+    let fist = gesture("fist").unwrap().pose(JointModel::Full);
+    let open = gesture("open").unwrap().pose(JointModel::Full);
+    let mut t = 0.0;
+    while t < 1.0 {
+        p.push(&joints_record(t, &fist), None).unwrap();
+        t += 1.0 / 60.0;
+    }
+    let last = t - 1.0 / 60.0;
+    p.advance(last + grace * 0.5);
+    assert_eq!(p.tracking(), Tracking::Tracking, "within the grace time");
+    p.advance(last + grace * 1.5);
+    assert_eq!(p.tracking(), Tracking::Lost);
+    assert!(max_diff_deg(p.pose(), &fist) < 0.5, "the hand holds its last good pose");
+    // Records return with another shape: the hand blends over `recover_s`, no jump.
+    let back = last + 1.0;
+    let mut previous = p.pose().clone();
+    let mut t = back;
+    let mut largest_step = 0.0f32;
+    while t < back + recover + 0.2 {
+        p.push(&joints_record(t, &open), None).unwrap();
+        assert_eq!(p.tracking(), Tracking::Tracking);
+        largest_step = largest_step.max(max_diff_deg(p.pose(), &previous));
+        previous = p.pose().clone();
+        t += 1.0 / 60.0;
+    }
+    let jump = max_diff_deg(&fist, &open);
+    assert!(largest_step < jump / 5.0, "largest step {largest_step}° of a {jump}° change");
+    assert!(max_diff_deg(p.pose(), &open) < 0.5, "after the blend the hand follows again");
+}
+
+#[test]
+fn unusable_geometry_is_refused() {
+    let mut p = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
+    let mut r = joints_record(0.0, &Pose::rest(JointModel::Full.dof_count()));
+    let Some(HandData::Joints(set)) = &mut r.hand else { unreachable!() };
+    let wrist = set.get(0).unwrap().position;
+    for i in 0..25 {
+        set.set(i, TrackedJoint { position: wrist, orientation: None, radius: 0.0 });
+    }
+    assert_eq!(p.push(&r, None).unwrap_err().kind, RejectKind::Unusable);
+    assert_eq!(p.tracking(), Tracking::Waiting);
+}
+
+/// The filter smooths jitter on a held pose and follows a change.
+#[test]
+fn the_filter_smooths_jitter() {
+    let mut filtered = InputPipeline::new(&rig(), None, InputConfig::default()).unwrap();
+    let mut raw = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
+    let pose = gesture("victory").unwrap().pose(JointModel::Full);
+    let mut rng = 0x2545_f491_u32;
+    let mut noise = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        (rng as f32 / u32::MAX as f32 - 0.5) * 0.003 // ±1.5 mm
+    };
+    let (mut raw_jitter, mut filtered_jitter) = (0.0f32, 0.0f32);
+    let (mut last_raw, mut last_filtered) = (None::<Pose>, None::<Pose>);
+    for k in 0..240 {
+        let mut r = joints_record(f64::from(k) / 60.0, &pose);
+        let Some(HandData::Joints(set)) = &mut r.hand else { unreachable!() };
+        for i in 0..25 {
+            let j = *set.get(i).unwrap();
+            set.set(i, TrackedJoint { position: j.position + Vec3::new(noise(), noise(), noise()), ..j });
+        }
+        raw.push(&r, None).unwrap();
+        filtered.push(&r, None).unwrap();
+        if k > 60 {
+            raw_jitter += max_diff_deg(raw.pose(), last_raw.as_ref().unwrap());
+            filtered_jitter += max_diff_deg(filtered.pose(), last_filtered.as_ref().unwrap());
+        }
+        last_raw = Some(raw.pose().clone());
+        last_filtered = Some(filtered.pose().clone());
+    }
+    assert!(filtered_jitter < raw_jitter / 3.0, "jitter raw {raw_jitter}, filtered {filtered_jitter}");
+    assert!(max_diff_deg(filtered.pose(), &pose) < 6.0);
+}
+
+/// Glove values become angles through the mapper; the tracker, through the mounting offset,
+/// becomes the wrist.
+#[test]
+fn glove_and_tracker_records_pose_the_hand() {
+    let table = MappingTable::builtin("5dt-14").unwrap();
+    let calibration = Calibration::default_for(&table);
+    let mapper = GloveMapper::new(&table, &calibration, JointModel::Full).unwrap();
+    let config = unfiltered();
+    let mount = config.tracker_mount;
+    let mut p = InputPipeline::new(&rig(), Some(mapper.clone()), config).unwrap();
+    let fist_raw = GloveSample::new(&[4095.0; 14]);
+    let tracker = RigidPose { position: Vec3::new(0.1, 1.0, -0.2), orientation: Quat::from_rotation_y(0.5) };
+    p.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: Some(tracker) }, None).unwrap();
+    let mut expected = vec![0.0; JointModel::Full.dof_count()];
+    mapper.map(&fist_raw, &mut expected).unwrap();
+    assert_eq!(p.pose().angles, expected);
+    assert_eq!(p.pose().wrist, Some(mount.wrist(tracker)));
+    let index_pip = JointModel::Full.dof_index("index-finger-phalanx-intermediate.flex").unwrap();
+    assert!(p.pose().angles[index_pip] > 1.0, "a fist curls the index");
+    // A raw value outside 0–4095 is refused and the pose kept.
+    let bad = GloveSample::new(&[5000.0; 14]);
+    let e = p.push(&Record { time: 0.1, side: Side::Right, hand: Some(HandData::Glove(bad)), tracker: None }, None).unwrap_err();
+    assert_eq!(e.kind, RejectKind::OutOfRange);
+    assert_eq!(p.pose().angles, expected);
+    // A glove record without a configured glove is refused.
+    let mut bare = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
+    assert!(bare.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: None }, None).is_err());
+    // A glove for another joint model is a configuration error.
+    let paper = GloveMapper::new(&table, &calibration, JointModel::Paper).unwrap();
+    assert!(InputPipeline::new(&rig(), Some(paper), unfiltered()).is_err());
+}
