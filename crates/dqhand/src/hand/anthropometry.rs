@@ -42,6 +42,26 @@ const MCP_ACROSS: [f32; 4] = [0.33, 0.10, -0.12, -0.32];
 /// Relaxed spread of the fingers at rest, degrees toward the radial side.
 const SPREAD_DEG: [f32; 4] = [9.0, 1.0, -7.0, -15.0];
 
+/// Hand length and breadth from the 25 WebXR joint positions of a hand (any pose, any
+/// place): the inverse of [`Anatomy::new`]'s proportions, so measuring a hand it built gives
+/// back its length and breadth.
+///
+/// * length: the middle finger's proximal + intermediate + distal bones, which do not change
+///   with the pose, over their fraction of hand length (Buchholz et al.);
+/// * breadth: the index-to-little knuckle distance across the palm (its component normal to
+///   the wrist→middle-knuckle axis) over the share of breadth the knuckles span.
+///
+/// `None` if the joints are degenerate.
+pub fn measure(joints: &[Vec3; 25]) -> Option<(f32, f32)> {
+    let middle = &SEGMENTS[2][1..];
+    let bones: f32 = (11..14).map(|i| (joints[i + 1] - joints[i]).length()).sum();
+    let length = bones / middle.iter().sum::<f32>();
+    let forward = (joints[11] - joints[0]).try_normalize()?;
+    let across = joints[6] - joints[21];
+    let breadth = (across - forward * across.dot(forward)).length() / (MCP_ACROSS[0] - MCP_ACROSS[3]);
+    (length.is_finite() && length > 0.0 && breadth.is_finite() && breadth > 0.0).then_some((length, breadth))
+}
+
 /// The hand's skeleton in world space and the half-breadth of the finger at each joint.
 #[derive(Clone, Debug)]
 pub(crate) struct Anatomy {

@@ -25,6 +25,7 @@ use crate::kinematics::webxr;
 use crate::model::Model;
 use crate::skin::{MeshData, SkinnedMesh};
 use crate::{Error, Result};
+pub use anthropometry::measure;
 use anthropometry::Anatomy;
 use shape::HandShape;
 
