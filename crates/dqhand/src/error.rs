@@ -94,6 +94,14 @@ pub enum Error {
     /// calibration recording in which sensors never moved.
     #[error("{0}")]
     Calibration(String),
+    /// A gesture definition file is malformed: the file, then the gesture and condition.
+    #[error("{file}: {problem}")]
+    GestureDefinition {
+        /// The file's path, or `gestures.json (built-in)`.
+        file: String,
+        /// What is wrong; match on it to tell the kinds apart.
+        problem: GestureProblem,
+    },
     /// A name (joint, DOF, node, method, joint model, gesture) is not known; lists the valid ones.
     #[error("unknown {kind} {name:?}; valid: {valid}")]
     UnknownName {
@@ -103,6 +111,80 @@ pub enum Error {
         name: String,
         /// The valid names, comma-separated.
         valid: String,
+    },
+}
+
+/// What is wrong in a gesture definition file ([`Error::GestureDefinition`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GestureProblem {
+    /// The text is not JSON of the expected shape (serde's message, with line and column).
+    #[error("not valid gesture definitions: {0}")]
+    Json(String),
+    /// Two gestures have the same name.
+    #[error("gesture {0:?} is defined twice")]
+    DuplicateName(String),
+    /// A gesture has no condition, so it would match every pose.
+    #[error("gesture {0:?} has no condition")]
+    NoCondition(String),
+    /// A condition is not `<feature> <op> <number> [release <number>]`.
+    #[error("gesture {gesture:?}, condition {condition:?}: expected `<feature> < or > <number> [release <number>]`")]
+    Syntax {
+        /// The gesture.
+        gesture: String,
+        /// The condition as written.
+        condition: String,
+    },
+    /// A condition names no feature.
+    #[error("gesture {gesture:?}, condition {condition:?}: unknown feature {feature:?}; valid: {valid}")]
+    UnknownFeature {
+        /// The gesture.
+        gesture: String,
+        /// The condition as written.
+        condition: String,
+        /// The name given.
+        feature: String,
+        /// The feature names, comma-separated.
+        valid: String,
+    },
+    /// A condition compares with something other than `<` or `>`.
+    #[error("gesture {gesture:?}, condition {condition:?}: unknown operator {operator:?}; use < or >")]
+    BadOperator {
+        /// The gesture.
+        gesture: String,
+        /// The condition as written.
+        condition: String,
+        /// The operator given.
+        operator: String,
+    },
+    /// A threshold is not a finite number.
+    #[error("gesture {gesture:?}, condition {condition:?}: threshold {value:?} is not a finite number")]
+    BadThreshold {
+        /// The gesture.
+        gesture: String,
+        /// The condition as written.
+        condition: String,
+        /// The threshold as written.
+        value: String,
+    },
+    /// A release threshold is on the entering side of the start threshold, so the gesture
+    /// would end as it starts.
+    #[error("gesture {gesture:?}, condition {condition:?}: release {release} must be above the threshold for <, below it for >")]
+    BadRelease {
+        /// The gesture.
+        gesture: String,
+        /// The condition as written.
+        condition: String,
+        /// The release threshold.
+        release: f32,
+    },
+    /// A setting (`min_hold_s`, a hysteresis margin) is negative or not finite.
+    #[error("{name} {value} is not a finite number ≥ 0")]
+    BadSetting {
+        /// The setting, `min_hold_s` or `hysteresis.<kind>`.
+        name: String,
+        /// Its value.
+        value: f64,
     },
 }
 
@@ -117,7 +199,7 @@ impl Error {
     #[must_use]
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         match self {
-            Error::Io { .. } | Error::File { .. } | Error::OutputFormat(_) => self,
+            Error::Io { .. } | Error::File { .. } | Error::OutputFormat(_) | Error::GestureDefinition { .. } => self,
             other => Error::File { path: path.into(), problem: Box::new(other) },
         }
     }

@@ -36,4 +36,4 @@ pub mod model;
 pub mod skin;
 pub mod stream;
 
-pub use error::{Error, Result};
+pub use error::{Error, GestureProblem, Result};

@@ -73,7 +73,7 @@ fn a_dropout_holds_the_pose_marks_it_lost_and_recovers_smoothly() {
     let (grace, recover) = (config.grace_s, f64::from(config.recover_s));
     let mut p = InputPipeline::new(&rig(), None, config).unwrap();
     let fist = gesture("fist").unwrap().pose(JointModel::Full);
-    let open = gesture("open").unwrap().pose(JointModel::Full);
+    let open = gesture("open_palm").unwrap().pose(JointModel::Full);
     let mut t = 0.0;
     while t < 1.0 {
         p.push(&joints_record(t, &fist), None).unwrap();

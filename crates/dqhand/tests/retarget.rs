@@ -204,7 +204,7 @@ fn a_collapsed_hand_is_refused() {
 fn hand_size_is_measured_from_joints() {
     for (length, breadth, side) in [(0.19, 0.085, Side::Right), (0.16, 0.075, Side::Left), (0.21, 0.10, Side::Right)] {
         let model = hand(length, breadth, side);
-        for name in ["open", "fist", "pinch"] {
+        for name in ["open_palm", "fist", "pinch"] {
             let (l, b) = dqhand::hand::measure(&positions(&model, JointModel::Full, &gesture(name).unwrap().pose(JointModel::Full))).unwrap();
             assert!((l - length).abs() < 0.002 && (b - breadth).abs() < 0.004, "{length}×{breadth} {name}: measured {l}×{b}");
         }

@@ -355,7 +355,7 @@ fn sequences_hit_their_keys_and_ease_between_them() {
     assert!(bad(vec![key(f32::NAN, &a)]).contains("not finite"));
     assert!(bad(vec![key(0.0, &Pose::rest(3))]).contains("3 angles"));
     let tour = Sequence::gestures(JointModel::Full);
-    let open = gesture("open").unwrap().pose(JointModel::Full);
+    let open = gesture("open_palm").unwrap().pose(JointModel::Full);
     assert_eq!(tour.keys().first().unwrap().pose, open);
     assert_eq!(tour.keys().last().unwrap().pose, open);
 }

@@ -110,14 +110,9 @@ const PINCH_THUMB: [(&str, f32); 4] = [
     ("thumb-phalanx-proximal.abd", 5.0),
     ("thumb-phalanx-distal.flex", 10.0),
 ];
-const PINCH_OTHERS: [(&str, f32); 6] = [
-    ("middle-finger-phalanx-proximal.flex", 30.0),
-    ("middle-finger-phalanx-intermediate.flex", 40.0),
-    ("ring-finger-phalanx-proximal.flex", 35.0),
-    ("ring-finger-phalanx-intermediate.flex", 45.0),
-    ("pinky-finger-phalanx-proximal.flex", 40.0),
-    ("pinky-finger-phalanx-intermediate.flex", 50.0),
-];
+/// The other fingers half curled, clearly not extended (curl about 0.45–0.5).
+const PINCH_OTHERS: [[(&str, f32); 3]; 3] =
+    [curl!("middle-finger", 40.0, 55.0, 25.0), curl!("ring-finger", 45.0, 60.0, 25.0), curl!("pinky-finger", 50.0, 65.0, 25.0)];
 const V_SPREAD: [(&str, f32); 2] = [("index-finger-phalanx-proximal.abd", 12.0), ("middle-finger-phalanx-proximal.abd", -10.0)];
 const PINKY_SPREAD: [(&str, f32); 1] = [("pinky-finger-phalanx-proximal.abd", 20.0)];
 
@@ -125,22 +120,29 @@ const FIST: &[&[(&str, f32)]] = &[&INDEX_FIST, &MIDDLE_FIST, &RING_FIST, &PINKY_
 const POINT: &[&[(&str, f32)]] = &[&MIDDLE_FIST, &RING_FIST, &PINKY_FIST, &CUP, &THUMB_OVER];
 const VICTORY: &[&[(&str, f32)]] = &[&RING_FIST, &PINKY_FIST, &CUP, &THUMB_OVER, &V_SPREAD];
 
-/// The gesture library, in demo order.
-pub const GESTURES: [Gesture; 14] = [
-    Gesture { name: "open", angles_deg: &[] },
+/// The thumb spread out beside the open hand, its pad turned toward the index.
+const THUMB_SPREAD: [(&str, f32); 3] =
+    [("thumb-metacarpal.abd", 25.0), ("thumb-metacarpal.flex", -15.0), ("thumb-phalanx-distal.flex", -5.0)];
+const OPEN_SPREAD: [(&str, f32); 3] = [
+    ("index-finger-phalanx-proximal.abd", 5.0),
+    ("ring-finger-phalanx-proximal.abd", 5.0),
+    ("pinky-finger-phalanx-proximal.abd", 10.0),
+];
+
+/// The gesture library, in demo order; the names are the recogniser's (`data/gestures.json`),
+/// which also defines `thumbs_down`: `thumbs_up`'s shape with the thumb pointing down.
+pub const GESTURES: [Gesture; 11] = [
+    Gesture { name: "open_palm", angles_deg: &[&THUMB_SPREAD, &OPEN_SPREAD] },
     Gesture { name: "fist", angles_deg: FIST },
     Gesture { name: "point", angles_deg: POINT },
     Gesture { name: "victory", angles_deg: VICTORY },
-    Gesture { name: "ok", angles_deg: &[&OK_INDEX, &OK_THUMB, &OK_OTHERS] },
-    Gesture { name: "thumbs-up", angles_deg: &[&INDEX_FIST, &MIDDLE_FIST, &RING_FIST, &PINKY_FIST, &CUP, &THUMB_OUT] },
-    Gesture { name: "pinch", angles_deg: &[&PINCH_INDEX, &PINCH_THUMB, &PINCH_OTHERS] },
-    Gesture { name: "call-me", angles_deg: &[&INDEX_FIST, &MIDDLE_FIST, &RING_FIST, &PINKY_SPREAD, &THUMB_OUT] },
-    Gesture { name: "horns", angles_deg: &[&MIDDLE_FIST, &RING_FIST, &THUMB_OVER] },
-    Gesture { name: "one", angles_deg: POINT },
-    Gesture { name: "two", angles_deg: VICTORY },
     Gesture { name: "three", angles_deg: &[&PINKY_FIST, &THUMB_IN] },
     Gesture { name: "four", angles_deg: &[&THUMB_IN] },
-    Gesture { name: "five", angles_deg: &[] },
+    Gesture { name: "rock", angles_deg: &[&MIDDLE_FIST, &RING_FIST, &THUMB_OVER] },
+    Gesture { name: "call_me", angles_deg: &[&INDEX_FIST, &MIDDLE_FIST, &RING_FIST, &PINKY_SPREAD, &THUMB_OUT] },
+    Gesture { name: "thumbs_up", angles_deg: &[&INDEX_FIST, &MIDDLE_FIST, &RING_FIST, &PINKY_FIST, &CUP, &THUMB_OUT] },
+    Gesture { name: "ok", angles_deg: &[&OK_INDEX, &OK_THUMB, &OK_OTHERS] },
+    Gesture { name: "pinch", angles_deg: &[&PINCH_INDEX, &PINCH_THUMB, &PINCH_OTHERS[0], &PINCH_OTHERS[1], &PINCH_OTHERS[2]] },
 ];
 
 #[cfg(test)]

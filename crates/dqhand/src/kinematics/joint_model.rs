@@ -98,7 +98,7 @@ const PAPER: [Dof; 18] = [
 ///
 /// * thumb CMC flexion −20…50° and palmar abduction −10…60°: Cooney's arcs (53°, 42°),
 ///   widened because these two axes also stand in for the CMC's coupled axial rotation, which
-///   opposition (OK sign, pinch, thumbs-up) needs;
+///   opposition (OK sign, pinch, thumbs up) needs;
 /// * thumb MCP abduction ±15°: the small radial/ulnar play that lets the thumb pad meet the
 ///   index pad in a pinch;
 /// * ring and little finger CMC flexion 0…10° and 0…20°: the palm arches around a grasped

@@ -107,7 +107,7 @@ pub struct Report {
 }
 
 /// The gestures whose self-intersections are counted.
-const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs-up"];
+const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs_up"];
 
 /// Measures LB, QB and DQB on every sweep, each frame one step of the [`Engine`].
 ///

@@ -1,0 +1,241 @@
+//! Hand features for gesture recognition, in the style of today's VR hand-tracking SDKs
+//! (per-finger curl, knuckle flexion, spread, thumb–fingertip distances, palm and thumb
+//! direction): measured on joint positions only, so any tracker that reports the 25 WebXR
+//! joints can drive the recogniser, not only this engine.
+//!
+//! Every feature, with its name in gesture definitions (`gestures.json`):
+//!
+//! | name | kind | unit | definition |
+//! |---|---|---|---|
+//! | `thumb.curl` | curl | 0–1 | (θ_MCP + θ_IP) / 140°, clamped to 1 |
+//! | `index.curl` … `pinky.curl` | curl | 0–1 | (θ_MCP + θ_PIP + θ_DIP) / 270°, clamped to 1 |
+//! | `thumb.flexion` | flexion | ° | unsigned angle between the thumb's metacarpal and proximal phalanx |
+//! | `index.flexion` … `pinky.flexion` | flexion | ° | signed angle of the proximal phalanx from the metacarpal about the knuckle's lateral axis, + toward the palm |
+//! | `thumb.abduction` … `ring.abduction` | abduction | ° | angle between the finger's proximal phalanx and the next finger's, both projected on the palm plane |
+//! | `index.opposition` … `pinky.opposition` | opposition | hand sizes | thumb tip to that fingertip / hand size |
+//! | `palm.up` | direction | ° | angle between the palm normal (out of the back of the hand) and world up (+Y) |
+//! | `thumb.up` | direction | ° | angle between the thumb (proximal phalanx base to tip) and world up (+Y) |
+//!
+//! θ is the unsigned angle between two successive bones (0 when they are collinear), so a
+//! straight finger has curl 0 whatever its direction. 270° is a tight fist's sum (MCP 90°,
+//! PIP 110°, DIP 70°), 140° the thumb's (MCP 60°, IP 80°): the anatomical ranges of
+//! [`JointModel`](crate::kinematics::JointModel).
+//!
+//! The hand size is the middle finger's chain, metacarpal base to tip: the sum of four bone
+//! lengths, so it does not change with the pose, and it scales distances so that one threshold
+//! fits small and large hands (0.16 on the built-in hand of 19 cm length).
+//!
+//! The palm normal is the dorsal direction, (middle knuckle − wrist) × (index knuckle − pinky
+//! knuckle) for a right hand and the opposite for a left one: the joint frames' +Y.
+
+use glam::Vec3;
+
+use crate::hand::Side;
+
+/// A finger, thumb first (WebXR order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Finger {
+    /// The thumb.
+    Thumb,
+    /// The index finger.
+    Index,
+    /// The middle finger.
+    Middle,
+    /// The ring finger.
+    Ring,
+    /// The little finger.
+    Pinky,
+}
+
+impl Finger {
+    /// The five, in WebXR order.
+    pub const ALL: [Finger; 5] = [Finger::Thumb, Finger::Index, Finger::Middle, Finger::Ring, Finger::Pinky];
+
+    /// The name used in feature names: `thumb`, `index`, `middle`, `ring`, `pinky`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        ["thumb", "index", "middle", "ring", "pinky"][self as usize]
+    }
+}
+
+/// What a feature measures, which decides its hysteresis margin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FeatureKind {
+    /// Curl, 0–1.
+    Curl,
+    /// Knuckle flexion, degrees.
+    Flexion,
+    /// Spread between adjacent fingers, degrees.
+    Abduction,
+    /// Thumb tip to fingertip, hand sizes.
+    Opposition,
+    /// Angle of a hand direction to world up, degrees.
+    Direction,
+}
+
+impl FeatureKind {
+    /// The name used in the `hysteresis` table of gesture definitions.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        ["curl", "flexion", "abduction", "opposition", "direction"][self as usize]
+    }
+}
+
+/// One named feature ([module docs](self) list them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Feature {
+    /// Curl of a finger, 0 straight … 1 fully curled.
+    Curl(Finger),
+    /// Flexion at a finger's knuckle (MCP), degrees.
+    Flexion(Finger),
+    /// Spread between a finger and the next one (not the pinky), degrees.
+    Abduction(Finger),
+    /// Thumb tip to a fingertip (not the thumb), in hand sizes.
+    Opposition(Finger),
+    /// Angle between the palm normal (dorsal) and world up, degrees.
+    PalmUp,
+    /// Angle between the thumb and world up, degrees.
+    ThumbUp,
+}
+
+use Finger::{Index, Middle, Pinky, Ring, Thumb};
+
+impl Feature {
+    /// Every feature, in the order of the module docs.
+    pub const ALL: [Feature; 20] = [
+        Feature::Curl(Thumb),
+        Feature::Curl(Index),
+        Feature::Curl(Middle),
+        Feature::Curl(Ring),
+        Feature::Curl(Pinky),
+        Feature::Flexion(Thumb),
+        Feature::Flexion(Index),
+        Feature::Flexion(Middle),
+        Feature::Flexion(Ring),
+        Feature::Flexion(Pinky),
+        Feature::Abduction(Thumb),
+        Feature::Abduction(Index),
+        Feature::Abduction(Middle),
+        Feature::Abduction(Ring),
+        Feature::Opposition(Index),
+        Feature::Opposition(Middle),
+        Feature::Opposition(Ring),
+        Feature::Opposition(Pinky),
+        Feature::PalmUp,
+        Feature::ThumbUp,
+    ];
+
+    /// The name in gesture definitions, `<finger>.<kind>` or `palm.up` / `thumb.up`.
+    #[must_use]
+    pub fn name(self) -> String {
+        match self {
+            Feature::Curl(f) => format!("{}.curl", f.name()),
+            Feature::Flexion(f) => format!("{}.flexion", f.name()),
+            Feature::Abduction(f) => format!("{}.abduction", f.name()),
+            Feature::Opposition(f) => format!("{}.opposition", f.name()),
+            Feature::PalmUp => "palm.up".into(),
+            Feature::ThumbUp => "thumb.up".into(),
+        }
+    }
+
+    /// The feature called `name`, `None` if there is none.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Feature> {
+        Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// What it measures.
+    #[must_use]
+    pub fn kind(self) -> FeatureKind {
+        match self {
+            Feature::Curl(_) => FeatureKind::Curl,
+            Feature::Flexion(_) => FeatureKind::Flexion,
+            Feature::Abduction(_) => FeatureKind::Abduction,
+            Feature::Opposition(_) => FeatureKind::Opposition,
+            Feature::PalmUp | Feature::ThumbUp => FeatureKind::Direction,
+        }
+    }
+}
+
+/// The features of one hand in one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HandFeatures {
+    /// Curl per finger (thumb first), 0–1.
+    pub curl: [f32; 5],
+    /// Knuckle flexion per finger, degrees.
+    pub flexion_deg: [f32; 5],
+    /// Spread thumb–index, index–middle, middle–ring, ring–pinky, degrees.
+    pub abduction_deg: [f32; 4],
+    /// Thumb tip to the index, middle, ring and pinky tips, in hand sizes.
+    pub opposition: [f32; 4],
+    /// Middle finger chain length, metres: the unit of `opposition`.
+    pub hand_size: f32,
+    /// Unit normal out of the back of the hand, world frame.
+    pub palm_normal: Vec3,
+    /// Unit direction of the thumb, proximal phalanx base to tip, world frame.
+    pub thumb_direction: Vec3,
+}
+
+/// The first joint of each finger's chain in WebXR order (thumb: its metacarpal).
+const CHAIN_START: [usize; 5] = [1, 5, 10, 15, 20];
+const TIP: [usize; 5] = [4, 9, 14, 19, 24];
+const WRIST: usize = 0;
+/// Knuckles (proximal phalanx bases) of the index, middle and pinky.
+const INDEX_KNUCKLE: usize = 6;
+const MIDDLE_KNUCKLE: usize = 11;
+const PINKY_KNUCKLE: usize = 21;
+/// Sums of joint angles that count as fully curled, radians.
+const THUMB_FULL_CURL: f32 = 140.0 * (core::f32::consts::PI / 180.0);
+const FINGER_FULL_CURL: f32 = 270.0 * (core::f32::consts::PI / 180.0);
+
+impl HandFeatures {
+    /// Measures the features of a hand from its 25 joint positions in the world (WebXR
+    /// order, [`webxr::JOINT_NAMES`](crate::kinematics::webxr::JOINT_NAMES)) and its side.
+    /// Allocates nothing.
+    ///
+    /// Degenerate input (coincident joints) gives NaN features, which match no condition.
+    #[must_use]
+    pub fn from_positions(p: &[Vec3; 25], side: Side) -> Self {
+        let across = p[INDEX_KNUCKLE] - p[PINKY_KNUCKLE];
+        let along = p[MIDDLE_KNUCKLE] - p[WRIST];
+        let right_normal = along.cross(across).normalize();
+        let palm_normal = if side == Side::Right { right_normal } else { -right_normal };
+        let bone = |f: usize, i: usize| p[CHAIN_START[f] + i + 1] - p[CHAIN_START[f] + i];
+
+        let mut curl = [0.0; 5];
+        let mut flexion_deg = [0.0; 5];
+        let mut proximal_on_palm = [Vec3::ZERO; 5];
+        for f in 0..5 {
+            let joints = if f == 0 { 2 } else { 3 };
+            let bent: f32 = (0..joints).map(|i| bone(f, i).angle_between(bone(f, i + 1))).sum();
+            curl[f] = (bent / if f == 0 { THUMB_FULL_CURL } else { FINGER_FULL_CURL }).min(1.0);
+            let (metacarpal, proximal) = (bone(f, 0).normalize(), bone(f, 1).normalize());
+            flexion_deg[f] = if f == 0 {
+                metacarpal.angle_between(proximal).to_degrees()
+            } else {
+                // Rotating the metacarpal about n × m turns it toward the palm (−n).
+                let lateral = palm_normal.cross(metacarpal).normalize();
+                metacarpal.cross(proximal).dot(lateral).atan2(metacarpal.dot(proximal)).to_degrees()
+            };
+            proximal_on_palm[f] = proximal.reject_from_normalized(palm_normal);
+        }
+        let abduction_deg = core::array::from_fn(|f| proximal_on_palm[f].angle_between(proximal_on_palm[f + 1]).to_degrees());
+        let hand_size: f32 = (0..4).map(|i| bone(2, i).length()).sum();
+        let opposition = core::array::from_fn(|f| p[TIP[0]].distance(p[TIP[f + 1]]) / hand_size);
+        let thumb_direction = (p[TIP[0]] - p[CHAIN_START[0] + 1]).normalize();
+        Self { curl, flexion_deg, abduction_deg, opposition, hand_size, palm_normal, thumb_direction }
+    }
+
+    /// The value of one feature, in its unit (module docs).
+    #[must_use]
+    pub fn get(&self, feature: Feature) -> f32 {
+        match feature {
+            Feature::Curl(f) => self.curl[f as usize],
+            Feature::Flexion(f) => self.flexion_deg[f as usize],
+            Feature::Abduction(f) => self.abduction_deg.get(f as usize).copied().unwrap_or(f32::NAN),
+            Feature::Opposition(f) => self.opposition.get((f as usize).wrapping_sub(1)).copied().unwrap_or(f32::NAN),
+            Feature::PalmUp => self.palm_normal.angle_between(Vec3::Y).to_degrees(),
+            Feature::ThumbUp => self.thumb_direction.angle_between(Vec3::Y).to_degrees(),
+        }
+    }
+}

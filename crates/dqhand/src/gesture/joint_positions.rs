@@ -1,0 +1,46 @@
+//! The 25 WebXR joint positions of a posed skeleton, the input of [`HandFeatures`]: the
+//! joint indices are resolved once per skeleton, so each frame only copies translations.
+//!
+//! [`HandFeatures`]: super::HandFeatures
+
+use glam::{Affine3A, Vec3};
+
+use crate::kinematics::{webxr, Skeleton};
+use crate::{Error, Result};
+
+/// Where the WebXR joints sit in one skeleton.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JointPositions {
+    /// Skeleton index of each WebXR joint, in [`webxr::JOINT_NAMES`] order.
+    indices: [usize; 25],
+}
+
+impl JointPositions {
+    /// Resolves the 25 WebXR joints of `skeleton` (e.g. [`Engine::skeleton`]).
+    ///
+    /// [`Engine::skeleton`]: crate::engine::Engine::skeleton
+    ///
+    /// # Errors
+    /// [`Error::MissingJoint`] naming the first WebXR joint the skeleton lacks.
+    pub fn new(skeleton: &Skeleton) -> Result<Self> {
+        let mut indices = [0; 25];
+        for (slot, name) in indices.iter_mut().zip(webxr::JOINT_NAMES) {
+            *slot = skeleton
+                .find(name)
+                .ok_or_else(|| Error::MissingJoint { joint: name.to_owned(), needed_for: "gesture features need the 25 WebXR hand joints" })?;
+        }
+        Ok(Self { indices })
+    }
+
+    /// The joints' world positions, metres, from the skeleton's world transforms (e.g.
+    /// [`Engine::world`]). Allocates nothing.
+    ///
+    /// [`Engine::world`]: crate::engine::Engine::world
+    ///
+    /// # Panics
+    /// If `world` is shorter than the skeleton these indices were resolved on.
+    #[must_use]
+    pub fn read(&self, world: &[Affine3A]) -> [Vec3; 25] {
+        self.indices.map(|i| world[i].translation.into())
+    }
+}
