@@ -15,6 +15,7 @@
 //! * [`gesture`] — the gesture library and pose sequences;
 //! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
 //!   join in later issues);
+//! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
 //! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
 //! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!
@@ -28,6 +29,7 @@ pub mod geometry;
 pub mod gesture;
 pub mod hand;
 pub mod input;
+pub mod interaction;
 pub mod io;
 pub mod kinematics;
 pub mod math;

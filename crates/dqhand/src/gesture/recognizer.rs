@@ -46,6 +46,14 @@ pub struct Events<'a> {
     next: usize,
 }
 
+impl Events<'_> {
+    /// No event (recognition off).
+    #[must_use]
+    pub fn none() -> Self {
+        Self { slots: [None, None], next: 0 }
+    }
+}
+
 impl<'a> Iterator for Events<'a> {
     type Item = Event<'a>;
 
@@ -99,7 +107,7 @@ impl Recognizer {
                 _ => gestures.iter().position(|g| g.matches(features, false)),
             }
         };
-        let mut events = Events { slots: [None, None], next: 0 };
+        let mut events = Events::none();
         if seen == self.current {
             self.pending = None;
             return events;

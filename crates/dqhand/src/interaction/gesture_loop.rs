@@ -1,0 +1,103 @@
+//! The gesture interaction loop: record → input pipeline (check, retarget or map, filter,
+//! dropouts) → kinematics of the virtual hand → finger features → recogniser.
+//!
+//! Gestures are recognised on the *virtual* hand, after retargeting: one set of thresholds
+//! then serves every source (gloves, joints, landmarks) and every user's hand size, and what
+//! the user sees is what is recognised.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use crate::engine::Engine;
+use crate::gesture::{Events, GestureSet, HandFeatures, JointPositions, Recognizer};
+use crate::hand::Side;
+use crate::input::{GloveMapper, InputConfig, InputPipeline, Record, Rejection};
+use crate::kinematics::JointModel;
+use crate::model::Model;
+use crate::Result;
+
+/// One user's hand driving one virtual hand, with an optional gesture recogniser.
+pub struct GestureLoop {
+    pipeline: InputPipeline,
+    engine: Engine,
+    joints: JointPositions,
+    positions: [Vec3; 25],
+    side: Side,
+    recognizer: Option<Recognizer>,
+}
+
+impl GestureLoop {
+    /// A loop posing `model` with `joint_model`; `gestures` turns recognition on.
+    ///
+    /// # Errors
+    /// As [`Engine::with_joint_model`], [`InputPipeline::new`] and [`JointPositions::new`].
+    pub fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>) -> Result<Self> {
+        let engine = Engine::with_joint_model(model, joint_model)?;
+        let rig = engine.rig().expect("an engine with a joint model has a rig");
+        let pipeline = InputPipeline::new(rig, glove, config)?;
+        let joints = JointPositions::new(engine.skeleton())?;
+        let side = pipeline.retargeter().side();
+        Ok(Self { pipeline, engine, joints, positions: [Vec3::ZERO; 25], side, recognizer: gestures.map(Recognizer::new) })
+    }
+
+    /// Takes one record (`arrival`: see [`InputPipeline::push`]): poses the virtual hand and,
+    /// with recognition on, returns the gesture events it caused. Allocates nothing.
+    ///
+    /// # Errors
+    /// The record's refusal; the hand keeps its pose.
+    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> Result<Events<'_>, Rejection> {
+        self.pipeline.push(record, arrival)?;
+        self.engine.pose(self.pipeline.pose());
+        self.positions = self.joints.read(self.engine.world());
+        Ok(self.recognize(record.time))
+    }
+
+    fn recognize(&mut self, time: f64) -> Events<'_> {
+        let features = HandFeatures::from_positions(&self.positions, self.side);
+        match &mut self.recognizer {
+            Some(r) => r.update(time, &features),
+            None => Events::none(),
+        }
+    }
+
+    /// The input pipeline (pose, tracking state, rejections).
+    #[must_use]
+    pub fn pipeline(&self) -> &InputPipeline {
+        &self.pipeline
+    }
+
+    /// Counts a record refused before it reached the loop.
+    pub fn reject(&mut self, rejection: Rejection) {
+        self.pipeline.reject(rejection);
+    }
+
+    /// Marks the hand lost after the grace time without records ([`InputPipeline::advance`]).
+    pub fn advance(&mut self, now: f64) {
+        self.pipeline.advance(now);
+    }
+
+    /// The current gesture, with recognition on.
+    #[must_use]
+    pub fn gesture(&self) -> Option<&str> {
+        self.recognizer.as_ref().and_then(Recognizer::current)
+    }
+
+    /// The gestures recognised, with recognition on.
+    #[must_use]
+    pub fn gestures(&self) -> Option<&GestureSet> {
+        self.recognizer.as_ref().map(Recognizer::set)
+    }
+
+    /// The virtual hand's 25 WebXR joint positions after the last record.
+    #[must_use]
+    pub fn joint_positions(&self) -> &[Vec3; 25] {
+        &self.positions
+    }
+
+    /// The engine that poses the virtual hand (kinematics only; skin it with
+    /// [`Engine::skin`] when the mesh is wanted).
+    pub fn engine_mut(&mut self) -> &mut Engine {
+        &mut self.engine
+    }
+}

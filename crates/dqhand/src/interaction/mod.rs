@@ -1,0 +1,8 @@
+//! The interaction loops on top of the engine step (paper Figure 1, bottom). Gesture
+//! interaction: records from the user's hand drive the virtual hand (what you see is what you
+//! do) and its gestures, recognised on the virtual hand, act as commands.
+
+mod gesture_loop;
+pub mod synthetic;
+
+pub use gesture_loop::GestureLoop;

@@ -1,0 +1,320 @@
+//! Synthetic, labelled recordings of the gesture library, made from our own kinematics: the
+//! sample recordings of the demo and the tests, and the sequences `dqhand gesture-bench`
+//! scores. They are labelled synthetic wherever they are written.
+//!
+//! A sequence is a user's hand (random size, proportions and side unless fixed) moving
+//! through the library's gestures (and thumbs down) in random order: each reached by an eased
+//! move (smoothstep), held, with the wrist turned up to ±25° from a neutral orientation
+//! (thumbs up and down keep the thumb pointing up or down), then a stretch of idle motion
+//! (a relaxed, half-curled hand drifting slowly), where no gesture should be seen. Every frame
+//! adds physiological tremor (9 Hz, per joint) and Gaussian joint noise; some records are
+//! dropped. Records carry joints (with orientations), MediaPipe landmarks, or glove values
+//! with a wrist tracker.
+
+use glam::{Affine3A, Quat, Vec3};
+
+use crate::gesture::{gesture, GESTURES};
+use crate::hand::{HandParams, Side};
+use crate::input::{mediapipe, Calibration, GloveSample, HandData, JointSet, MappingTable, MountingOffset, Record, RigidPose, TrackedJoint};
+use crate::kinematics::{forward_kinematics, webxr, HandRig, JointModel, Limits, Pose};
+use crate::math::DualQuat;
+use crate::Result;
+
+/// What the records carry.
+#[derive(Clone, Debug)]
+pub enum SyntheticFormat {
+    /// The 25 WebXR joints with orientations.
+    Joints,
+    /// MediaPipe's 21 landmarks.
+    Landmarks,
+    /// Raw values of a glove (its default calibration) and a wrist tracker.
+    Glove(MappingTable),
+}
+
+/// How a sequence is made.
+#[derive(Clone, Debug)]
+pub struct SyntheticParams {
+    /// Seed of every random choice: the same seed gives the same sequence.
+    pub seed: u64,
+    /// The user's hand; `None` draws length 0.16–0.21 m, breadth 42–50 % of it, either side.
+    pub hand: Option<HandParams>,
+    /// Gestures held, in random order, cycling through the library and thumbs down.
+    pub holds: usize,
+    /// Seconds each gesture is held after it is reached.
+    pub hold_s: f64,
+    /// Seconds of the eased move to each gesture.
+    pub move_s: f64,
+    /// Seconds of idle motion at the end.
+    pub idle_s: f64,
+    /// Records per second.
+    pub rate_hz: f64,
+    /// Root-mean-square joint noise, metres (per joint, in 3D).
+    pub noise_m: f32,
+    /// Tremor amplitude per joint angle, degrees.
+    pub tremor_deg: f32,
+    /// Largest wrist turn from the neutral orientation, degrees.
+    pub wrist_turn_deg: f32,
+    /// Share of records dropped.
+    pub drop_rate: f64,
+    /// What the records carry.
+    pub format: SyntheticFormat,
+}
+
+impl Default for SyntheticParams {
+    fn default() -> Self {
+        Self {
+            seed: 1,
+            hand: None,
+            holds: 13,
+            hold_s: 1.0,
+            move_s: 0.4,
+            idle_s: 10.0,
+            rate_hz: 60.0,
+            noise_m: 0.0015,
+            tremor_deg: 0.5,
+            wrist_turn_deg: 25.0,
+            drop_rate: 0.02,
+            format: SyntheticFormat::Joints,
+        }
+    }
+}
+
+/// One labelled hold: `gesture` is shown from `reached` to `until` (seconds).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// The gesture's name.
+    pub gesture: String,
+    /// When the pose is reached (the end of the move).
+    pub reached: f64,
+    /// When the move to the next pose begins.
+    pub until: f64,
+}
+
+/// A generated sequence.
+#[derive(Clone, Debug)]
+pub struct Synthetic {
+    /// The user's hand.
+    pub hand: HandParams,
+    /// The records, in time order, with the dropped ones left out.
+    pub records: Vec<Record>,
+    /// The true pose of every record (angles of the `full` model, the wrist).
+    pub truth: Vec<Pose>,
+    /// The holds.
+    pub labels: Vec<Label>,
+    /// The idle stretch, seconds from and to.
+    pub idle: (f64, f64),
+}
+
+/// A small, seedable generator (xorshift64*), so that sequences do not depend on a crate's
+/// version.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next_f64()
+    }
+    fn normal(&mut self) -> f32 {
+        let (u, v) = (self.next_f64().max(1e-12), self.next_f64());
+        ((-2.0 * u.ln()).sqrt() * (core::f64::consts::TAU * v).cos()) as f32
+    }
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(self.normal(), self.normal(), self.normal());
+            if let Some(u) = v.try_normalize() {
+                return u;
+            }
+        }
+    }
+}
+
+/// Generates a sequence.
+///
+/// # Errors
+/// [`crate::Error::HandParameter`] for a hand that cannot be built.
+pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
+    let mut rng = Rng::new(params.seed);
+    let hand = params.hand.unwrap_or_else(|| {
+        let length = rng.uniform(0.16, 0.21) as f32;
+        HandParams {
+            length,
+            breadth: length * rng.uniform(0.42, 0.50) as f32,
+            side: if rng.next_f64() < 0.5 { Side::Left } else { Side::Right },
+            vertices: *crate::hand::VERTEX_RANGE.start(),
+        }
+    });
+    let model = crate::hand::build(&HandParams { vertices: *crate::hand::VERTEX_RANGE.start(), ..hand })?;
+    let rig = HandRig::new(&model.skeleton, JointModel::Full)?;
+    let index: Vec<usize> = webxr::JOINT_NAMES.iter().map(|n| rig.skeleton().find(n).expect("the built hand has every WebXR joint")).collect();
+    let rest_wrist = rig.rest_wrist();
+
+    // The shapes: the library and thumbs down, in a shuffled cycle.
+    let thumbs_up = gesture("thumbs_up")?.pose(JointModel::Full);
+    let thumb_direction = |pose: &Pose| {
+        let world = world_of(&rig, pose);
+        (Vec3::from(world[index[4]].translation) - Vec3::from(world[index[2]].translation)).normalize()
+    };
+    let up_turn = Quat::from_rotation_arc(thumb_direction(&thumbs_up), Vec3::Y);
+    let down_turn = Quat::from_rotation_arc(thumb_direction(&thumbs_up), -Vec3::Y);
+    let mut names: Vec<&str> = GESTURES.iter().map(|g| g.name).chain(["thumbs_down"]).collect();
+    let (rest_rotation, rest_translation) = rest_wrist.to_rotation_translation();
+    let mut keys = Vec::new(); // (time, pose, label)
+    let mut time = 0.0;
+    let mut previous = relaxed(&mut rng);
+    previous.wrist = Some(rest_wrist);
+    keys.push((0.0, previous.clone(), None));
+    time += 0.5;
+    keys.push((time, previous, None));
+    for k in 0..params.holds {
+        if k % names.len() == 0 {
+            for i in (1..names.len()).rev() {
+                names.swap(i, (rng.next_f64() * (i + 1) as f64) as usize);
+            }
+        }
+        let name = names[k % names.len()];
+        let shape = if name == "thumbs_down" { thumbs_up.clone() } else { gesture(name)?.pose(JointModel::Full) };
+        let turn = Quat::from_axis_angle(rng.unit(), (rng.uniform(-1.0, 1.0) * f64::from(params.wrist_turn_deg)).to_radians() as f32);
+        let rotation = match name {
+            "thumbs_up" => turn_about_y(&mut rng) * up_turn * rest_rotation,
+            "thumbs_down" => turn_about_y(&mut rng) * down_turn * rest_rotation,
+            _ => turn * rest_rotation,
+        };
+        let pose = Pose { wrist: Some(DualQuat::from_rotation_translation(rotation, rest_translation)), angles: shape.angles };
+        time += params.move_s;
+        keys.push((time, pose.clone(), Some((name, time, time + params.hold_s))));
+        time += params.hold_s;
+        keys.push((time, pose, None));
+    }
+    // Idle: relaxed shapes drifting slowly.
+    let idle_start = time + params.move_s;
+    while time < idle_start + params.idle_s {
+        time += rng.uniform(1.0, 2.0);
+        let mut pose = relaxed(&mut rng);
+        let turn = Quat::from_axis_angle(rng.unit(), (rng.uniform(-1.0, 1.0) * f64::from(params.wrist_turn_deg)).to_radians() as f32);
+        pose.wrist = Some(DualQuat::from_rotation_translation(turn * rest_rotation, rest_translation + rng.unit() * 0.05));
+        keys.push((time, pose, None));
+    }
+    let labels = keys.iter().filter_map(|(_, _, l)| l.map(|(g, reached, until)| Label { gesture: g.to_owned(), reached, until })).collect();
+
+    let dofs = JointModel::Full.dof_count();
+    let phases: Vec<f32> = (0..dofs).map(|_| rng.uniform(0.0, core::f64::consts::TAU) as f32).collect();
+    let sigma = params.noise_m / 3f32.sqrt();
+    let glove = match &params.format {
+        SyntheticFormat::Glove(table) => Some((table, Calibration::default_for(table))),
+        _ => None,
+    };
+    let mount = MountingOffset::default();
+    let (mut records, mut truth) = (Vec::new(), Vec::new());
+    let mut pose = Pose::rest(dofs);
+    let mut k = 0;
+    let end = keys.last().map_or(0.0, |k| k.0);
+    let mut frame = 0u64;
+    loop {
+        let t = frame as f64 / params.rate_hz;
+        if t > end {
+            break;
+        }
+        frame += 1;
+        while k + 1 < keys.len() && keys[k + 1].0 <= t {
+            k += 1;
+        }
+        let (t0, a, _) = &keys[k];
+        let (t1, b, _) = keys.get(k + 1).unwrap_or(&keys[k]);
+        let s = if t1 > t0 { ((t - t0) / (t1 - t0)).clamp(0.0, 1.0) as f32 } else { 1.0 };
+        a.interpolate_into(b, s * s * (3.0 - 2.0 * s), rest_wrist, &mut pose);
+        for (angle, phase) in pose.angles.iter_mut().zip(&phases) {
+            *angle += params.tremor_deg.to_radians() * (core::f32::consts::TAU * 9.0 * t as f32 + phase).sin();
+        }
+        rig.clamp(&mut pose);
+        if rng.next_f64() < params.drop_rate {
+            continue;
+        }
+        let world = world_of(&rig, &pose);
+        let mut positions = [Vec3::ZERO; 25];
+        for (p, &j) in positions.iter_mut().zip(&index) {
+            *p = Vec3::from(world[j].translation) + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+        }
+        let record_hand = match &params.format {
+            SyntheticFormat::Joints => {
+                let mut set = JointSet::new();
+                for (i, (&j, p)) in index.iter().zip(&positions).enumerate() {
+                    let (_, rotation, _) = world[j].to_scale_rotation_translation();
+                    set.set(i, TrackedJoint { position: *p, orientation: Some(rotation.normalize()), radius: 0.0 });
+                }
+                HandData::Joints(set)
+            }
+            SyntheticFormat::Landmarks => HandData::Landmarks(mediapipe::WEBXR_INDEX.map(|w| positions[w])),
+            SyntheticFormat::Glove(_) => {
+                let (table, calibration) = glove.as_ref().expect("a glove format has its table");
+                HandData::Glove(glove_values(table, calibration, &pose, &mut rng))
+            }
+        };
+        let tracker = glove.as_ref().map(|_| {
+            let (r, p) = pose.wrist.unwrap_or(rest_wrist).to_rotation_translation();
+            let wrist = Affine3A::from_rotation_translation(r, p);
+            let offset = Affine3A::from_rotation_translation(Quat::from_array(mount.q), Vec3::from(mount.p));
+            let (_, orientation, position) = (wrist * offset.inverse()).to_scale_rotation_translation();
+            RigidPose { position, orientation: orientation.normalize() }
+        });
+        records.push(Record { time: t, side: hand.side, hand: Some(record_hand), tracker });
+        truth.push(pose.clone());
+    }
+    Ok(Synthetic { hand, records, truth, labels, idle: (idle_start, end) })
+}
+
+/// A relaxed hand: every finger half curled (neither extended nor curled), the thumb loose.
+fn relaxed(rng: &mut Rng) -> Pose {
+    let mut pose = Pose::rest(JointModel::Full.dof_count());
+    for (d, a) in JointModel::Full.dofs().zip(&mut pose.angles) {
+        let deg = match (d.bone, d.motion) {
+            (b, crate::kinematics::Motion::Flex) if b.starts_with("thumb") => rng.uniform(10.0, 25.0),
+            (b, crate::kinematics::Motion::Flex) if b.ends_with("proximal") => rng.uniform(30.0, 45.0),
+            (b, crate::kinematics::Motion::Flex) if b.ends_with("intermediate") => rng.uniform(40.0, 55.0),
+            (_, crate::kinematics::Motion::Flex) => rng.uniform(15.0, 30.0),
+            (_, crate::kinematics::Motion::Abd) => rng.uniform(-3.0, 3.0),
+        };
+        *a = (deg as f32).to_radians();
+    }
+    pose
+}
+
+/// A turn of up to ±25° about the world vertical (keeps a thumb pointing up or down).
+fn turn_about_y(rng: &mut Rng) -> Quat {
+    Quat::from_rotation_y(rng.uniform(-25.0, 25.0).to_radians() as f32)
+}
+
+fn world_of(rig: &HandRig, pose: &Pose) -> Vec<Affine3A> {
+    let mut locals = rig.skeleton().rest_locals();
+    rig.locals(pose, Limits::Anatomical, &mut locals);
+    let mut world = vec![Affine3A::IDENTITY; locals.len()];
+    forward_kinematics(rig.skeleton(), &locals, &mut world);
+    world
+}
+
+/// Raw glove values that the table maps back to `pose` (each sensor from the first DOF it
+/// drives), with ±8 units of sensor noise.
+fn glove_values(table: &MappingTable, calibration: &Calibration, pose: &Pose, rng: &mut Rng) -> GloveSample {
+    let layout = table.layout();
+    let mut values = [0.0f32; crate::input::MAX_GLOVE_SENSORS];
+    for (i, sensor) in layout.sensors().iter().enumerate() {
+        let c = calibration.sensors.get(&sensor.name);
+        let flat = c.map_or(0.0, |c| c.flat);
+        let full = c.and_then(|c| c.fist.or(c.spread)).unwrap_or(crate::input::RAW_MAX);
+        let n = table
+            .entries()
+            .iter()
+            .find(|e| e.sensor == sensor.name)
+            .and_then(|e| JointModel::Full.dof_index(&e.dof).ok().map(|d| (pose.angles[d].to_degrees() - e.offset_deg) / e.gain_deg))
+            .unwrap_or(0.0);
+        values[i] = (flat + n * (full - flat) + rng.normal() * 8.0).clamp(0.0, crate::input::RAW_MAX);
+    }
+    GloveSample::new(&values[..layout.len()])
+}
