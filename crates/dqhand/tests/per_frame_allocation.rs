@@ -8,8 +8,8 @@ use std::cell::Cell;
 use std::sync::Arc;
 
 use dqhand::engine::Engine;
-use dqhand::gesture::Sequence;
-use dqhand::hand::{build, HandParams};
+use dqhand::gesture::{GestureSet, HandFeatures, JointPositions, Recognizer, Sequence};
+use dqhand::hand::{build, HandParams, Side};
 use dqhand::kinematics::{JointModel, Pose};
 use dqhand::skin::MethodSet;
 use dqhand::stream::{Command, Session};
@@ -76,4 +76,26 @@ fn a_viewer_session_frame_allocates_nothing() {
         session.render(120.0, &mut frame);
     }
     assert_eq!(allocations() - before, 0, "allocations during 30 frames of a move to a gesture");
+}
+
+#[test]
+fn gesture_features_and_recognition_allocate_nothing() {
+    let model = Arc::new(build(&HandParams { vertices: 2000, ..HandParams::default() }).unwrap());
+    let mut engine = Engine::with_joint_model(model, JointModel::Full).unwrap();
+    let joints = JointPositions::new(engine.skeleton()).unwrap();
+    let mut recognizer = Recognizer::new(GestureSet::builtin());
+    let sequence = Sequence::gestures(JointModel::Full);
+    let rest_wrist = engine.rig().unwrap().rest_wrist();
+    let mut pose = Pose::rest(JointModel::Full.dof_count());
+    let mut events = 0;
+    let before = allocations();
+    for f in 0..600 {
+        let t = f as f32 / 30.0;
+        sequence.sample(t, rest_wrist, &mut pose);
+        engine.pose(&pose);
+        let features = HandFeatures::from_positions(&joints.read(engine.world()), Side::Right);
+        events += recognizer.update(f64::from(t), &features).count();
+    }
+    assert_eq!(allocations() - before, 0, "allocations during 600 frames of features and recognition");
+    assert!(events > 10, "the sequence's gestures were recognised: {events} events");
 }

@@ -11,7 +11,7 @@
 //! | `index.curl` … `pinky.curl` | curl | 0–1 | (θ_MCP + θ_PIP + θ_DIP) / 270°, clamped to 1 |
 //! | `thumb.flexion` | flexion | ° | unsigned angle between the thumb's metacarpal and proximal phalanx |
 //! | `index.flexion` … `pinky.flexion` | flexion | ° | signed angle of the proximal phalanx from the metacarpal about the knuckle's lateral axis, + toward the palm |
-//! | `thumb.abduction` … `ring.abduction` | abduction | ° | angle between the finger's proximal phalanx and the next finger's, both projected on the palm plane |
+//! | `thumb.abduction` … `ring.abduction` | abduction | ° | angle between the finger's proximal phalanx and the next finger's, both projected on the palm plane (0 if one is perpendicular to the palm) |
 //! | `index.opposition` … `pinky.opposition` | opposition | hand sizes | thumb tip to that fingertip / hand size |
 //! | `palm.up` | direction | ° | angle between the palm normal (out of the back of the hand) and world up (+Y) |
 //! | `thumb.up` | direction | ° | angle between the thumb (proximal phalanx base to tip) and world up (+Y) |
@@ -207,11 +207,11 @@ impl HandFeatures {
         let mut proximal_on_palm = [Vec3::ZERO; 5];
         for f in 0..5 {
             let joints = if f == 0 { 2 } else { 3 };
-            let bent: f32 = (0..joints).map(|i| bone(f, i).angle_between(bone(f, i + 1))).sum();
+            let bent: f32 = (0..joints).map(|i| angle(bone(f, i), bone(f, i + 1))).sum();
             curl[f] = (bent / if f == 0 { THUMB_FULL_CURL } else { FINGER_FULL_CURL }).min(1.0);
             let (metacarpal, proximal) = (bone(f, 0).normalize(), bone(f, 1).normalize());
             flexion_deg[f] = if f == 0 {
-                metacarpal.angle_between(proximal).to_degrees()
+                angle(metacarpal, proximal).to_degrees()
             } else {
                 // Rotating the metacarpal about n × m turns it toward the palm (−n).
                 let lateral = palm_normal.cross(metacarpal).normalize();
@@ -219,7 +219,7 @@ impl HandFeatures {
             };
             proximal_on_palm[f] = proximal.reject_from_normalized(palm_normal);
         }
-        let abduction_deg = core::array::from_fn(|f| proximal_on_palm[f].angle_between(proximal_on_palm[f + 1]).to_degrees());
+        let abduction_deg = core::array::from_fn(|f| angle(proximal_on_palm[f], proximal_on_palm[f + 1]).to_degrees());
         let hand_size: f32 = (0..4).map(|i| bone(2, i).length()).sum();
         let opposition = core::array::from_fn(|f| p[TIP[0]].distance(p[TIP[f + 1]]) / hand_size);
         let thumb_direction = (p[TIP[0]] - p[CHAIN_START[0] + 1]).normalize();
@@ -234,8 +234,78 @@ impl HandFeatures {
             Feature::Flexion(f) => self.flexion_deg[f as usize],
             Feature::Abduction(f) => self.abduction_deg.get(f as usize).copied().unwrap_or(f32::NAN),
             Feature::Opposition(f) => self.opposition.get((f as usize).wrapping_sub(1)).copied().unwrap_or(f32::NAN),
-            Feature::PalmUp => self.palm_normal.angle_between(Vec3::Y).to_degrees(),
-            Feature::ThumbUp => self.thumb_direction.angle_between(Vec3::Y).to_degrees(),
+            Feature::PalmUp => angle(self.palm_normal, Vec3::Y).to_degrees(),
+            Feature::ThumbUp => angle(self.thumb_direction, Vec3::Y).to_degrees(),
         }
+    }
+}
+
+/// The unsigned angle between two vectors, radians; atan2 keeps it exact near 0 and 180°
+/// (acos of a rounded cosine does not), and gives 0 for a zero vector.
+fn angle(a: Vec3, b: Vec3) -> f32 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::{Feature, Finger, HandFeatures};
+    use crate::hand::Side;
+
+    /// A flat right hand, palm down (dorsal +Y), fingers along −Z; the index chain turned by
+    /// `index_knuckle` toward the palm at its knuckle.
+    fn hand(index_knuckle: f32) -> [Vec3; 25] {
+        let mut p = [Vec3::ZERO; 25];
+        let thumb = Vec3::new(-1.0, 0.0, -1.0).normalize();
+        for (i, d) in [0.01, 0.04, 0.07, 0.095].into_iter().enumerate() {
+            p[1 + i] = Vec3::new(-0.02, 0.0, -0.01) + thumb * d;
+        }
+        for (f, x) in [-0.03f32, -0.01, 0.01, 0.03].into_iter().enumerate() {
+            let base = 5 + 5 * f;
+            p[base] = Vec3::new(x, 0.0, -0.01);
+            p[base + 1] = Vec3::new(x, 0.0, -0.08);
+            let along = if f == 0 { Vec3::new(0.0, -index_knuckle.sin(), -index_knuckle.cos()) } else { -Vec3::Z };
+            for (j, length) in [0.04, 0.025, 0.02].into_iter().enumerate() {
+                p[base + 2 + j] = p[base + 1 + j] + along * length;
+            }
+        }
+        p
+    }
+
+    #[test]
+    fn a_straight_hand_has_no_curl_or_flexion() {
+        let f = HandFeatures::from_positions(&hand(0.0), Side::Right);
+        for finger in Finger::ALL {
+            assert!(f.get(Feature::Curl(finger)).abs() < 1e-5, "{finger:?} {f:?}");
+            assert!(f.get(Feature::Flexion(finger)).abs() < 1e-3, "{finger:?} {f:?}");
+        }
+        assert!((f.hand_size - 0.155).abs() < 1e-6);
+        assert!(f.get(Feature::PalmUp) < 1e-3, "palm down: the back of the hand faces up");
+        assert!((f.get(Feature::ThumbUp) - 90.0).abs() < 1e-3);
+        assert!((f.get(Feature::Abduction(Finger::Thumb)) - 45.0).abs() < 1e-3);
+        assert!(f.get(Feature::Abduction(Finger::Index)).abs() < 1e-3);
+        let tips = (hand(0.0)[4] - hand(0.0)[9]).length();
+        assert!((f.get(Feature::Opposition(Finger::Index)) - tips / 0.155).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_finger_bent_90_degrees_at_the_knuckle_has_flexion_90() {
+        let f = HandFeatures::from_positions(&hand(90f32.to_radians()), Side::Right);
+        assert!((f.get(Feature::Flexion(Finger::Index)) - 90.0).abs() < 1e-3, "{f:?}");
+        assert!((f.get(Feature::Curl(Finger::Index)) - 1.0 / 3.0).abs() < 1e-5, "{f:?}");
+        let back = HandFeatures::from_positions(&hand(-20f32.to_radians()), Side::Right);
+        assert!((back.get(Feature::Flexion(Finger::Index)) + 20.0).abs() < 1e-3, "hyperextension is negative");
+    }
+
+    #[test]
+    fn a_mirrored_left_hand_has_the_same_features() {
+        let mirror = hand(60f32.to_radians()).map(|p| p * Vec3::new(-1.0, 1.0, 1.0));
+        let (left, right) = (HandFeatures::from_positions(&mirror, Side::Left), HandFeatures::from_positions(&hand(60f32.to_radians()), Side::Right));
+        for feature in Feature::ALL {
+            assert!((left.get(feature) - right.get(feature)).abs() < 1e-3, "{}: {} vs {}", feature.name(), left.get(feature), right.get(feature));
+        }
+        assert_eq!(Feature::from_name("pinky.abduction"), None);
+        assert_eq!(Feature::from_name("thumb.up"), Some(Feature::ThumbUp));
     }
 }
