@@ -10,7 +10,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench fuzz clean
+.PHONY: demo test build viewer assets chromium figures bench fuzz clean recordings
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -18,6 +18,20 @@ demo: build viewer
 
 build:
 	$(CARGO) build --release --locked -p dqhand-cli
+
+# Sample recordings of the gesture library: synthetic (made from our own kinematics by
+# `dqhand synthesize`, seeded, labelled so in their .labels.json), not captured from a person.
+RECORDINGS := crates/dqhand/data/recordings
+DQHAND_DEBUG := target/debug/dqhand
+
+recordings: $(RECORDINGS)/gestures-joints.jsonl
+
+$(RECORDINGS)/gestures-joints.jsonl: $(wildcard crates/*/src/*.rs crates/*/src/*/*.rs)
+	$(CARGO) build --locked -p dqhand-cli
+	mkdir -p $(RECORDINGS)
+	$(DQHAND_DEBUG) synthesize --format joints --seed 1 --length 0.18 --breadth 0.08 --side right --out $(RECORDINGS)/gestures-joints.jsonl
+	$(DQHAND_DEBUG) synthesize --format landmarks --seed 3 --length 0.17 --breadth 0.08 --side left --out $(RECORDINGS)/gestures-landmarks.jsonl
+	$(DQHAND_DEBUG) synthesize --format glove --seed 2 --length 0.2 --breadth 0.09 --side right --out $(RECORDINGS)/gestures-glove.csv
 
 # The page (TypeScript + three.js, built by Vite into viewer/dist, which `dqhand demo` serves).
 viewer: $(VIEWER_DIST)
@@ -45,7 +59,7 @@ chromium:
 
 # Rust tests (unit, property, golden, CLI, server), the Khronos glTF validator on what we write,
 # then the page: protocol unit tests and browser tests against a real `dqhand demo`.
-test: assets viewer chromium
+test: assets viewer chromium recordings
 	$(CARGO) test --locked --workspace
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
@@ -77,4 +91,4 @@ bench: build
 
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules viewer/node_modules viewer/dist
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist $(RECORDINGS)

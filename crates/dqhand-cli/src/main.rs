@@ -5,12 +5,16 @@
 
 mod bench;
 mod bench_stream;
+mod calibrate;
 mod demo;
 mod hand;
 mod info;
 mod metrics;
+mod recording;
+mod replay;
 mod server;
 mod skin;
+mod synthesize;
 
 use clap::{Parser, Subcommand};
 
@@ -39,6 +43,13 @@ enum Command {
     /// Realism metrics of LB, QB and DQB: volume, collapse and bulge, candy wrapper,
     /// distortion and continuity over joint sweeps.
     Metrics(metrics::Args),
+    /// Play a recording (glove CSV, joints or landmarks JSON lines) through the gesture loop
+    /// as fast as it goes; gesture events as JSON lines on stdout.
+    Replay(replay::Args),
+    /// Derive a glove calibration from a recording of the calibration poses.
+    Calibrate(calibrate::Args),
+    /// Write a synthetic, labelled recording of the gesture library (from our own kinematics).
+    Synthesize(synthesize::Args),
 }
 
 fn main() {
@@ -50,6 +61,9 @@ fn main() {
         Command::Bench(a) => bench::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Metrics(a) => metrics::run(&a),
+        Command::Replay(a) => replay::run(&a),
+        Command::Calibrate(a) => calibrate::run(&a),
+        Command::Synthesize(a) => synthesize::run(&a),
     };
     if let Err(e) = result {
         eprintln!("dqhand: error: {e:#}");

@@ -175,8 +175,13 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
     keys.push((time, previous, None));
     for k in 0..params.holds {
         if k % names.len() == 0 {
+            let last = k.checked_sub(1).map(|p| names[p % names.len()]);
             for i in (1..names.len()).rev() {
                 names.swap(i, (rng.next_f64() * (i + 1) as f64) as usize);
+            }
+            // The same gesture twice in a row would be one hold.
+            if Some(names[0]) == last {
+                names.swap(0, 1);
             }
         }
         let name = names[k % names.len()];
@@ -270,7 +275,8 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
     Ok(Synthetic { hand, records, truth, labels, idle: (idle_start, end) })
 }
 
-/// A relaxed hand: every finger half curled (neither extended nor curled), the thumb loose.
+/// A relaxed hand: every finger half curled (neither extended nor curled), the thumb loose
+/// and away from the fingertips.
 fn relaxed(rng: &mut Rng) -> Pose {
     let mut pose = Pose::rest(JointModel::Full.dof_count());
     for (d, a) in JointModel::Full.dofs().zip(&mut pose.angles) {
@@ -279,6 +285,7 @@ fn relaxed(rng: &mut Rng) -> Pose {
             (b, crate::kinematics::Motion::Flex) if b.ends_with("proximal") => rng.uniform(30.0, 45.0),
             (b, crate::kinematics::Motion::Flex) if b.ends_with("intermediate") => rng.uniform(40.0, 55.0),
             (_, crate::kinematics::Motion::Flex) => rng.uniform(15.0, 30.0),
+            ("thumb-metacarpal", crate::kinematics::Motion::Abd) => rng.uniform(25.0, 35.0),
             (_, crate::kinematics::Motion::Abd) => rng.uniform(-3.0, 3.0),
         };
         *a = (deg as f32).to_radians();

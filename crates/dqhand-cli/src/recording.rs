@@ -1,0 +1,101 @@
+//! Recordings on disk, and the options every input command shares: which glove, which
+//! calibration, which configuration and gesture definitions.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use dqhand::hand::Side;
+use dqhand::input::json_record::JsonRecordReader;
+use dqhand::input::{Calibration, GloveCsvReader, GloveMapper, InputConfig, MappingTable, Record, Rejection};
+use dqhand::kinematics::JointModel;
+
+/// The file formats of recordings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// Glove CSV: `t`, the glove's sensor columns, optional tracker and hand columns.
+    Glove,
+    /// JSON lines with `joints` (WebXR or OpenXR names) or `landmarks`.
+    Joints,
+    /// JSON lines with MediaPipe `landmarks` (read like `joints`).
+    Landmarks,
+}
+
+/// Input options shared by `replay`, `listen`, `calibrate` and `demo`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct InputArgs {
+    /// The glove's mapping table: `5dt-14`, `5dt-5`, `cyberglove-18` or a JSON file.
+    #[arg(long, default_value = "5dt-14")]
+    pub glove: String,
+    /// The glove's calibration (JSON, from `dqhand calibrate`); default: raw 0 flat, 4095 fist.
+    #[arg(long)]
+    pub calib: Option<PathBuf>,
+    /// Input configuration (filters, dropouts, tracker mount, gesture commands), JSON.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The side of records that do not say.
+    #[arg(long, default_value = "right", value_parser = parse_side)]
+    pub hand: Side,
+}
+
+pub fn parse_side(s: &str) -> Result<Side, String> {
+    match s {
+        "left" => Ok(Side::Left),
+        "right" => Ok(Side::Right),
+        _ => Err(format!("{s:?} is neither left nor right")),
+    }
+}
+
+impl InputArgs {
+    pub fn table(&self) -> anyhow::Result<MappingTable> {
+        Ok(if MappingTable::BUILTIN.contains(&self.glove.as_str()) { MappingTable::builtin(&self.glove)? } else { MappingTable::load(Path::new(&self.glove))? })
+    }
+
+    pub fn mapper(&self, joint_model: JointModel) -> anyhow::Result<GloveMapper> {
+        let table = self.table()?;
+        let calibration = match &self.calib {
+            Some(path) => Calibration::load(path)?,
+            None => Calibration::default_for(&table),
+        };
+        Ok(GloveMapper::new(&table, &calibration, joint_model)?)
+    }
+
+    pub fn config(&self) -> anyhow::Result<InputConfig> {
+        Ok(match &self.config {
+            Some(path) => InputConfig::load(path)?,
+            None => InputConfig::default(),
+        })
+    }
+}
+
+/// A recording being read, record by record.
+pub enum RecordingReader {
+    Json(JsonRecordReader<BufReader<File>>),
+    Glove(GloveCsvReader<BufReader<File>>),
+}
+
+impl RecordingReader {
+    /// Opens `path` as `format`, or by its extension (`.csv` glove, else JSON lines).
+    pub fn open(path: &Path, format: Option<Format>, args: &InputArgs) -> anyhow::Result<Self> {
+        let file = File::open(path).with_context(|| path.display().to_string())?;
+        let reader = BufReader::new(file);
+        let format = format.unwrap_or(if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) { Format::Glove } else { Format::Joints });
+        Ok(match format {
+            Format::Glove => Self::Glove(GloveCsvReader::new(reader, &args.table()?, args.hand).map_err(|e| e.in_file(path))?),
+            Format::Joints | Format::Landmarks => {
+                let sensors = args.table()?.layout().sensors().iter().map(|s| s.name.clone()).collect();
+                Self::Json(JsonRecordReader::new(reader, args.hand, sensors))
+            }
+        })
+    }
+
+    /// The next record: `None` at the end, else the record or its rejection.
+    pub fn next(&mut self, out: &mut Record) -> std::io::Result<Option<Result<(), Rejection>>> {
+        match self {
+            Self::Json(r) => r.next_record(out),
+            Self::Glove(r) => Ok(r.next_record(out)),
+        }
+    }
+}
+

@@ -1,0 +1,136 @@
+//! The gesture loop through the real command: synthesize a labelled recording, replay it,
+//! and check the printed events against the labels; bad records counted, not fatal.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dqhand-replay-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn dqhand<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(args).output().unwrap();
+    assert!(out.status.success(), "dqhand {:?}: {}", args.iter().map(|a| a.as_ref().to_owned()).collect::<Vec<_>>(), String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+fn synthesize(dir: &Path, format: &str, extension: &str, extra: &[&str]) -> (PathBuf, serde_json::Value) {
+    let path = dir.join(format!("rec.{extension}"));
+    let mut args = vec!["synthesize", "--format", format, "--holds", "13", "--idle", "20", "--out", path.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    dqhand(&args);
+    let labels: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path.with_extension("labels.json")).unwrap()).unwrap();
+    assert!(labels["synthetic"].as_str().unwrap().contains("not captured"));
+    (path, labels)
+}
+
+fn events(out: &Output) -> Vec<(f64, String, String)> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            (v["t"].as_f64().unwrap(), v["event"].as_str().unwrap().to_owned(), v["gesture"].as_str().unwrap().to_owned())
+        })
+        .collect()
+}
+
+/// Every labelled hold starts within 150 ms of the pose being reached; idle motion starts
+/// nothing.
+fn check_recognition(out: &Output, labels: &serde_json::Value) {
+    let events = events(out);
+    for hold in labels["holds"].as_array().unwrap() {
+        let (gesture, reached) = (hold["gesture"].as_str().unwrap(), hold["reached"].as_f64().unwrap());
+        let start = events.iter().find(|(t, e, g)| e == "start" && g == gesture && *t > reached - 0.4 && *t <= reached + 0.15);
+        assert!(start.is_some(), "{gesture} reached at {reached} s not recognised within 150 ms: {events:?}");
+    }
+    let idle = labels["idle"][0].as_f64().unwrap() + 0.3;
+    let spurious: Vec<_> = events.iter().filter(|(t, e, _)| e == "start" && *t > idle).collect();
+    assert!(spurious.is_empty(), "idle motion started {spurious:?}");
+}
+
+#[test]
+fn joints_and_landmarks_recordings_print_the_labelled_gestures() {
+    let dir = temp_dir("joints");
+    for (format, hand) in [("joints", "right"), ("landmarks", "left")] {
+        let (path, labels) = synthesize(&dir, format, "jsonl", &["--seed", "5", "--length", "0.17", "--breadth", "0.08", "--side", hand]);
+        let poses = dir.join("poses.jsonl");
+        let out = dqhand(&["replay", "--input", path.to_str().unwrap(), "--gestures", "--stats", "--out", poses.to_str().unwrap()]);
+        check_recognition(&out, &labels);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("0 rejected"), "{stderr}");
+        assert!(stderr.contains("length 0.17"), "the user's hand is measured: {stderr}");
+        let first: serde_json::Value = serde_json::from_str(std::fs::read_to_string(&poses).unwrap().lines().next().unwrap()).unwrap();
+        assert_eq!(first["model"], "full");
+        assert!(first["t"].is_number() && first["wrist"].is_object() && first["tracking"] == "tracking");
+    }
+}
+
+/// A glove recording drives the hand: the finger gestures a 14-sensor glove can tell apart.
+#[test]
+fn a_glove_recording_prints_its_finger_gestures() {
+    let dir = temp_dir("glove");
+    let (path, labels) = synthesize(&dir, "glove", "csv", &["--seed", "4", "--side", "right"]);
+    let out = dqhand(&["replay", "--input", path.to_str().unwrap(), "--gestures"]);
+    let events = events(&out);
+    // The 5DT has no thumb CMC flexion or thumb-tip sensing: only the finger-defined gestures.
+    for hold in labels["holds"].as_array().unwrap() {
+        let (gesture, reached) = (hold["gesture"].as_str().unwrap(), hold["reached"].as_f64().unwrap());
+        if ["fist", "point", "victory", "three", "four"].contains(&gesture) {
+            assert!(events.iter().any(|(t, e, g)| e == "start" && g == gesture && (*t - reached).abs() < 0.5), "{gesture} at {reached}: {events:?}");
+        }
+    }
+}
+
+/// `calibrate` finds the flat, fist and spread readings of a calibration recording, and the
+/// calibration it writes is what a replay then uses.
+#[test]
+fn calibrate_writes_the_extremes_of_the_calibration_poses() {
+    let dir = temp_dir("calibrate");
+    let sensors = ["thumb_near", "thumb_far", "thumb_index", "index_near", "index_far", "index_middle", "middle_near", "middle_far", "middle_ring", "ring_near", "ring_far", "ring_little", "little_near", "little_far"];
+    let abduction = |s: &str| ["thumb_index", "index_middle", "middle_ring", "ring_little"].contains(&s);
+    let mut csv = format!("t,{}\n", sensors.join(","));
+    for (k, (flex, abd)) in [(600.0, 700.0), (3400.0, 700.0), (600.0, 2900.0)].iter().enumerate() {
+        for i in 0..20 {
+            let t = (k * 20 + i) as f64 * 0.02;
+            let values: Vec<String> = sensors.iter().map(|s| format!("{}", if abduction(s) { abd } else { flex } + (i % 3) as f64)).collect();
+            csv += &format!("{t},{}\n", values.join(","));
+        }
+    }
+    let path = dir.join("calibration.csv");
+    std::fs::write(&path, csv).unwrap();
+    let calib = dir.join("calib.json");
+    dqhand(&["calibrate", "--input", path.to_str().unwrap(), "--out", calib.to_str().unwrap()]);
+    let c: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&calib).unwrap()).unwrap();
+    let index = &c["sensors"]["index_near"];
+    assert!((index["flat"].as_f64().unwrap() - 601.0).abs() <= 2.0 && (index["fist"].as_f64().unwrap() - 3401.0).abs() <= 2.0, "{c}");
+    let spread = &c["sensors"]["index_middle"];
+    assert!((spread["flat"].as_f64().unwrap() - 701.0).abs() <= 2.0 && (spread["spread"].as_f64().unwrap() - 2901.0).abs() <= 2.0, "{c}");
+    dqhand(&["replay", "--input", path.to_str().unwrap(), "--calib", calib.to_str().unwrap()]);
+}
+
+/// Bad records are counted per kind on stderr; the good ones still drive the hand.
+#[test]
+fn bad_records_are_summarised_and_skipped() {
+    let dir = temp_dir("bad");
+    let (path, _) = synthesize(&dir, "joints", "jsonl", &["--seed", "6", "--side", "right"]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    lines.insert(10, "{\"t\": 0.1, \"joints\": {\"wrist\"".into());
+    lines.insert(20, lines[5].clone()); // time going backwards
+    lines.insert(30, lines[31].replace("\"wrist\"", "\"wrist-bone\""));
+    let bad = dir.join("bad.jsonl");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let out = dqhand(&["replay", "--input", bad.to_str().unwrap(), "--gestures"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for needle in ["1 record rejected (malformed), first: line 11", "1 record rejected (unknown name), first: line 31", "1 record rejected (out of order)", "3 rejected"] {
+        assert!(stderr.contains(needle), "{needle:?} not in {stderr}");
+    }
+    assert!(!events(&out).is_empty());
+    // A file that is not there is one clear error.
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["replay", "--input", "/no/such.jsonl"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.jsonl"));
+}
