@@ -18,7 +18,10 @@ export function dqhandBin() {
   return existsSync(release) ? release : path.join(root, 'target/debug/dqhand');
 }
 
-/** Starts the viewer server; resolves once it prints its URL. */
+/**
+ * Starts the viewer server; resolves once it prints its URL.
+ * @param {{ port?: number, args?: string[] }} [options] - `args`: more `dqhand demo` arguments (e.g. `--input FILE`)
+ */
 export function startServer({ port = 0, args = [] } = {}) {
   const child = spawn(dqhandBin(), ['demo', '--no-open', '--port', String(port), '--viewer', path.join(root, 'viewer/dist'), ...args], {
     stdio: ['ignore', 'pipe', 'inherit'],

@@ -3,13 +3,15 @@
 
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand,
-  type Command, type Frame, type Hello, type Topology,
+  type Command, type Frame, type Hello, type InputMessage, type Topology,
 } from './protocol';
 
 export interface ConnectionEvents {
   hello(hello: Hello): void;
   topology(topology: Topology): void;
   frame(frame: Frame): void;
+  /** The live input's state changed (only when the hello announces an input). */
+  input(message: InputMessage): void;
   error(message: string): void;
   status(connected: boolean): void;
 }
@@ -51,6 +53,7 @@ export class Connection {
       if (typeof data === 'string') {
         const message = decodeText(data);
         if (message.type === 'hello') this.events.hello(message);
+        else if (message.type === 'input') this.events.input(message);
         else this.events.error(message.message);
         return;
       }
@@ -75,7 +78,12 @@ export class Connection {
 
   /** Sends a setting and remembers it for the next session (view, heat map, limits, model). */
   setting(command: Command): void {
-    this.settings.set(command.type, command);
+    this.remember(command);
     this.send(command);
+  }
+
+  /** Remembers a setting the engine already has (it changed it itself, e.g. on a gesture) without sending it. */
+  remember(command: Command): void {
+    this.settings.set(command.type, command);
   }
 }

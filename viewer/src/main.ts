@@ -2,7 +2,8 @@
 
 import './style.css';
 import { Connection } from './connection';
-import { type Command, type Frame, type Hello, type Method, METHODS } from './protocol';
+import { InputPanel } from './input';
+import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS } from './protocol';
 import { HandScene } from './scene';
 import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
 
@@ -12,6 +13,7 @@ const figure = params.has('figure');
 document.body.classList.toggle('figure', figure);
 
 const scene = new HandScene($<HTMLCanvasElement>('view'));
+const inputPanel = new InputPanel($);
 const errors: string[] = [];
 let hello: Hello | null = null;
 let frame: Frame | null = null;
@@ -33,19 +35,25 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
     const select = $<HTMLSelectElement>('joint-model');
     select.replaceChildren(...h.joint_models.map((m) => new Option(`${m} (${m === h.joint_model ? h.dofs.length + ' DOF' : '…'})`, m, false, m === h.joint_model)));
     $<HTMLInputElement>('timeline').max = String(h.sequence.duration);
+    inputPanel.setSource(h.input);
   },
   topology(t) {
     scene.setTopology(t);
   },
   frame(f) {
     frame = f;
+    followView(f.header);
     scene.showFrame(f);
+  },
+  input(message) {
+    inputPanel.update(message);
   },
   error(message) {
     errors.push(message);
     status(`engine: ${message}`, 'error');
   },
   status(connected) {
+    if (connected) inputPanel.reset();
     status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
 });
@@ -63,6 +71,31 @@ $('heatmap').addEventListener('change', () => {
   $('legend').hidden = !on;
   connection.setting({ type: 'heatmap', on });
 });
+
+/** The methods and heat map of the previous frame ('' and null before the first). */
+let viewShown = '';
+let heatmapShown: boolean | null = null;
+/**
+ * Moves the skinning controls to what the frames show when that changes, whoever changed it
+ * (the engine does on an input gesture's action), and remembers it as the settings to replay
+ * after a reconnect. Only changes count: a click's own change arrives a few frames later.
+ */
+function followView(h: FrameHeader): void {
+  const view = h.methods.join();
+  if (view !== viewShown) {
+    viewShown = view;
+    const split = h.methods.length > 1;
+    $<HTMLInputElement>('split').checked = split;
+    if (!split) $<HTMLInputElement>(`method-${h.methods[0]}`).checked = true;
+    connection.remember({ type: 'view', methods: [...h.methods] });
+  }
+  if (h.distortion !== heatmapShown) {
+    heatmapShown = h.distortion;
+    $<HTMLInputElement>('heatmap').checked = h.distortion;
+    $('legend').hidden = !h.distortion;
+    connection.remember({ type: 'heatmap', on: h.distortion });
+  }
+}
 $('wireframe').addEventListener('change', () => scene.setWireframe($<HTMLInputElement>('wireframe').checked));
 $('skeleton').addEventListener('change', () => (scene.showSkeleton = $<HTMLInputElement>('skeleton').checked));
 $('limits').addEventListener('change', () => {
@@ -214,6 +247,8 @@ window.dqhand = {
     joints: hello ? [...hello.joints] : [],
     pageFps,
     visible: scene.visibleMethods(),
+    /** The live input, null without one: tracking, the gesture now, record totals, the event log (newest first). */
+    input: inputPanel.state(),
     geometries: scene.renderer.info.memory.geometries,
     frame: frame && {
       sequence: frame.header.sequence,

@@ -1,5 +1,5 @@
 // The stream's wire format, version 1 (crates/dqhand/src/stream/frame.rs is the reference):
-// a topology message once, then binary frames; JSON text for hello, errors and commands.
+// a topology message once, then binary frames; JSON text for hello, input state, errors and commands.
 // Arrays are 4-byte aligned, so they are read as typed-array views without copying.
 
 export const VERSION = 1;
@@ -79,9 +79,55 @@ export interface Hello {
   methods: Method[];
   gesture_seconds: number;
   max_message_bytes: number;
+  /** The live input driving the hand, or null when the demo has none (an older server omits it: null). */
+  input: HelloInput | null;
 }
 
-export type ServerText = Hello | { type: 'error'; message: string };
+/** The hello's description of the live input (`dqhand demo --input FILE` or `--udp PORT`). */
+export interface HelloInput {
+  /** Where the records come from, for display: a recording's path, or e.g. `udp 127.0.0.1:9000`. */
+  source: string;
+  /** The gestures the recogniser knows, by name. */
+  gestures: string[];
+}
+
+export const TRACKING_STATES = ['waiting', 'tracking', 'lost'] as const;
+/** The input's tracking: no record yet, records arriving, or none for longer than the grace period. */
+export type Tracking = (typeof TRACKING_STATES)[number];
+export const INPUT_ACTIONS = ['next_method', 'split_view', 'toggle_heatmap'] as const;
+export type InputAction = (typeof INPUT_ACTIONS)[number];
+
+/** A recognised gesture starting or ending, at `t` seconds of the input's clock. */
+export interface GestureEvent {
+  t: number;
+  event: 'start' | 'end';
+  gesture: string;
+}
+
+/** An action the server applied because of a gesture, at `t` seconds of the input's clock. */
+export interface ActionEvent {
+  t: number;
+  gesture: string;
+  action: InputAction;
+}
+
+/** The input's state, sent when something in it changes (at most once per frame). */
+export interface InputMessage {
+  type: 'input';
+  tracking: Tracking;
+  /** The gesture recognised now, or null. */
+  gesture: string | null;
+  /** Gesture starts and ends since the previous input message. */
+  events: GestureEvent[];
+  /** Actions applied since the previous input message. */
+  actions: ActionEvent[];
+  /** Records accepted since the input started (a running total). */
+  accepted: number;
+  /** Records refused since the input started (a running total). */
+  rejected: number;
+}
+
+export type ServerText = Hello | InputMessage | { type: 'error'; message: string };
 
 /** Which binary message this is, from its magic; null if neither. */
 export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
@@ -190,8 +236,50 @@ export function decodeText(text: string): ServerText {
     throw new ProtocolError(`text message is not JSON: ${(e as Error).message}`);
   }
   const type = (value as { type?: unknown } | null)?.type;
-  if (type !== 'hello' && type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
+  if (type === 'hello') return checkHello(value as Record<string, unknown>);
+  if (type === 'input') return checkInput(value as Record<string, unknown>);
+  if (type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
   return value as ServerText;
+}
+
+const isObject = (v: unknown): v is Record<string, unknown> => typeof v === 'object' && v !== null && !Array.isArray(v);
+const isString = (v: unknown): v is string => typeof v === 'string';
+const isCount = (v: unknown): v is number => typeof v === 'number' && Number.isSafeInteger(v) && v >= 0;
+const isTime = (v: unknown): v is number => typeof v === 'number' && Number.isFinite(v);
+const oneOf = <T extends string>(values: readonly T[], v: unknown): v is T => values.includes(v as T);
+
+/** The hello with its `input` checked (the rest is trusted, as before): null or a source and gesture names. */
+function checkHello(value: Record<string, unknown>): Hello {
+  const input = value.input ?? null;
+  if (input !== null && !(isObject(input) && isString(input.source) && Array.isArray(input.gestures) && input.gestures.every(isString))) {
+    throw new ProtocolError(`hello: input ${JSON.stringify(input)} is neither null nor {source, gestures}`);
+  }
+  return { ...value, input } as unknown as Hello;
+}
+
+/** Checks every field of an input message; the message names the first bad one. */
+function checkInput(v: Record<string, unknown>): InputMessage {
+  const bad = (field: string, value: unknown) => new ProtocolError(`input message: ${field} ${JSON.stringify(value)}`);
+  if (!oneOf(TRACKING_STATES, v.tracking)) throw bad('tracking', v.tracking);
+  if (v.gesture !== null && !isString(v.gesture)) throw bad('gesture', v.gesture);
+  if (!Array.isArray(v.events)) throw bad('events', v.events);
+  v.events.forEach((e: unknown, i) => {
+    if (!(isObject(e) && isTime(e.t) && (e.event === 'start' || e.event === 'end') && isString(e.gesture))) throw bad(`events[${i}]`, e);
+  });
+  if (!Array.isArray(v.actions)) throw bad('actions', v.actions);
+  v.actions.forEach((a: unknown, i) => {
+    if (!(isObject(a) && isTime(a.t) && isString(a.gesture) && oneOf(INPUT_ACTIONS, a.action))) throw bad(`actions[${i}]`, a);
+  });
+  if (!isCount(v.accepted)) throw bad('accepted', v.accepted);
+  if (!isCount(v.rejected)) throw bad('rejected', v.rejected);
+  const events = v.events as GestureEvent[];
+  const actions = v.actions as ActionEvent[];
+  return {
+    type: 'input', tracking: v.tracking, gesture: v.gesture as string | null,
+    events: events.map(({ t, event, gesture }) => ({ t, event, gesture })),
+    actions: actions.map(({ t, gesture, action }) => ({ t, gesture, action })),
+    accepted: v.accepted, rejected: v.rejected,
+  };
 }
 
 /** The commands the engine accepts (crates/dqhand/src/stream/command.rs). */

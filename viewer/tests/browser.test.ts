@@ -1,10 +1,12 @@
 // The real page in headless Chromium against a real `dqhand demo`: it loads and draws, the
 // controls reach the engine and come back as the right change on screen, and it survives a
-// server restart.
+// server restart; and, with a recorded live input, that the Input panel follows it.
 
+import { spawnSync } from 'node:child_process';
+import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, onTestFinished, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
-import { canvasStats, countColour, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, dqhandBin, launchBrowser, root, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 let server: Server;
@@ -19,6 +21,8 @@ interface State {
   visible: string[];
   /** Geometries the renderer holds on the GPU. */
   geometries: number;
+  errors: string[];
+  input: { source: string; gestures: string[]; tracking: string; gesture: string | null; accepted: number; rejected: number; log: string[] } | null;
   /** `wrist`: translation xyz (m), rotation xyzw, as the engine reports it. */
   frame: { methods: string[]; anglesDeg: number[]; joints: number[]; wrist: number[]; playing: boolean } | null;
 }
@@ -73,6 +77,8 @@ describe('the viewer page', () => {
     const s = await state();
     expect(s.frame!.playing).toBe(true);
     expect(s.dofs).toHaveLength(23);
+    expect(s.input).toBeNull(); // no input: no Input panel
+    expect(await page.locator('#input-panel').isVisible()).toBe(false);
     await settle(page);
     const stats = await canvasStats(page);
     const covered = stats.strips[0] / (stats.width * stats.height);
@@ -187,6 +193,23 @@ describe('the viewer page', () => {
     await waitState(page, 's.visible.length === 3');
   });
 
+  test('the skinning controls follow a change the engine makes itself (as on an input gesture)', async () => {
+    const checked = (id: string) => page.locator(`#${id}`).isChecked();
+    // `send`, not `setting`: the page's controls learn of it from the frames only.
+    await send({ type: 'view', methods: ['qb'] });
+    await send({ type: 'heatmap', on: true });
+    await waitState(page, 's.visible.join() === "qb" && s.frame.distortion');
+    await settle(page);
+    expect([await checked('split'), await checked('method-qb'), await checked('heatmap')]).toEqual([false, true, true]);
+    expect(await page.locator('#legend').isVisible()).toBe(true);
+    await send({ type: 'view', methods: ['lb', 'qb', 'dqb'] });
+    await send({ type: 'heatmap', on: false });
+    await waitState(page, 's.visible.length === 3 && !s.frame.distortion');
+    await settle(page);
+    expect([await checked('split'), await checked('heatmap')]).toEqual([true, false]);
+    expect(await page.locator('#legend').isVisible()).toBe(false);
+  });
+
   test('the page reconnects after the server restarts, with its settings', async () => {
     await restartServer(async () => expect(await page.locator('#status').textContent()).toMatch(/reconnecting/));
   });
@@ -199,5 +222,130 @@ describe('the viewer page', () => {
     await settle(page);
     expect((await state()).geometries).toBe(before);
     await page.uncheck('#skeleton');
+  });
+});
+
+describe('the Input panel, on input messages put into the real stream', () => {
+  let p: Page;
+  /** Sends a text message to the page as if from the engine (set once the page's socket opens). */
+  let toPage: (message: string) => void = () => {};
+  const input = (fields: object) => toPage(JSON.stringify({ type: 'input', events: [], actions: [], accepted: 0, rejected: 0, ...fields }));
+  const inputState = () => p.evaluate(() => (window as unknown as { dqhand: { state(): State } }).dqhand.state());
+
+  beforeAll(async () => {
+    p = await browser.newPage({ viewport: { width: 900, height: 520 } });
+    p.on('pageerror', (e) => console.error('page error:', e.message));
+    // The engine's messages pass through, its hello announcing an input.
+    await p.routeWebSocket(/\/stream$/, (ws) => {
+      const engine = ws.connectToServer();
+      engine.onMessage((m) => {
+        if (typeof m === 'string' && JSON.parse(m).type === 'hello') {
+          m = JSON.stringify({ ...JSON.parse(m), input: { source: 'udp 127.0.0.1:9000', gestures: ['open_palm', 'fist', 'thumbs_up'] } });
+        }
+        ws.send(m);
+      });
+      ws.onMessage((m) => engine.send(m));
+      toPage = (m) => ws.send(m);
+    });
+    await p.goto(server.url);
+    await waitState(p, 's.connected && s.framesReceived > 3 && s.input !== null');
+  });
+
+  afterAll(async () => {
+    await p?.close();
+  });
+
+  test('shows source, tracking, the gesture now, the counts and the log, newest first', async () => {
+    expect(await p.locator('#input-panel').isVisible()).toBe(true);
+    expect(await p.locator('#input-source').textContent()).toBe('udp 127.0.0.1:9000');
+    expect(await p.locator('#tracking').textContent()).toBe('waiting for input');
+    expect(await p.locator('#gesture-now').textContent()).toBe('—');
+    input({ tracking: 'tracking', gesture: 'fist', events: [{ t: 1.25, event: 'start', gesture: 'fist' }], accepted: 10 });
+    await waitState(p, 's.input.gesture === "fist"');
+    expect(await p.locator('#gesture-now').textContent()).toBe('fist');
+    expect(await p.locator('#tracking').textContent()).toBe('tracking');
+    input({
+      tracking: 'lost', gesture: null, accepted: 1234, rejected: 5,
+      events: [{ t: 2, event: 'end', gesture: 'fist' }, { t: 1.8, event: 'start', gesture: 'thumbs_up' }],
+      actions: [{ t: 1.8, gesture: 'thumbs_up', action: 'next_method' }],
+    });
+    await waitState(p, 's.input.tracking === "lost"');
+    const s = (await inputState()).input!;
+    expect(s).toMatchObject({ gesture: null, accepted: 1234, rejected: 5 });
+    expect(s.log).toEqual(['2.00  end fist', '1.80  thumbs_up → next_method', '1.80  start thumbs_up', '1.25  start fist']);
+    expect(await p.locator('#input-log li').allTextContents()).toEqual(s.log);
+    expect(await p.locator('#tracking-lost').isVisible()).toBe(true);
+    expect(await p.locator('#tracking').textContent()).toBe('tracking lost');
+    expect(await p.locator('#gesture-now').textContent()).toBe('—');
+    expect(await p.locator('#input-accepted').textContent()).toMatch(/^1\D?234$/); // grouped as the locale groups
+    input({ tracking: 'tracking', gesture: 'open_palm', events: Array.from({ length: 40 }, (_, k) => ({ t: 3 + k, event: 'start', gesture: 'open_palm' })) });
+    await waitState(p, 's.input.tracking === "tracking" && s.input.log[0] === "42.00  start open_palm"');
+    expect(await p.locator('#input-log li').count()).toBe(30);
+    expect(await p.locator('#tracking-lost').isVisible()).toBe(false);
+  });
+
+  test('a malformed input message is shown as an error and changes nothing', async () => {
+    const before = (await inputState()).input;
+    input({ tracking: 'searching', gesture: 'fist' });
+    await waitState(p, 's.errors.some((e) => e.includes("tracking \\"searching\\""))');
+    expect(await p.locator('#status').textContent()).toMatch(/input message: tracking "searching"/);
+    expect((await inputState()).input).toEqual(before);
+    const frames = (await inputState()).framesReceived;
+    await waitState(p, `s.framesReceived > ${frames + 3}`); // the stream goes on
+  });
+});
+
+/** A synthetic recording of the gesture library, as tracked joints. */
+const RECORDING = path.join(root, 'crates/dqhand/data/recordings/gestures-joints.jsonl');
+
+describe('the viewer page with a recorded input', () => {
+  /** Whether this dqhand's demo takes `--input` (checked once; the test is skipped, saying so, when not). */
+  let supportsInput = false;
+  let inputServer: Server | null = null;
+  let inputPage: Page | null = null;
+
+  beforeAll(async () => {
+    const help = spawnSync(dqhandBin(), ['demo', '--help'], { encoding: 'utf8' });
+    supportsInput = /--input\b/.test(`${help.stdout}${help.stderr}`);
+    if (!supportsInput) return;
+    inputServer = await startServer({ args: ['--input', RECORDING] });
+    inputPage = await browser.newPage({ viewport: { width: 900, height: 520 } });
+    inputPage.on('pageerror', (e) => console.error('page error:', e.message));
+    await inputPage.goto(inputServer.url);
+  });
+
+  afterAll(async () => {
+    await inputPage?.close();
+    await inputServer?.stop();
+  });
+
+  test('shows the source, tracking, the recognised gesture and its events, and the sliders follow the hand', async ({ skip }) => {
+    skip(!supportsInput, `${dqhandBin()} demo has no --input option (the server side of live input has not landed)`);
+    const p = inputPage!;
+    await waitState(p, 's.connected && s.framesReceived > 3 && s.input !== null');
+    expect(await p.locator('#input-panel').isVisible()).toBe(true);
+    expect(await p.locator('#input-source').textContent()).toContain('gestures-joints.jsonl');
+    await waitState(p, 's.input.tracking === "tracking"', 30_000);
+    expect(await p.locator('#tracking').textContent()).toBe('tracking');
+    // A gesture of the library recognised (shown in the panel as it is in the state) and its start logged.
+    await waitState(
+      p,
+      's.input.gestures.includes(s.input.gesture) && document.getElementById("gesture-now").textContent === s.input.gesture' +
+        ' && s.input.log.some((line) => line.includes(" start "))',
+      15_000,
+    );
+    const s = await p.evaluate(() => (window as unknown as { dqhand: { state(): { input: { accepted: number; log: string[] }; errors: string[] } } }).dqhand.state());
+    expect(s.input.accepted).toBeGreaterThan(0);
+    expect(s.input.log[0]).toMatch(/^\d+\.\d\d {2}/);
+    expect(await p.locator('#input-log li').count()).toBe(s.input.log.length);
+    // The joint sliders show the pose the input drives (once it holds a bent pose, to the degree).
+    await waitState(
+      p,
+      's.frame.anglesDeg.some((a) => Math.abs(a) > 20) && s.frame.anglesDeg.every((a, i) => {' +
+        ' const el = document.querySelector(`input[data-dof="${s.dofs[i]}"]`);' +
+        ' return el && Math.abs(Number(el.value) - Math.min(Math.max(Math.round(a), Number(el.min)), Number(el.max))) <= 1; })',
+      15_000,
+    );
+    expect(s.errors).toEqual([]);
   });
 });

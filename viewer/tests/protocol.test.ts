@@ -3,7 +3,8 @@
 
 import { readFileSync } from 'node:fs';
 import { describe, expect, test } from 'vitest';
-import { binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, ProtocolError } from '../src/protocol';
+import { InputLog, LOG_LENGTH } from '../src/input';
+import { binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, type InputMessage, ProtocolError } from '../src/protocol';
 
 const fixture = (name: string): ArrayBuffer => {
   const bytes = readFileSync(new URL(`./fixtures/${name}`, import.meta.url));
@@ -86,5 +87,80 @@ describe('text messages and commands', () => {
       '{"type":"angle","dof":"index-finger-phalanx-intermediate.flex","deg":90}',
     );
     expect(JSON.parse(encodeCommand({ type: 'view', methods: ['lb', 'qb', 'dqb'] }))).toEqual({ type: 'view', methods: ['lb', 'qb', 'dqb'] });
+  });
+});
+
+describe('live input', () => {
+  const good = {
+    type: 'input', tracking: 'tracking', gesture: 'fist',
+    events: [{ t: 1.25, event: 'start', gesture: 'fist' }, { t: 1.0, event: 'end', gesture: 'open_palm' }],
+    actions: [{ t: 1.8, gesture: 'thumbs_up', action: 'next_method' }],
+    accepted: 1234, rejected: 5,
+  };
+  const text = (edit: Record<string, unknown> = {}) => JSON.stringify({ ...good, ...edit });
+
+  test('an input message is parsed with every field', () => {
+    expect(decodeText(text())).toEqual(good);
+    const quiet = decodeText(text({ tracking: 'lost', gesture: null, events: [], actions: [] })) as InputMessage;
+    expect(quiet).toMatchObject({ tracking: 'lost', gesture: null, events: [], actions: [], accepted: 1234 });
+  });
+
+  test('a malformed input message is refused, naming the field', () => {
+    const cases: [string, RegExp][] = [
+      [text({ tracking: 'searching' }), /tracking "searching"/],
+      [text({ tracking: undefined }), /tracking undefined/],
+      [text({ gesture: 3 }), /gesture 3/],
+      [text({ events: null }), /events null/],
+      [text({ events: [{ t: 1, event: 'begin', gesture: 'fist' }] }), /events\[0\]/],
+      [text({ events: [{ t: '1', event: 'start', gesture: 'fist' }] }), /events\[0\]/],
+      [text({ actions: [{ t: 1, gesture: 'fist', action: 'explode' }] }), /actions\[0\]/],
+      [text({ actions: undefined }), /actions undefined/],
+      [text({ accepted: -1 }), /accepted -1/],
+      [text({ rejected: 1.5 }), /rejected 1.5/],
+    ];
+    for (const [t, message] of cases) {
+      expect(() => decodeText(t)).toThrow(ProtocolError);
+      expect(() => decodeText(t)).toThrow(message);
+    }
+  });
+
+  test('the hello\'s input is null, absent (an older server: null) or a source and gesture names', () => {
+    const hello = (input: unknown) => JSON.stringify({ type: 'hello', version: 1, ...(input === undefined ? {} : { input }) });
+    expect(decodeText(hello(undefined))).toMatchObject({ input: null });
+    expect(decodeText(hello(null))).toMatchObject({ input: null });
+    const input = { source: 'udp 127.0.0.1:9000', gestures: ['open_palm', 'fist'] };
+    expect(decodeText(hello(input))).toMatchObject({ input });
+    expect(() => decodeText(hello({ source: 'x' }))).toThrow(/hello: input/);
+    expect(() => decodeText(hello({ source: 1, gestures: [] }))).toThrow(/hello: input/);
+    expect(() => decodeText(hello('udp'))).toThrow(/hello: input/);
+  });
+
+  test('the event log puts the newest first, an action after the event that caused it', () => {
+    const log = new InputLog();
+    log.add({ events: [{ t: 0.5, event: 'start', gesture: 'open_palm' }], actions: [] });
+    log.add({
+      events: [{ t: 1.8, event: 'start', gesture: 'thumbs_up' }, { t: 1.75, event: 'end', gesture: 'open_palm' }],
+      actions: [{ t: 1.8, gesture: 'thumbs_up', action: 'next_method' }],
+    });
+    expect(log.lines).toEqual([
+      '1.80  thumbs_up → next_method',
+      '1.80  start thumbs_up',
+      '1.75  end open_palm',
+      '0.50  start open_palm',
+    ]);
+    log.add({ events: [], actions: [] });
+    expect(log.lines).toHaveLength(4);
+  });
+
+  test('the event log keeps the latest 30 entries', () => {
+    const log = new InputLog();
+    expect(LOG_LENGTH).toBe(30);
+    for (let i = 0; i < 25; i++) log.add({ events: [{ t: i, event: 'start', gesture: 'fist' }], actions: [] });
+    log.add({ events: Array.from({ length: 10 }, (_, k) => ({ t: 25 + k, event: 'end' as const, gesture: 'fist' })), actions: [] });
+    expect(log.lines).toHaveLength(30);
+    expect(log.lines[0]).toBe('34.00  end fist');
+    expect(log.lines[29]).toBe('5.00  start fist');
+    log.clear();
+    expect(log.lines).toEqual([]);
   });
 });

@@ -1,0 +1,90 @@
+// The live input (`dqhand demo --input FILE` or `--udp PORT`) as the page shows it: source,
+// tracking, the gesture recognised now, record counters and a log of gesture events and the
+// actions they triggered. `InputLog` holds no DOM, so the tests run it in Node.
+
+import type { HelloInput, InputMessage, Tracking } from './protocol';
+
+/** Entries the event log keeps. */
+export const LOG_LENGTH = 30;
+
+/** What the tracking badge says for each state. */
+const TRACKING_TEXT: Record<Tracking, string> = { waiting: 'waiting for input', tracking: 'tracking', lost: 'tracking lost' };
+
+/** The event log: one line per gesture event or action, newest first, at most `capacity` lines. */
+export class InputLog {
+  /** The lines, newest first. */
+  readonly lines: string[] = [];
+
+  constructor(readonly capacity = LOG_LENGTH) {}
+
+  /**
+   * Adds a message's events and actions, in time order (an event before an action at the same
+   * time: the gesture's start triggers the action), so that the latest ends up first.
+   */
+  add(message: Pick<InputMessage, 'events' | 'actions'>): void {
+    const entries = [
+      ...message.events.map((e) => ({ t: e.t, order: 0, text: `${e.t.toFixed(2)}  ${e.event} ${e.gesture}` })),
+      ...message.actions.map((a) => ({ t: a.t, order: 1, text: `${a.t.toFixed(2)}  ${a.gesture} → ${a.action}` })),
+    ].sort((a, b) => a.t - b.t || a.order - b.order);
+    for (const e of entries) this.lines.unshift(e.text);
+    this.lines.length = Math.min(this.lines.length, this.capacity);
+  }
+
+  clear(): void {
+    this.lines.length = 0;
+  }
+}
+
+/** The page's Input panel (hidden unless the hello announces an input) and the stage's "tracking lost" banner. */
+export class InputPanel {
+  /** The hello's input, or null when the demo has none. */
+  source: HelloInput | null = null;
+  tracking: Tracking = 'waiting';
+  gesture: string | null = null;
+  accepted = 0;
+  rejected = 0;
+  readonly log = new InputLog();
+
+  constructor(private readonly $: (id: string) => HTMLElement) {}
+
+  /** Shows or hides the panel for a hello's input (a hello also comes after a joint-model change: the log stays). */
+  setSource(input: HelloInput | null): void {
+    this.source = input;
+    this.$('input-panel').hidden = input === null;
+    this.$('input-source').textContent = input?.source ?? '';
+    this.$('input-gestures').textContent = input ? `recognises ${input.gestures.join(', ')}` : '';
+    this.render();
+  }
+
+  /** Forgets the previous session's state (its counters and times restart with the new one). */
+  reset(): void {
+    Object.assign(this, { tracking: 'waiting', gesture: null, accepted: 0, rejected: 0 });
+    this.log.clear();
+    this.render();
+  }
+
+  update(message: InputMessage): void {
+    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, accepted: message.accepted, rejected: message.rejected });
+    this.log.add(message);
+    this.render();
+  }
+
+  private render(): void {
+    const badge = this.$('tracking');
+    badge.textContent = TRACKING_TEXT[this.tracking];
+    badge.className = `badge ${this.tracking}`;
+    this.$('tracking-lost').hidden = this.source === null || this.tracking !== 'lost';
+    this.$('gesture-now').textContent = this.gesture ?? '—';
+    this.$('input-accepted').textContent = this.accepted.toLocaleString();
+    this.$('input-rejected').textContent = this.rejected.toLocaleString();
+    const list = this.$('input-log');
+    list.replaceChildren(...this.log.lines.map((line) => Object.assign(document.createElement('li'), { textContent: line })));
+  }
+
+  /** The test hook's view: null without an input. */
+  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; accepted: number; rejected: number; log: string[] } | null {
+    if (!this.source) return null;
+    const { tracking, gesture, accepted, rejected } = this;
+    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, accepted, rejected, log: [...this.log.lines] };
+  }
+}
