@@ -47,9 +47,14 @@ pub fn parse_side(s: &str) -> Result<Side, String> {
     }
 }
 
+/// A glove's mapping table: a built-in name (`5dt-14`, …) or a JSON file.
+pub fn glove_table(name: &str) -> anyhow::Result<MappingTable> {
+    Ok(if MappingTable::BUILTIN.contains(&name) { MappingTable::builtin(name)? } else { MappingTable::load(Path::new(name))? })
+}
+
 impl InputArgs {
     pub fn table(&self) -> anyhow::Result<MappingTable> {
-        Ok(if MappingTable::BUILTIN.contains(&self.glove.as_str()) { MappingTable::builtin(&self.glove)? } else { MappingTable::load(Path::new(&self.glove))? })
+        glove_table(&self.glove)
     }
 
     pub fn mapper(&self, joint_model: JointModel) -> anyhow::Result<GloveMapper> {

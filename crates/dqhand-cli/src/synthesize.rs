@@ -11,7 +11,7 @@ use dqhand::input::json_record::write_record;
 use dqhand::input::GloveCsvWriter;
 use dqhand::interaction::synthetic::{generate, SyntheticFormat, SyntheticParams};
 
-use crate::recording::{parse_side, Format};
+use crate::recording::{glove_table, parse_side, Format};
 
 /// Arguments of `dqhand synthesize`.
 #[derive(clap::Args)]
@@ -48,7 +48,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let table = match args.format {
-        Format::Glove => Some(crate::recording::InputArgs { glove: args.glove.clone(), calib: None, config: None, hand: Side::Right }.table()?),
+        Format::Glove => Some(glove_table(&args.glove)?),
         _ => None,
     };
     let hand = match (args.length, args.breadth, args.side) {

@@ -32,6 +32,12 @@ impl JointPositions {
         Ok(Self { indices })
     }
 
+    /// Skeleton index of each WebXR joint, in [`webxr::JOINT_NAMES`] order.
+    #[must_use]
+    pub fn indices(&self) -> &[usize; 25] {
+        &self.indices
+    }
+
     /// The joints' world positions, metres, from the skeleton's world transforms (e.g.
     /// [`Engine::world`]). Allocates nothing.
     ///

@@ -7,7 +7,7 @@
 //! `dx̂ = α(d_cutoff)·(x − x̂_prev)/dt + (1 − α(d_cutoff))·dx̂_prev`;
 //! `fc = min_cutoff + β·|dx̂|`; `x̂ = α(fc)·x + (1 − α(fc))·x̂_prev`.
 //!
-//! Three filters share that rule: [`OneEuro`] on a scalar (a joint angle), [`OneEuroVec3`] on
+//! One [`OneEuroFilter`] serves three kinds of value ([`Filtered`]): [`OneEuro`] on a scalar (a joint angle), [`OneEuroVec3`] on
 //! a position (speed = the length of the velocity, so all axes share one cutoff), and
 //! [`OneEuroRotation`] on an orientation, filtered on the sphere: the speed is the angular
 //! speed and the step is a slerp toward the new sample, never a per-component blend that
@@ -57,14 +57,61 @@ impl OneEuroParams {
     }
 }
 
-/// A One Euro filter on one value.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OneEuro {
-    params: OneEuroParams,
-    state: Option<(f32, f32)>,
+/// What the One Euro rule needs of a filtered value: how fast it moves from one sample to
+/// the next, and the step of a low-pass toward a new sample.
+pub trait Filtered: Copy {
+    /// Speed from `prev` to `x` over `dt` seconds (a scalar's signed rate; a position's or
+    /// an orientation's magnitude).
+    fn speed(prev: Self, x: Self, dt: f32) -> f32;
+    /// `prev` moved toward `x` by `alpha` in [0, 1].
+    fn blend(prev: Self, x: Self, alpha: f32) -> Self;
 }
 
-impl OneEuro {
+impl Filtered for f32 {
+    fn speed(prev: Self, x: Self, dt: f32) -> f32 {
+        (x - prev) / dt
+    }
+    fn blend(prev: Self, x: Self, alpha: f32) -> Self {
+        alpha * x + (1.0 - alpha) * prev
+    }
+}
+
+impl Filtered for Vec3 {
+    fn speed(prev: Self, x: Self, dt: f32) -> f32 {
+        (x - prev).length() / dt
+    }
+    fn blend(prev: Self, x: Self, alpha: f32) -> Self {
+        prev.lerp(x, alpha)
+    }
+}
+
+impl Filtered for Quat {
+    /// The angle from the previous estimate over `dt`.
+    fn speed(prev: Self, x: Self, dt: f32) -> f32 {
+        prev.angle_between(x) / dt
+    }
+    /// A slerp along the shorter arc, staying on the unit sphere.
+    fn blend(prev: Self, x: Self, alpha: f32) -> Self {
+        prev.slerp(x, alpha).normalize()
+    }
+}
+
+/// A One Euro filter on a value of type `T`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OneEuroFilter<T> {
+    params: OneEuroParams,
+    /// The last estimate and its filtered speed.
+    state: Option<(T, f32)>,
+}
+
+/// A One Euro filter on one value (a joint angle).
+pub type OneEuro = OneEuroFilter<f32>;
+/// A One Euro filter on a position: one cutoff from the speed, applied to all three axes.
+pub type OneEuroVec3 = OneEuroFilter<Vec3>;
+/// A One Euro filter on an orientation, on the unit sphere of quaternions.
+pub type OneEuroRotation = OneEuroFilter<Quat>;
+
+impl<T: Filtered> OneEuroFilter<T> {
     /// A filter that passes its first sample through.
     #[must_use]
     pub fn new(params: OneEuroParams) -> Self {
@@ -76,87 +123,18 @@ impl OneEuro {
         self.state = None;
     }
 
-    /// Filters sample `x` taken `dt` seconds after the previous one (`dt` > 0).
-    pub fn filter(&mut self, x: f32, dt: f32) -> f32 {
-        let (x_hat, dx_hat) = match self.state {
-            Some((prev, dx_prev)) if dt > 0.0 => {
-                let (dx_hat, a) = self.params.step((x - prev) / dt, dx_prev, dt);
-                (a * x + (1.0 - a) * prev, dx_hat)
-            }
-            Some(state) => state,
-            None => (x, 0.0),
-        };
-        self.state = Some((x_hat, dx_hat));
-        x_hat
-    }
-}
-
-/// A One Euro filter on a position: one cutoff from the speed, applied to all three axes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OneEuroVec3 {
-    params: OneEuroParams,
-    state: Option<(Vec3, f32)>,
-}
-
-impl OneEuroVec3 {
-    /// A filter that passes its first sample through.
-    #[must_use]
-    pub fn new(params: OneEuroParams) -> Self {
-        Self { params, state: None }
-    }
-
-    /// Forgets the past.
-    pub fn reset(&mut self) {
-        self.state = None;
-    }
-
-    /// Filters position `x` taken `dt` seconds after the previous one.
-    pub fn filter(&mut self, x: Vec3, dt: f32) -> Vec3 {
+    /// Filters sample `x` taken `dt` seconds after the previous one (`dt` > 0; a sample at
+    /// the same time leaves the estimate as it is).
+    pub fn filter(&mut self, x: T, dt: f32) -> T {
         let (x_hat, speed_hat) = match self.state {
             Some((prev, speed_prev)) if dt > 0.0 => {
-                let (speed_hat, a) = self.params.step((x - prev).length() / dt, speed_prev, dt);
-                (prev.lerp(x, a), speed_hat)
+                let (speed_hat, a) = self.params.step(T::speed(prev, x, dt), speed_prev, dt);
+                (T::blend(prev, x, a), speed_hat)
             }
             Some(state) => state,
             None => (x, 0.0),
         };
         self.state = Some((x_hat, speed_hat));
         x_hat
-    }
-}
-
-/// A One Euro filter on an orientation, on the unit sphere of quaternions.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OneEuroRotation {
-    params: OneEuroParams,
-    state: Option<(Quat, f32)>,
-}
-
-impl OneEuroRotation {
-    /// A filter that passes its first sample through.
-    #[must_use]
-    pub fn new(params: OneEuroParams) -> Self {
-        Self { params, state: None }
-    }
-
-    /// Forgets the past.
-    pub fn reset(&mut self) {
-        self.state = None;
-    }
-
-    /// Filters orientation `q` (unit) taken `dt` seconds after the previous one: the speed
-    /// is the angle from the previous estimate over `dt`, the step a slerp by α along the
-    /// shorter arc.
-    pub fn filter(&mut self, q: Quat, dt: f32) -> Quat {
-        let (q_hat, speed_hat) = match self.state {
-            Some((prev, speed_prev)) if dt > 0.0 => {
-                let (speed_hat, a) = self.params.step(prev.angle_between(q) / dt, speed_prev, dt);
-                (prev.slerp(q, a).normalize(), speed_hat)
-            }
-            Some(state) => state,
-            None => (q, 0.0),
-        };
-        self.state = Some((q_hat, speed_hat));
-        q_hat
     }
 }

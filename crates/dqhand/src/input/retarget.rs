@@ -203,7 +203,7 @@ impl Retargeter {
             if along.length_squared() < 1e-12 {
                 return Err(Rejection::new(RejectKind::Unusable, format!("joints: {} and {} coincide", webxr::JOINT_NAMES[w], webxr::JOINT_NAMES[child])));
             }
-            let frame = self.world[step.parent] * self.rest_world_local(step.joint);
+            let frame = self.world[step.parent] * self.rest_local(step.joint);
             let to_frame = frame.matrix3.inverse();
             let u = to_frame.mul_vec3(along.into()).normalize();
             // The finger's bending plane: its normal is the next joint's flexion axis.
@@ -219,7 +219,7 @@ impl Retargeter {
     }
 
     /// The rest local transform of `joint` as an affine (its parent's frame → its rest frame).
-    fn rest_world_local(&self, joint: usize) -> Affine3A {
+    fn rest_local(&self, joint: usize) -> Affine3A {
         self.rig.skeleton().joints()[joint].rest.to_affine()
     }
 

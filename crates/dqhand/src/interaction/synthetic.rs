@@ -11,12 +11,15 @@
 //! dropped. Records carry joints (with orientations), MediaPipe landmarks, or glove values
 //! with a wrist tracker.
 
+use std::sync::Arc;
+
 use glam::{Affine3A, Quat, Vec3};
 
-use crate::gesture::{gesture, GESTURES};
+use crate::engine::Engine;
+use crate::gesture::{gesture, JointPositions, GESTURES};
 use crate::hand::{HandParams, Side};
 use crate::input::{mediapipe, Calibration, GloveSample, HandData, JointSet, MappingTable, MountingOffset, Record, RigidPose, TrackedJoint};
-use crate::kinematics::{forward_kinematics, webxr, HandRig, JointModel, Limits, Pose};
+use crate::kinematics::{JointModel, Pose};
 use crate::math::DualQuat;
 use crate::Result;
 
@@ -152,18 +155,18 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         }
     });
     let model = crate::hand::build(&HandParams { vertices: *crate::hand::VERTEX_RANGE.start(), ..hand })?;
-    let rig = HandRig::new(&model.skeleton, JointModel::Full)?;
-    let index: Vec<usize> = webxr::JOINT_NAMES.iter().map(|n| rig.skeleton().find(n).expect("the built hand has every WebXR joint")).collect();
+    let mut engine = Engine::with_joint_model(Arc::new(model), JointModel::Full)?;
+    let rig = engine.rig().expect("an engine with a joint model has a rig").clone();
+    let joints = JointPositions::new(engine.skeleton())?;
     let rest_wrist = rig.rest_wrist();
 
     // The shapes: the library and thumbs down, in a shuffled cycle.
     let thumbs_up = gesture("thumbs_up")?.pose(JointModel::Full);
-    let thumb_direction = |pose: &Pose| {
-        let world = world_of(&rig, pose);
-        (Vec3::from(world[index[4]].translation) - Vec3::from(world[index[2]].translation)).normalize()
-    };
-    let up_turn = Quat::from_rotation_arc(thumb_direction(&thumbs_up), Vec3::Y);
-    let down_turn = Quat::from_rotation_arc(thumb_direction(&thumbs_up), -Vec3::Y);
+    engine.pose(&thumbs_up);
+    let thumb = joints.read(engine.world());
+    let thumb_direction = (thumb[4] - thumb[2]).normalize();
+    let up_turn = Quat::from_rotation_arc(thumb_direction, Vec3::Y);
+    let down_turn = Quat::from_rotation_arc(thumb_direction, -Vec3::Y);
     let mut names: Vec<&str> = GESTURES.iter().map(|g| g.name).chain(["thumbs_down"]).collect();
     let (rest_rotation, rest_translation) = rest_wrist.to_rotation_translation();
     let mut keys = Vec::new(); // (time, pose, label)
@@ -242,15 +245,16 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         if rng.next_f64() < params.drop_rate {
             continue;
         }
-        let world = world_of(&rig, &pose);
-        let mut positions = [Vec3::ZERO; 25];
-        for (p, &j) in positions.iter_mut().zip(&index) {
-            *p = Vec3::from(world[j].translation) + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+        engine.pose(&pose);
+        let world = engine.world();
+        let mut positions = joints.read(world);
+        for p in &mut positions {
+            *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
         }
         let record_hand = match &params.format {
             SyntheticFormat::Joints => {
                 let mut set = JointSet::new();
-                for (i, (&j, p)) in index.iter().zip(&positions).enumerate() {
+                for (i, (&j, p)) in joints.indices().iter().zip(&positions).enumerate() {
                     let (_, rotation, _) = world[j].to_scale_rotation_translation();
                     set.set(i, TrackedJoint { position: *p, orientation: Some(rotation.normalize()), radius: 0.0 });
                 }
@@ -296,14 +300,6 @@ fn relaxed(rng: &mut Rng) -> Pose {
 /// A turn of up to ±25° about the world vertical (keeps a thumb pointing up or down).
 fn turn_about_y(rng: &mut Rng) -> Quat {
     Quat::from_rotation_y(rng.uniform(-25.0, 25.0).to_radians() as f32)
-}
-
-fn world_of(rig: &HandRig, pose: &Pose) -> Vec<Affine3A> {
-    let mut locals = rig.skeleton().rest_locals();
-    rig.locals(pose, Limits::Anatomical, &mut locals);
-    let mut world = vec![Affine3A::IDENTITY; locals.len()];
-    forward_kinematics(rig.skeleton(), &locals, &mut world);
-    world
 }
 
 /// Raw glove values that the table maps back to `pose` (each sensor from the first DOF it
