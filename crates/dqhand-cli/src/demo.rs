@@ -1,7 +1,7 @@
 //! `dqhand demo`: the live viewer (a local server for the browser page), or with `--out` the
 //! gesture library posed with LB, QB and DQB and written as files.
 
-use std::net::{IpAddr, SocketAddr, TcpListener};
+use std::net::{IpAddr, SocketAddr, TcpListener, UdpSocket};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -11,8 +11,13 @@ use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::GESTURES;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
+use dqhand::interaction::GestureLoop;
 use dqhand::skin::Method;
+use dqhand::stream::LiveInput;
 
+use crate::feed::Feed;
+use crate::live::LiveRecords;
+use crate::recording::{gesture_set, Format, InputArgs, RecordingReader};
 use crate::server;
 
 /// Arguments of `dqhand demo`.
@@ -44,6 +49,24 @@ pub struct Args {
     /// pose files and the rigged hand into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Play this recording (glove CSV, joints or landmarks JSON lines) as the live input, in
+    /// real time and over and over.
+    #[arg(long, conflicts_with = "udp")]
+    input: Option<PathBuf>,
+    /// The recording's format (default: `.csv` is glove, anything else JSON lines).
+    #[arg(long, requires = "input")]
+    format: Option<Format>,
+    /// Take live records on this UDP port, one JSON record per datagram, at --host.
+    #[arg(long)]
+    udp: Option<u16>,
+    /// Append every live record taken (UDP, the /input WebSocket) to this file, JSON lines.
+    #[arg(long)]
+    record: Option<PathBuf>,
+    #[command(flatten)]
+    common: InputArgs,
+    /// Gesture definitions to recognise instead of the built-in ones.
+    #[arg(long)]
+    gestures_file: Option<PathBuf>,
 }
 
 pub(crate) fn parse_fps(s: &str) -> Result<f64, String> {
@@ -63,6 +86,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let address = SocketAddr::new(args.host, args.port);
     let listener = TcpListener::bind(address).with_context(|| format!("cannot listen on {address} (try another --port)"))?;
     let bound = listener.local_addr()?;
+    let model = Arc::new(model);
+    let feed = live_input(args, &model, bound.ip())?;
     let url = format!("http://{}/", if bound.ip().is_unspecified() { SocketAddr::new([127, 0, 0, 1].into(), bound.port()) } else { bound });
     println!("{}", model.description);
     if bound.ip().is_loopback() {
@@ -75,9 +100,53 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !args.no_open {
         open_browser(&url);
     }
-    let shared = server::Shared { model: Arc::new(model), joint_model: args.joint_model, assets: Some(assets), fps: args.fps };
+    let shared = server::Shared { model, joint_model: args.joint_model, assets: Some(assets), fps: args.fps, feed: Some(feed) };
     server::serve(listener, shared)?;
     Ok(())
+}
+
+/// The live input: the recording played, or the UDP port, or only the `/input` WebSocket
+/// (always open), each record recognised and every viewer following.
+fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> anyhow::Result<Arc<Feed>> {
+    let gestures = Some(gesture_set(args.gestures_file.as_deref(), true)?.expect("recognition on"));
+    let mapper = Some(args.common.mapper(args.joint_model)?);
+    let gesture_loop = GestureLoop::new(Arc::clone(model), args.joint_model, mapper, args.common.config()?, gestures)?;
+    let records = LiveRecords::new(&args.common, args.record.as_deref())?;
+    let udp = match args.udp {
+        Some(port) => {
+            let address = SocketAddr::new(host, port);
+            Some(UdpSocket::bind(address).with_context(|| format!("cannot receive on udp {address} (try another --udp port)"))?)
+        }
+        None => None,
+    };
+    let source = match (&args.input, &udp) {
+        (Some(path), _) => path.display().to_string(),
+        (None, Some(socket)) => format!("udp {}", socket.local_addr()?),
+        (None, None) => "WebSocket /input".to_owned(),
+    };
+    let announce = args.input.is_some() || udp.is_some();
+    let feed = Arc::new(Feed { input: LiveInput::new(gesture_loop, source.clone(), announce), records });
+    if let Some(path) = &args.input {
+        RecordingReader::open(path, args.format, &args.common)?; // fail now, not in the thread
+        let (feed, path, format, common) = (Arc::clone(&feed), path.clone(), args.format, args.common.clone());
+        std::thread::spawn(move || {
+            if let Err(e) = feed.play(&path, format, &common) {
+                eprintln!("dqhand: error: {e:#}");
+            }
+        });
+        println!("input: {source}, played in real time over and over");
+    }
+    if let Some(socket) = udp {
+        println!("input: {source}, one JSON record per datagram");
+        let feed = Arc::clone(&feed);
+        std::thread::spawn(move || {
+            if let Err(e) = feed.receive(&socket) {
+                eprintln!("dqhand: error: {source}: {e}");
+            }
+        });
+    }
+    println!("input WebSocket: /input on this server, one JSON record per message");
+    Ok(feed)
 }
 
 /// The built page: `--viewer`, else `viewer/dist` here or in this checkout.

@@ -7,8 +7,11 @@ mod bench;
 mod bench_stream;
 mod calibrate;
 mod demo;
+mod feed;
 mod hand;
 mod info;
+mod listen;
+mod live;
 mod metrics;
 mod recording;
 mod replay;
@@ -46,6 +49,9 @@ enum Command {
     /// Play a recording (glove CSV, joints or landmarks JSON lines) through the gesture loop
     /// as fast as it goes; gesture events as JSON lines on stdout.
     Replay(replay::Args),
+    /// Live input without the viewer: records on a UDP port drive the gesture loop; gesture
+    /// events as JSON lines on stdout, optionally recorded to a file.
+    Listen(listen::Args),
     /// Derive a glove calibration from a recording of the calibration poses.
     Calibrate(calibrate::Args),
     /// Write a synthetic, labelled recording of the gesture library (from our own kinematics).
@@ -62,6 +68,7 @@ fn main() {
         Command::Demo(a) => demo::run(&a),
         Command::Metrics(a) => metrics::run(&a),
         Command::Replay(a) => replay::run(&a),
+        Command::Listen(a) => listen::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Synthesize(a) => synthesize::run(&a),
     };

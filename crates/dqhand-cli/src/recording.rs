@@ -6,6 +6,7 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use dqhand::gesture::GestureSet;
 use dqhand::hand::Side;
 use dqhand::input::json_record::JsonRecordReader;
 use dqhand::input::{Calibration, GloveCsvReader, GloveMapper, InputConfig, MappingTable, Record, Rejection};
@@ -72,6 +73,16 @@ impl InputArgs {
             None => InputConfig::default(),
         })
     }
+}
+
+/// The gesture definitions of `--gestures-file`, else the built-in ones when recognition
+/// is `on`, else none.
+pub fn gesture_set(file: Option<&Path>, on: bool) -> anyhow::Result<Option<GestureSet>> {
+    Ok(match (file, on) {
+        (Some(path), _) => Some(GestureSet::load(path)?),
+        (None, true) => Some(GestureSet::builtin()),
+        (None, false) => None,
+    })
 }
 
 /// A recording being read, record by record.

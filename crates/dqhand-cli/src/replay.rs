@@ -9,7 +9,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 use dqhand::engine::ModelSource;
-use dqhand::gesture::GestureSet;
 use dqhand::input::{Record, Tracking};
 use dqhand::interaction::GestureLoop;
 use dqhand::io::PoseFile;
@@ -51,11 +50,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = Arc::new(args.model.load()?);
-    let gestures = match (&args.gestures_file, args.gestures) {
-        (Some(path), _) => Some(GestureSet::load(path)?),
-        (None, true) => Some(GestureSet::builtin()),
-        (None, false) => None,
-    };
+    let gestures = crate::recording::gesture_set(args.gestures_file.as_deref(), args.gestures)?;
     let mapper = Some(args.common.mapper(args.joint_model)?);
     let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
     let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.common.config()?, gestures)?;

@@ -1,8 +1,12 @@
-//! The gesture loop through the real command: synthesize a labelled recording, replay it,
-//! and check the printed events against the labels; bad records counted, not fatal.
+//! The gesture loop through the real command: synthesize a labelled recording, replay it
+//! (or stream it to `listen`), and check the printed events against the labels; bad records
+//! counted, not fatal.
 
+use std::io::{BufRead, BufReader, Read};
+use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::Duration;
 
 fn temp_dir(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("dqhand-replay-{}-{test}", std::process::id()));
@@ -28,7 +32,11 @@ fn synthesize(dir: &Path, format: &str, extension: &str, extra: &[&str]) -> (Pat
 }
 
 fn events(out: &Output) -> Vec<(f64, String, String)> {
-    String::from_utf8_lossy(&out.stdout)
+    events_in(&String::from_utf8_lossy(&out.stdout))
+}
+
+fn events_in(stdout: &str) -> Vec<(f64, String, String)> {
+    stdout
         .lines()
         .map(|l| {
             let v: serde_json::Value = serde_json::from_str(l).unwrap();
@@ -40,7 +48,10 @@ fn events(out: &Output) -> Vec<(f64, String, String)> {
 /// Every labelled hold starts within 150 ms of the pose being reached; idle motion starts
 /// nothing.
 fn check_recognition(out: &Output, labels: &serde_json::Value) {
-    let events = events(out);
+    check_events(&events(out), labels);
+}
+
+fn check_events(events: &[(f64, String, String)], labels: &serde_json::Value) {
     for hold in labels["holds"].as_array().unwrap() {
         let (gesture, reached) = (hold["gesture"].as_str().unwrap(), hold["reached"].as_f64().unwrap());
         let start = events.iter().find(|(t, e, g)| e == "start" && g == gesture && *t > reached - 0.4 && *t <= reached + 0.15);
@@ -133,4 +144,55 @@ fn bad_records_are_summarised_and_skipped() {
     let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["replay", "--input", "/no/such.jsonl"]).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.jsonl"));
+}
+
+/// `listen` takes a recording streamed over UDP, one record per datagram, with bad datagrams
+/// among them: it prints the labelled gestures as they happen, summarises the refusals per
+/// kind, and records exactly the records it took, in a file `replay` reads back to the same
+/// events.
+#[test]
+fn listen_takes_udp_records_prints_events_and_records_what_it_took() {
+    let dir = temp_dir("listen");
+    let (path, labels) = synthesize(&dir, "joints", "jsonl", &["--seed", "7", "--side", "left"]);
+    let recorded = dir.join("live.jsonl");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dqhand"))
+        .args(["listen", "--udp", "0", "--gestures", "--hand", "left", "--seconds", "15", "--record", recorded.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut banner = String::new();
+    stderr.read_line(&mut banner).unwrap();
+    let address = banner.strip_prefix("listening on udp ").and_then(|a| a.split(',').next()).unwrap_or_else(|| panic!("{banner}")).trim().to_owned();
+    assert!(banner.contains("this machine only"), "{banner}");
+    let lines: Vec<String> = std::fs::read_to_string(&path).unwrap().lines().map(str::to_owned).collect();
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    for (i, line) in lines.iter().enumerate() {
+        match i {
+            10 => drop(socket.send_to(b"{\"t\": 0.1, \"joints\": {\"wrist\"", &address)),
+            20 => drop(socket.send_to(lines[5].as_bytes(), &address)), // time going backwards
+            30 => drop(socket.send_to(lines[31].replace("\"wrist\"", "\"wrist-bone\"").as_bytes(), &address)),
+            40 => drop(socket.send_to(&vec![b' '; 20_000], &address)),
+            _ => {}
+        }
+        socket.send_to(line.as_bytes(), &address).unwrap();
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let mut stdout = String::new();
+    child.stdout.take().unwrap().read_to_string(&mut stdout).unwrap();
+    let mut rest = String::new();
+    stderr.read_to_string(&mut rest).unwrap();
+    assert!(child.wait().unwrap().success(), "{rest}");
+    let live = events_in(&stdout);
+    check_events(&live, &labels);
+    for needle in ["1 record rejected (malformed)", "1 record rejected (unknown name)", "1 record rejected (out of order)", "1 record rejected (too large)", "tracking: tracking", "tracking: lost"] {
+        assert!(rest.contains(needle), "{needle:?} not in {rest}");
+    }
+    let taken = format!("{} records taken, 4 rejected", lines.len());
+    assert!(rest.contains(&taken), "{taken:?} not in {rest}");
+    let recording = std::fs::read_to_string(&recorded).unwrap();
+    assert_eq!(recording.lines().count(), lines.len(), "every record taken is recorded, nothing else");
+    let replayed = dqhand(&["replay", "--input", recorded.to_str().unwrap(), "--gestures", "--hand", "left"]);
+    assert_eq!(events(&replayed), live, "the recording replays to the events seen live");
 }

@@ -301,7 +301,7 @@ fn switching_the_joint_model_keeps_the_shared_angles() {
     s.apply(&command(r#"{"type":"angle","dof":"middle-finger-phalanx-proximal.flex","deg":45}"#)).unwrap();
     s.apply(&command(r#"{"type":"angle","dof":"thumb-metacarpal.flex","deg":20}"#)).unwrap();
     assert_eq!(s.apply(&command(r#"{"type":"joint_model","name":"paper"}"#)).unwrap(), Applied::Hello);
-    let hello: serde_json::Value = serde_json::from_str(&s.hello(4096)).unwrap();
+    let hello: serde_json::Value = serde_json::from_str(&s.hello(4096, None)).unwrap();
     assert_eq!(hello["dofs"].as_array().unwrap().len(), 18);
     assert_eq!(hello["joint_model"], "paper");
     let i = JointModel::Paper.dof_index("middle-finger-phalanx-proximal.flex").unwrap();
@@ -313,7 +313,7 @@ fn switching_the_joint_model_keeps_the_shared_angles() {
 #[test]
 fn hello_describes_the_model_and_its_controls() {
     let s = Session::new(HAND.clone(), JointModel::Full).unwrap();
-    let hello: serde_json::Value = serde_json::from_str(&s.hello(4096)).unwrap();
+    let hello: serde_json::Value = serde_json::from_str(&s.hello(4096, None)).unwrap();
     assert_eq!(hello["type"], "hello");
     assert_eq!(hello["vertices"], 3000);
     assert_eq!(hello["joints"].as_array().unwrap().len(), 25);

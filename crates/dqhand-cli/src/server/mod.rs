@@ -3,6 +3,7 @@
 //! thread, never the engine of another viewer.
 
 mod assets;
+mod input_socket;
 mod request;
 mod socket;
 
@@ -14,6 +15,8 @@ use std::time::Duration;
 
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
+
+use crate::feed::Feed;
 
 /// Connections served at once; more are answered 503 (each holds a thread).
 const MAX_CONNECTIONS: usize = 64;
@@ -30,6 +33,9 @@ pub struct Shared {
     pub assets: Option<PathBuf>,
     /// Frames per second streamed to each viewer.
     pub fps: f64,
+    /// The live input every viewer follows once it has records (the `/input` WebSocket
+    /// feeds it, beside the demo's recording or UDP port); `None`: no input, no `/input`.
+    pub feed: Option<Arc<Feed>>,
 }
 
 /// Accepts connections forever, one thread each.
@@ -73,9 +79,13 @@ fn connection(stream: TcpStream, shared: &Shared, loopback_only: bool) -> std::i
             return request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false);
         }
     };
-    if request.path == socket::PATH {
+    let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
+    if request.path == socket::PATH || feed.is_some() {
         match request.websocket_accept() {
-            Ok(accept) => socket::run(stream, request, &accept, shared),
+            Ok(accept) => match feed {
+                Some(feed) => input_socket::run(stream, request, &accept, feed),
+                None => socket::run(stream, request, &accept, shared),
+            },
             Err(request::Refusal { status, message }) => {
                 request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false)
             }

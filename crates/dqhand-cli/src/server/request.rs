@@ -93,7 +93,7 @@ impl Request {
             self.header(name).is_some_and(|v| v.split(',').any(|t| t.trim().eq_ignore_ascii_case(token)))
         };
         if self.method != "GET" || !has("upgrade", "websocket") || !has("connection", "upgrade") {
-            return Err(refuse(426, "this path serves the engine stream: a WebSocket upgrade is required"));
+            return Err(refuse(426, "this path is a WebSocket: an upgrade is required"));
         }
         if self.header("sec-websocket-version") != Some("13") {
             return Err(refuse(426, "WebSocket version 13 is required"));

@@ -6,7 +6,7 @@ use std::io::{ErrorKind, Write};
 use std::net::TcpStream;
 use std::time::{Duration, Instant};
 
-use dqhand::stream::{Applied, Command, Session};
+use dqhand::stream::{Applied, Command, LiveInput, Session};
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 
@@ -25,20 +25,27 @@ const WINDOW: u32 = 3;
 /// A send that cannot complete in this time (the client stopped reading) ends the connection.
 const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
 
-/// Completes the handshake and streams until the client leaves.
-pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Shared) -> std::io::Result<()> {
+/// Completes the WebSocket handshake (the server's answer to a checked upgrade request).
+pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> std::io::Result<WebSocket<TcpStream>> {
     let response = format!(
         "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
     );
     stream.write_all(response.as_bytes())?;
     stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
     let config = WebSocketConfig::default().max_message_size(Some(MAX_WIRE_BYTES)).max_frame_size(Some(MAX_WIRE_BYTES));
-    let mut ws = WebSocket::from_partially_read(stream, request.rest, Role::Server, Some(config));
+    Ok(WebSocket::from_partially_read(stream, request.rest, Role::Server, Some(config)))
+}
+
+/// Completes the handshake and streams until the client leaves.
+pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -> std::io::Result<()> {
+    let mut ws = upgrade(stream, request, accept)?;
     let mut session = match Session::new(shared.model.clone(), shared.joint_model) {
         Ok(s) => s,
         Err(e) => return send_error(&mut ws, &e.to_string()).map_err(io),
     };
-    ws.send(Message::text(session.hello(MAX_COMMAND_BYTES))).map_err(io)?;
+    let input = shared.feed.as_deref().map(|f| &f.input);
+    let mut view = input.map(LiveInput::view);
+    ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?;
     ws.send(Message::binary(session.topology().encode())).map_err(io)?;
 
     let period = Duration::from_secs_f64(1.0 / shared.fps);
@@ -67,7 +74,7 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
                         Ok(Command::Ack { seq }) => acked = seq.wrapping_add(1),
                         Ok(command) => match session.apply(&command) {
                             Ok(Applied::Frame) => {}
-                            Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES))).map_err(io)?,
+                            Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
                             Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
                         },
                         Err(e) => send_error(&mut ws, &e).map_err(io)?,
@@ -76,25 +83,24 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
                 Ok(Message::Binary(_)) => send_error(&mut ws, "binary messages are not commands; send JSON text").map_err(io)?,
                 Ok(Message::Close(_)) => return Ok(()),
                 Ok(_) => {}
-                Err(tungstenite::Error::Io(e)) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-                Err(tungstenite::Error::Capacity(e)) => {
-                    let _ = send_error(&mut ws, &format!("message refused: {e}; closing"));
-                    let _ = ws.close(None);
-                    let _ = ws.flush();
-                    linger(ws.get_mut());
-                    return Ok(());
-                }
-                Err(
-                    tungstenite::Error::ConnectionClosed
-                    | tungstenite::Error::AlreadyClosed
-                    | tungstenite::Error::Protocol(tungstenite::error::ProtocolError::ResetWithoutClosingHandshake),
-                ) => return Ok(()),
-                Err(e) => return Err(io(e)),
+                Err(e) => match read_failure(&mut ws, e) {
+                    Some(end) => return end,
+                    None => {}
+                },
             }
         }
         let now = Instant::now();
         session.advance((now - last_frame).as_secs_f32().min(0.1));
         last_frame = now;
+        if let (Some(input), Some(view)) = (input, &mut view) {
+            let update = input.update(&mut session, view);
+            if update.hello {
+                ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, Some(input)))).map_err(io)?;
+            }
+            if let Some(message) = update.message {
+                ws.send(Message::text(message)).map_err(io)?;
+            }
+        }
         session.render(rate.tick(now), &mut frame);
         // tungstenite takes ownership of each message: one buffer per frame is the transport's
         // cost (the engine's own buffers are reused).
@@ -104,6 +110,25 @@ pub fn run(mut stream: TcpStream, request: Request, accept: &str, shared: &Share
         if next_frame < now {
             next_frame = now; // after a stall, resume the rate instead of bursting to catch up
         }
+    }
+}
+
+/// What a failed read means: `None` to read on (a timeout), else how the connection ends
+/// (a message over the size bound is answered with an error before closing).
+pub(super) fn read_failure(ws: &mut WebSocket<TcpStream>, e: tungstenite::Error) -> Option<std::io::Result<()>> {
+    match e {
+        tungstenite::Error::Io(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => None,
+        tungstenite::Error::Capacity(e) => {
+            let _ = send_error(ws, &format!("message refused: {e}; closing"));
+            let _ = ws.close(None);
+            let _ = ws.flush();
+            linger(ws.get_mut());
+            Some(Ok(()))
+        }
+        tungstenite::Error::ConnectionClosed
+        | tungstenite::Error::AlreadyClosed
+        | tungstenite::Error::Protocol(tungstenite::error::ProtocolError::ResetWithoutClosingHandshake) => Some(Ok(())),
+        e => Some(Err(io(e))),
     }
 }
 
@@ -125,7 +150,7 @@ fn linger(stream: &mut TcpStream) {
     }
 }
 
-fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungstenite::Result<()> {
+pub(super) fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungstenite::Result<()> {
     ws.send(Message::text(serde_json::json!({ "type": "error", "message": message }).to_string()))
 }
 

@@ -133,6 +133,19 @@ impl<'de: 'a, 'a, V: Deserialize<'de> + Copy + Default, const N: usize> Deserial
     }
 }
 
+/// Parses one record received as bytes (a UDP datagram, a WebSocket message, a line of a
+/// file): UTF-8 text, surrounding whitespace ignored, then as [`parse_record`].
+///
+/// # Errors
+/// As [`parse_record`]; `TooLarge` beyond [`MAX_RECORD_BYTES`], `Malformed` if not UTF-8.
+pub fn parse_message<S: AsRef<str>>(bytes: &[u8], default_side: Side, glove_sensors: &[S], out: &mut Record) -> Result<(), Rejection> {
+    if bytes.len() > MAX_RECORD_BYTES {
+        return Err(Rejection::new(RejectKind::TooLarge, format!("record of {} bytes (at most {MAX_RECORD_BYTES})", bytes.len())));
+    }
+    let text = std::str::from_utf8(bytes).map_err(|_| Rejection::new(RejectKind::Malformed, "not UTF-8 text"))?;
+    parse_record(text.trim(), default_side, glove_sensors, out)
+}
+
 /// Parses one JSON record into `out`.
 ///
 /// * `default_side` — the hand when the record does not say;
@@ -363,14 +376,10 @@ impl<R: BufRead> JsonRecordReader<R> {
                 let bytes = self.line.len() + skip_line(&mut self.reader)?;
                 return Ok(Some(Err(Rejection::new(RejectKind::TooLarge, format!("{at}: {bytes} bytes (at most {MAX_RECORD_BYTES})")))));
             }
-            let Ok(text) = std::str::from_utf8(&self.line) else {
-                return Ok(Some(Err(Rejection::new(RejectKind::Malformed, format!("{at}: not UTF-8 text")))));
-            };
-            let text = text.trim();
-            if text.is_empty() {
+            if self.line.iter().all(u8::is_ascii_whitespace) {
                 continue;
             }
-            return Ok(Some(parse_record(text, self.default_side, &self.glove_sensors, out).map_err(|r| r.at(at))));
+            return Ok(Some(parse_message(&self.line, self.default_side, &self.glove_sensors, out).map_err(|r| r.at(at))));
         }
     }
 }

@@ -12,7 +12,8 @@ use glam::Vec3;
 use crate::engine::Engine;
 use crate::gesture::{Events, GestureSet, HandFeatures, JointPositions, Recognizer};
 use crate::hand::Side;
-use crate::input::{GloveMapper, InputConfig, InputPipeline, Record, Rejection};
+use super::CommandTable;
+use crate::input::{Action, GloveMapper, InputConfig, InputPipeline, Record, Rejection};
 use crate::kinematics::JointModel;
 use crate::model::Model;
 use crate::Result;
@@ -25,28 +26,37 @@ pub struct GestureLoop {
     positions: [Vec3; 25],
     side: Side,
     recognizer: Option<Recognizer>,
+    commands: Option<CommandTable>,
+    /// The command the last record triggered.
+    action: Option<Action>,
 }
 
 impl GestureLoop {
     /// A loop posing `model` with `joint_model`; `gestures` turns recognition on.
     ///
+    /// With recognition on, the configuration's `actions` become the loop's commands.
+    ///
     /// # Errors
-    /// As [`Engine::with_joint_model`], [`InputPipeline::new`] and [`JointPositions::new`].
+    /// As [`Engine::with_joint_model`], [`InputPipeline::new`], [`JointPositions::new`] and
+    /// [`CommandTable::new`].
     pub fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>) -> Result<Self> {
         let engine = Engine::with_joint_model(model, joint_model)?;
         let rig = engine.rig().expect("an engine with a joint model has a rig");
         let pipeline = InputPipeline::new(rig, glove, config)?;
         let joints = JointPositions::new(engine.skeleton())?;
         let side = pipeline.retargeter().side();
-        Ok(Self { pipeline, engine, joints, positions: [Vec3::ZERO; 25], side, recognizer: gestures.map(Recognizer::new) })
+        let commands = gestures.as_ref().map(|set| CommandTable::new(&pipeline.config().actions, set)).transpose()?;
+        Ok(Self { pipeline, engine, joints, positions: [Vec3::ZERO; 25], side, recognizer: gestures.map(Recognizer::new), commands, action: None })
     }
 
     /// Takes one record (`arrival`: see [`InputPipeline::push`]): poses the virtual hand and,
-    /// with recognition on, returns the gesture events it caused. Allocates nothing.
+    /// with recognition on, returns the gesture events it caused (and sets [`Self::action`]).
+    /// Allocates nothing.
     ///
     /// # Errors
     /// The record's refusal; the hand keeps its pose.
     pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> Result<Events<'_>, Rejection> {
+        self.action = None;
         self.pipeline.push(record, arrival)?;
         self.engine.pose(self.pipeline.pose());
         self.positions = self.joints.read(self.engine.world());
@@ -55,10 +65,18 @@ impl GestureLoop {
 
     fn recognize(&mut self, time: f64) -> Events<'_> {
         let features = HandFeatures::from_positions(&self.positions, self.side);
-        match &mut self.recognizer {
-            Some(r) => r.update(time, &features),
-            None => Events::none(),
+        let Some(recognizer) = &mut self.recognizer else { return Events::none() };
+        let events = recognizer.update(time, &features);
+        if let Some(commands) = &mut self.commands {
+            self.action = commands.update(time, events.clone());
         }
+        events
+    }
+
+    /// The command (a row of the configuration's `actions`) that the last record triggered.
+    #[must_use]
+    pub fn action(&self) -> Option<Action> {
+        self.action
     }
 
     /// The input pipeline (pose, tracking state, rejections).

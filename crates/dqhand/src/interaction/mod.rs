@@ -2,7 +2,9 @@
 //! interaction: records from the user's hand drive the virtual hand (what you see is what you
 //! do) and its gestures, recognised on the virtual hand, act as commands.
 
+mod command_table;
 mod gesture_loop;
 pub mod synthetic;
 
+pub use command_table::CommandTable;
 pub use gesture_loop::GestureLoop;

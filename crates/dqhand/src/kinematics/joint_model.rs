@@ -153,6 +153,17 @@ impl JointModel {
         self.dofs().count()
     }
 
+    /// Copies the `angles` (of this model) of the DOFs that `to` shares with it, the same
+    /// bone and motion, into `out` (of `to`); the others in `out` are left as they are.
+    /// Allocates nothing.
+    pub fn carry_angles(self, angles: &[f32], to: JointModel, out: &mut [f32]) {
+        for (d, &a) in self.dofs().zip(angles) {
+            if let Some(i) = to.dofs().position(|e| e.bone == d.bone && e.motion == d.motion) {
+                out[i] = a;
+            }
+        }
+    }
+
     /// Index of the DOF called `"<bone>.<motion>"`, or an error listing the valid names.
     ///
     /// # Errors

@@ -6,8 +6,10 @@
 
 pub mod frame;
 mod command;
+mod live_input;
 mod session;
 
 pub use command::Command;
 pub use frame::{FrameHeader, FrameView, FrameWriter, Topology};
+pub use live_input::{InputUpdate, InputView, LiveInput};
 pub use session::{Applied, Session, GESTURE_SECONDS};

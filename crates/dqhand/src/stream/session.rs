@@ -11,9 +11,10 @@ use glam::{EulerRot, Quat, Vec3};
 use serde_json::json;
 
 use super::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYING, VERSION};
-use super::Command;
+use super::{Command, LiveInput};
 use crate::engine::Engine;
 use crate::gesture::{gesture, Sequence, GESTURES};
+use crate::input::Action;
 use crate::kinematics::{HandRig, JointModel, Limits, Pose};
 use crate::math::DualQuat;
 use crate::metrics::VertexDistortion;
@@ -81,9 +82,9 @@ impl Session {
     }
 
     /// The JSON greeting: the model, the DOFs with their ranges, the gestures, sequences and
-    /// methods the page can ask for.
+    /// methods the page can ask for, and the live input driving the hand, if any.
     #[must_use]
-    pub fn hello(&self, max_message_bytes: usize) -> String {
+    pub fn hello(&self, max_message_bytes: usize, input: Option<&LiveInput>) -> String {
         let model = self.joint_model();
         let (description, mesh) = (&self.engine.model().description, &self.engine.model().mesh);
         let dofs: Vec<_> = model
@@ -105,6 +106,7 @@ impl Session {
             "methods": Method::ALL.map(Method::as_str),
             "gesture_seconds": GESTURE_SECONDS,
             "max_message_bytes": max_message_bytes,
+            "input": input.and_then(LiveInput::describe),
         })
         .to_string()
     }
@@ -220,6 +222,42 @@ impl Session {
         Ok(Applied::Frame)
     }
 
+    /// Shows `pose` (of `model`) from the live input: the timeline and any move stop, and
+    /// the angles of DOFs the two joint models share are taken. Allocates nothing.
+    pub fn follow(&mut self, pose: &Pose, model: JointModel) {
+        self.stop();
+        model.carry_angles(&pose.angles, self.joint_model(), &mut self.pose.angles);
+        self.wrist = pose.wrist;
+        self.pose.wrist = pose.wrist;
+    }
+
+    /// Applies a gesture command to the view: `next_method` shows the method after the first
+    /// one in view alone, `split_view` shows LB, QB and DQB side by side, `toggle_heatmap`
+    /// turns the distortion heat map on or off.
+    pub fn act(&mut self, action: Action) {
+        match action {
+            Action::NextMethod => {
+                let first = self.engine.methods().as_slice()[0];
+                let next = Method::ALL[(first.index() + 1) % Method::ALL.len()];
+                self.engine.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
+            }
+            Action::SplitView => self.engine.set_methods(MethodSet::ALL),
+            Action::ToggleHeatmap => self.heatmap = !self.heatmap,
+        }
+    }
+
+    /// Whether the distortion heat map is on.
+    #[must_use]
+    pub fn heatmap(&self) -> bool {
+        self.heatmap
+    }
+
+    /// The methods in view.
+    #[must_use]
+    pub fn methods(&self) -> MethodSet {
+        self.engine.methods()
+    }
+
     fn stop(&mut self) {
         self.playing = false;
         self.transition = None;
@@ -229,11 +267,7 @@ impl Session {
         let old = self.joint_model();
         self.engine.set_joint_model(model)?;
         let mut pose = Pose::rest(model.dof_count());
-        for (d, a) in old.dofs().zip(&self.pose.angles) {
-            if let Ok(i) = model.dof_index(&d.name()) {
-                pose.angles[i] = *a;
-            }
-        }
+        old.carry_angles(&self.pose.angles, model, &mut pose.angles);
         pose.wrist = self.wrist;
         self.pose = pose;
         self.timeline = Sequence::gestures(model);

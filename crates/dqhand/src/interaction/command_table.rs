@@ -1,0 +1,112 @@
+//! Gestures as commands: the configuration's table of held gestures and the viewer actions
+//! they trigger (the paper's "gestures act as commands"), each once per hold.
+
+use crate::gesture::{Event, EventKind, GestureSet};
+use crate::input::{Action, GestureAction};
+use crate::{Error, Result};
+
+/// Watches the gesture events and fires each row's action once, when its gesture has been
+/// held for the row's `hold_s` since it started. A gesture released and made again fires again.
+#[derive(Clone, Debug)]
+pub struct CommandTable {
+    rows: Vec<GestureAction>,
+    /// The held gesture's first row, since when, and which rows have fired during this hold
+    /// (bit per row); `None` while no gesture with a row is held.
+    held: Option<(usize, f64, u64)>,
+}
+
+impl CommandTable {
+    /// The table of `actions` over `set`'s gestures.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming a row whose gesture `set` does not define, or a table of
+    /// more than 64 rows.
+    pub fn new(actions: &[GestureAction], set: &GestureSet) -> Result<Self> {
+        if actions.len() > 64 {
+            return Err(Error::Config(format!("actions: {} rows (at most 64)", actions.len())));
+        }
+        if let Some(a) = actions.iter().find(|a| !set.gestures().iter().any(|g| g.name() == a.gesture)) {
+            return Err(Error::Config(format!("actions: {:?} is not a gesture of the definitions in use", a.gesture)));
+        }
+        Ok(Self { rows: actions.to_vec(), held: None })
+    }
+
+    /// Takes one update's gesture `events` at `time_s` and returns the action due now, if
+    /// any (the first due row; another due at the same time follows on the next update).
+    /// Allocates nothing.
+    pub fn update<'a>(&mut self, time_s: f64, events: impl IntoIterator<Item = Event<'a>>) -> Option<Action> {
+        for e in events {
+            self.held = match e.event {
+                EventKind::Start => self.rows.iter().position(|r| r.gesture == e.gesture).map(|row| (row, e.t, 0)),
+                EventKind::End => None,
+            };
+        }
+        let (first, since, fired) = self.held.as_mut()?;
+        let gesture = &self.rows[*first].gesture;
+        let (i, row) = self
+            .rows
+            .iter()
+            .enumerate()
+            .find(|(i, r)| r.gesture == *gesture && *fired & (1 << i) == 0 && time_s - *since >= f64::from(r.hold_s))?;
+        *fired |= 1 << i;
+        Some(row.action)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(rows: &[(&str, f32, Action)]) -> CommandTable {
+        let actions: Vec<_> = rows.iter().map(|&(g, hold_s, action)| GestureAction { gesture: g.into(), hold_s, action }).collect();
+        CommandTable::new(&actions, &GestureSet::builtin()).unwrap()
+    }
+
+    fn start(t: f64, gesture: &str) -> [Event<'_>; 1] {
+        [Event { t, event: EventKind::Start, gesture }]
+    }
+
+    fn end(t: f64, gesture: &str) -> [Event<'_>; 1] {
+        [Event { t, event: EventKind::End, gesture }]
+    }
+
+    #[test]
+    fn fires_once_per_hold_after_its_time() {
+        let mut t = table(&[("thumbs_up", 0.5, Action::NextMethod)]);
+        assert_eq!(t.update(1.0, start(1.0, "thumbs_up")), None);
+        assert_eq!(t.update(1.49, []), None);
+        assert_eq!(t.update(1.5, []), Some(Action::NextMethod));
+        assert_eq!(t.update(2.5, []), None, "once per hold");
+        assert_eq!(t.update(2.6, end(2.6, "thumbs_up")), None);
+        assert_eq!(t.update(3.0, start(3.0, "thumbs_up")), None);
+        assert_eq!(t.update(3.5, []), Some(Action::NextMethod), "a new hold fires again");
+    }
+
+    #[test]
+    fn another_gesture_restarts_the_hold() {
+        let mut t = table(&[("rock", 0.8, Action::ToggleHeatmap)]);
+        assert_eq!(t.update(0.0, start(0.0, "rock")), None);
+        let switch = [Event { t: 0.5, event: EventKind::End, gesture: "rock" }, Event { t: 0.5, event: EventKind::Start, gesture: "fist" }];
+        assert_eq!(t.update(0.5, switch), None);
+        assert_eq!(t.update(1.0, []), None, "fist has no row");
+        assert_eq!(t.update(1.1, start(1.1, "rock")), None);
+        assert_eq!(t.update(1.8, []), None, "0.7 s of this hold");
+        assert_eq!(t.update(1.9, []), Some(Action::ToggleHeatmap));
+    }
+
+    #[test]
+    fn rows_of_one_gesture_fire_in_turn() {
+        let mut t = table(&[("victory", 0.0, Action::SplitView), ("point", 0.0, Action::NextMethod), ("victory", 1.0, Action::ToggleHeatmap)]);
+        assert_eq!(t.update(0.0, start(0.0, "victory")), Some(Action::SplitView));
+        assert_eq!(t.update(0.5, []), None);
+        assert_eq!(t.update(1.0, []), Some(Action::ToggleHeatmap));
+        assert_eq!(t.update(5.0, []), None);
+    }
+
+    #[test]
+    fn an_unknown_gesture_is_a_config_error_naming_it() {
+        let actions = [GestureAction { gesture: "wave".into(), hold_s: 0.5, action: Action::NextMethod }];
+        let e = CommandTable::new(&actions, &GestureSet::builtin()).unwrap_err().to_string();
+        assert!(e.contains("\"wave\""), "{e}");
+    }
+}
