@@ -317,3 +317,156 @@ fn refuses_a_port_in_use_and_a_missing_viewer() {
     let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["demo", "--fps", "0"]).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A synthetic, labelled joints recording (`dqhand synthesize`) in the test's directory.
+fn recording(test: &str) -> (Vec<String>, Value) {
+    let path = site(test).join("rec.jsonl");
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["synthesize", "--format", "joints", "--seed", "3", "--out"]).arg(&path).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let labels = serde_json::from_str(&std::fs::read_to_string(path.with_extension("labels.json")).unwrap()).unwrap();
+    (std::fs::read_to_string(&path).unwrap().lines().map(str::to_owned).collect(), labels)
+}
+
+/// The stream's next message that is not a frame (frames are acknowledged on the way).
+fn next_text(ws: &mut Client) -> Value {
+    loop {
+        match ws.read().unwrap() {
+            Message::Text(t) => return serde_json::from_str(&t).unwrap(),
+            Message::Binary(b) if b.starts_with(b"DQHF") => {
+                let seq = FrameView::parse(&b).unwrap().header.sequence;
+                ws.send(Message::text(format!(r#"{{"type":"ack","seq":{seq}}}"#))).unwrap();
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Without a recording or UDP port the demo still takes records on its `/input` WebSocket:
+/// a viewer is told of the input with its first record, follows the hand, sees the
+/// recognised gestures, and the held gestures of the command table change its view. A bad
+/// record is answered with an error naming it, and the stream goes on.
+#[test]
+fn the_input_socket_drives_the_viewers_and_gestures_act_as_commands() {
+    let server = start("input-socket", &[]);
+    let (lines, labels) = recording("input-socket-rec");
+    let mut viewer = connect(&server);
+    let hello = text(&mut viewer);
+    assert!(hello["input"].is_null(), "no input until a record comes: {hello}");
+    let (mut input, _) = tungstenite::connect(format!("ws://{}/input", server.address)).unwrap();
+    input.send(Message::text("{\"t\": 0.1, \"joints\": {\"wrist\"")).unwrap();
+    let Message::Text(reply) = input.read().unwrap() else { panic!("an error reply expected") };
+    assert!(reply.contains("\"error\"") && reply.contains("truncated record"), "{reply}");
+    input.send(Message::text(" ".repeat(20_000))).unwrap();
+    let Message::Text(reply) = input.read().unwrap() else { panic!("an error reply expected") };
+    assert!(reply.contains("20000 bytes (at most 16384)"), "{reply}");
+    let sender = std::thread::spawn(move || {
+        for line in &lines {
+            input.send(Message::text(line.as_str())).unwrap();
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        input
+    });
+    let again = next_text(&mut viewer);
+    assert_eq!(again["type"], "hello", "the hello again, announcing the input: {again}");
+    assert_eq!(again["input"]["source"], "WebSocket /input");
+    assert!(again["input"]["gestures"].as_array().unwrap().len() >= 12);
+    let (mut events, mut actions, mut states) = (Vec::new(), Vec::new(), Vec::new());
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while states.last() != Some(&"lost".to_owned()) {
+        let m = next_text(&mut viewer);
+        assert_eq!(m["type"], "input", "{m}");
+        assert!(Instant::now() < deadline, "the input never ended: {states:?}");
+        events.extend(m["events"].as_array().unwrap().iter().filter(|e| e["event"] == "start").map(|e| e["gesture"].as_str().unwrap().to_owned()));
+        actions.extend(m["actions"].as_array().unwrap().iter().map(|a| a["action"].as_str().unwrap().to_owned()));
+        states.push(m["tracking"].as_str().unwrap().to_owned());
+        if states.last().unwrap() == "lost" {
+            assert!(m["accepted"].as_u64().unwrap() > 1000 && m["rejected"] == 2, "{m}");
+        }
+    }
+    drop(sender.join().unwrap());
+    let labelled: Vec<&str> = labels["holds"].as_array().unwrap().iter().map(|h| h["gesture"].as_str().unwrap()).collect();
+    let mut expected_events = labelled.clone();
+    expected_events.dedup();
+    assert_eq!(events, expected_events, "each labelled gesture starts once, in order");
+    let expected_actions: Vec<&str> = labelled
+        .iter()
+        .filter_map(|g| match *g {
+            "thumbs_up" => Some("next_method"),
+            "victory" => Some("split_view"),
+            "rock" => Some("toggle_heatmap"),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(actions, expected_actions, "the default command table, once per hold");
+    // The view the commands left (DQB → …): the frames show it, with the hand where the input left it.
+    let mut methods = vec!["dqb"]; // a viewer's first view
+    for a in &expected_actions {
+        match *a {
+            "next_method" => methods = vec![["qb", "dqb", "lb"][["lb", "qb", "dqb"].iter().position(|m| *m == methods[0]).unwrap()]],
+            "split_view" => methods = vec!["lb", "qb", "dqb"],
+            _ => {}
+        }
+    }
+    let heatmap = expected_actions.iter().filter(|a| **a == "toggle_heatmap").count() % 2 == 1;
+    let f = next_frame(&mut viewer);
+    assert_eq!(f.header.methods.as_slice().iter().map(|m| m.as_str()).collect::<Vec<_>>(), methods);
+    assert_eq!(f.header.distortion, heatmap);
+    assert!(f.angles.iter().any(|a| a.abs() > 0.1), "the hand holds the input's last pose, not the rest pose");
+    assert_eq!(f.header.state & 1, 0, "the input stopped the timeline");
+    // A viewer arriving now is told of the input at once.
+    let mut late = connect(&server);
+    assert_eq!(text(&mut late)["input"]["source"], "WebSocket /input");
+}
+
+/// `--udp` and `--input`: the viewers are told of the input from the start and follow it.
+#[test]
+fn udp_and_recorded_inputs_are_announced_and_followed() {
+    let (lines, _) = recording("udp-rec");
+    let server = start("udp", &["--udp", "0"]);
+    let address = server.banner.lines().find_map(|l| l.strip_prefix("input: udp ")).and_then(|l| l.split(',').next()).unwrap_or_else(|| panic!("{}", server.banner)).to_owned();
+    let mut viewer = connect(&server);
+    assert_eq!(text(&mut viewer)["input"]["source"], format!("udp {address}"));
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    for line in lines.iter().take(300) {
+        socket.send_to(line.as_bytes(), &address).unwrap();
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let m = next_text(&mut viewer);
+        if m["tracking"] == "lost" && m["accepted"] == 300 {
+            break;
+        }
+        assert!(Instant::now() < deadline, "{m}");
+    }
+    drop(server);
+    let path = site("recorded-rec").join("rec.jsonl");
+    std::fs::write(&path, lines.join("\n")).unwrap();
+    let server = start("recorded", &["--input", path.to_str().unwrap()]);
+    let mut viewer = connect(&server);
+    assert_eq!(text(&mut viewer)["input"]["source"], path.display().to_string());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let m = next_text(&mut viewer);
+        if m["tracking"] == "tracking" && m["gesture"].is_string() {
+            break;
+        }
+        assert!(Instant::now() < deadline, "{m}");
+    }
+}
+
+/// The input socket is a WebSocket of this server: a page of another site is refused.
+#[test]
+fn the_input_socket_refuses_other_origins() {
+    let server = start("input-origin", &[]);
+    let a = &server.address;
+    let (status, _) = http(
+        a,
+        &format!(
+            "GET /input HTTP/1.1\r\nHost: {a}\r\nOrigin: http://evil.example\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+             Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n"
+        ),
+    );
+    assert_eq!(status, 403);
+    assert_eq!(get(a, "/input").0, 426, "a plain GET is not an upgrade");
+}

@@ -375,3 +375,45 @@ fn vertex_distortion_is_the_mean_change_of_the_edges_at_each_vertex() {
     assert!((out[1] - (1.0 + e12) / 2.0).abs() < 1e-6, "{out:?}");
     assert!((out[2] - e12 / 2.0).abs() < 1e-6, "{out:?}");
 }
+
+/// A viewer in the paper model follows a live input posed in the full model: the DOFs both
+/// have take the input's angles, by name, and its wrist; the timeline stops.
+#[test]
+fn following_an_input_of_another_joint_model_takes_the_shared_angles() {
+    let mut s = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    s.apply(&command(r#"{"type":"joint_model","name":"paper"}"#)).unwrap();
+    let mut input = Pose::rest(JointModel::Full.dof_count());
+    for (k, a) in input.angles.iter_mut().enumerate() {
+        *a = 0.01 * (k + 1) as f32;
+    }
+    input.wrist = Some(DualQuat::from_rotation_translation(glam::Quat::from_rotation_y(0.3), glam::Vec3::new(0.1, 1.0, 0.0)));
+    s.follow(&input, JointModel::Full);
+    for (i, d) in JointModel::Paper.dofs().enumerate() {
+        let k = JointModel::Full.dof_index(&d.name()).unwrap();
+        assert_eq!(s.pose().angles[i], input.angles[k], "{}", d.name());
+    }
+    assert_eq!(s.pose().wrist, input.wrist);
+    assert_eq!(frame(&mut s).header.state & STATE_PLAYING, 0);
+}
+
+/// Gesture commands change the view: the next method alone (cycling), all three, the heat map.
+#[test]
+fn gesture_commands_change_the_view() {
+    use dqhand::input::Action;
+    let mut s = paused();
+    let shown = |s: &Session| s.methods().as_slice().to_vec();
+    assert_eq!(shown(&s), [Method::Dqb]);
+    for expected in [Method::Lb, Method::Qb, Method::Dqb] {
+        s.act(Action::NextMethod);
+        assert_eq!(shown(&s), [expected]);
+    }
+    s.act(Action::SplitView);
+    assert_eq!(shown(&s), Method::ALL);
+    s.act(Action::NextMethod);
+    assert_eq!(shown(&s), [Method::Qb], "after the first of the split view");
+    assert!(!s.heatmap());
+    s.act(Action::ToggleHeatmap);
+    assert!(s.heatmap() && frame(&mut s).header.distortion);
+    s.act(Action::ToggleHeatmap);
+    assert!(!s.heatmap());
+}
