@@ -91,7 +91,7 @@ mod tests {
         assert_eq!(t.update(1.0, []), None, "fist has no row");
         assert_eq!(t.update(1.1, start(1.1, "rock")), None);
         assert_eq!(t.update(1.8, []), None, "0.7 s of this hold");
-        assert_eq!(t.update(1.9, []), Some(Action::ToggleHeatmap));
+        assert_eq!(t.update(1.95, []), Some(Action::ToggleHeatmap));
     }
 
     #[test]
