@@ -1,7 +1,8 @@
 //! The per-frame path allocates nothing: one engine step (pose → local transforms → forward
 //! kinematics → skinning transforms → deformation with each method), with buffers made once
 //! beforehand; and so does a viewer session's frame (playback, three methods, heat map,
-//! encoding).
+//! encoding), and a live record through the gesture loop (check, retarget, filter,
+//! kinematics, features, recogniser, commands) into the input every viewer follows.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -12,7 +13,10 @@ use dqhand::gesture::{GestureSet, HandFeatures, JointPositions, Recognizer, Sequ
 use dqhand::hand::{build, HandParams, Side};
 use dqhand::kinematics::{JointModel, Pose};
 use dqhand::skin::MethodSet;
-use dqhand::stream::{Command, Session};
+use dqhand::input::InputConfig;
+use dqhand::interaction::synthetic::{generate, SyntheticParams};
+use dqhand::interaction::GestureLoop;
+use dqhand::stream::{Command, LiveInput, Session};
 
 /// Counts the allocations of each thread (tests run on threads of their own).
 struct Counting;
@@ -98,4 +102,29 @@ fn gesture_features_and_recognition_allocate_nothing() {
     }
     assert_eq!(allocations() - before, 0, "allocations during 600 frames of features and recognition");
     assert!(events > 10, "the sequence's gestures were recognised: {events} events");
+}
+
+#[test]
+fn a_live_record_and_a_viewer_update_without_news_allocate_nothing() {
+    let model = Arc::new(build(&HandParams { vertices: 2000, ..HandParams::default() }).unwrap());
+    let synthetic = generate(&SyntheticParams { seed: 9, holds: 4, idle_s: 1.0, ..SyntheticParams::default() }).unwrap();
+    let gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, None, InputConfig::default(), Some(GestureSet::builtin())).unwrap();
+    let input = LiveInput::new(gesture_loop, "test", true);
+    let mut session = Session::new(model, JointModel::Full).unwrap();
+    let mut view = input.view();
+    let (warm_up, rest) = synthetic.records.split_at(10);
+    for r in warm_up {
+        input.push(r).unwrap();
+    }
+    let before = allocations();
+    let taken = rest.iter().filter(|r| input.push(r).is_ok()).count();
+    assert_eq!(allocations() - before, 0, "allocations during {} live records", rest.len());
+    assert!(taken > 300, "{taken} records taken");
+    assert!(input.update(&mut session, &mut view).message.is_some(), "the first update reports the state");
+    let _ = input.update(&mut session, &mut view); // the hand may have been marked lost since
+    let before = allocations();
+    for _ in 0..30 {
+        assert!(input.update(&mut session, &mut view).message.is_none());
+    }
+    assert_eq!(allocations() - before, 0, "allocations during 30 viewer updates without news");
 }

@@ -3,12 +3,25 @@
 use crate::math::DualQuat;
 
 /// What a glove and tracker report each frame (paper Figure 1, input layer).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Pose {
     /// The wrist's world transform (the tracker), `None` to keep the rest wrist.
     pub wrist: Option<DualQuat>,
     /// Joint angles in radians, in the order of [`JointModel::dofs`](super::JointModel::dofs).
     pub angles: Vec<f32>,
+}
+
+impl Clone for Pose {
+    fn clone(&self) -> Self {
+        Self { wrist: self.wrist, angles: self.angles.clone() }
+    }
+
+    /// Reuses the angle buffer (a derived `Clone` would allocate a new one per copy, and
+    /// per-frame code copies poses).
+    fn clone_from(&mut self, source: &Self) {
+        self.wrist = source.wrist;
+        self.angles.clone_from(&source.angles);
+    }
 }
 
 impl Pose {
