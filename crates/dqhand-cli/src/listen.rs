@@ -74,8 +74,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let arrival = start.elapsed().as_secs_f64();
         match socket.recv_from(&mut buf) {
             Ok((n, _)) => match live.decode(&buf[..n], &mut record) {
-                Ok(()) => match gesture_loop.push(&record, Some(arrival)) {
-                    Ok(events) => {
+                // A refusal by the loop is counted there.
+                Ok(()) => {
+                    if let Ok(events) = gesture_loop.push(&record, Some(arrival)) {
                         let mut out = stdout.lock();
                         for event in events {
                             serde_json::to_writer(&mut out, &event)?;
@@ -84,8 +85,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         out.flush()?;
                         live.keep(&record);
                     }
-                    Err(_) => {} // counted by the loop
-                },
+                }
                 Err(rejection) => gesture_loop.reject(rejection),
             },
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted) => {}

@@ -318,12 +318,19 @@ fn refuses_a_port_in_use_and_a_missing_viewer() {
     assert_eq!(out.status.code(), Some(2));
 }
 
-/// A synthetic, labelled joints recording (`dqhand synthesize`) in the test's directory.
-fn recording(test: &str) -> (Vec<String>, Value) {
-    let path = site(test).join("rec.jsonl");
-    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["synthesize", "--format", "joints", "--seed", "3", "--out"]).arg(&path).output().unwrap();
+/// A synthetic, labelled recording (`dqhand synthesize`) in the test's directory: its path
+/// and labels.
+fn synthesize(test: &str, format: &str, extension: &str) -> (PathBuf, Value) {
+    let path = site(test).join(format!("rec.{extension}"));
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["synthesize", "--format", format, "--seed", "3", "--out"]).arg(&path).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let labels = serde_json::from_str(&std::fs::read_to_string(path.with_extension("labels.json")).unwrap()).unwrap();
+    (path, labels)
+}
+
+/// A joints recording's lines and labels.
+fn recording(test: &str) -> (Vec<String>, Value) {
+    let (path, labels) = synthesize(test, "joints", "jsonl");
     (std::fs::read_to_string(&path).unwrap().lines().map(str::to_owned).collect(), labels)
 }
 
@@ -439,19 +446,28 @@ fn udp_and_recorded_inputs_are_announced_and_followed() {
         }
         assert!(Instant::now() < deadline, "{m}");
     }
-    drop(server);
-    let path = site("recorded-rec").join("rec.jsonl");
-    std::fs::write(&path, lines.join("\n")).unwrap();
-    let server = start("recorded", &["--input", path.to_str().unwrap()]);
-    let mut viewer = connect(&server);
-    assert_eq!(text(&mut viewer)["input"]["source"], path.display().to_string());
-    let deadline = Instant::now() + Duration::from_secs(60);
-    loop {
-        let m = next_text(&mut viewer);
-        if m["tracking"] == "tracking" && m["gesture"].is_string() {
-            break;
+}
+
+/// A glove, a joints and a landmarks recording each drive the viewer: announced, tracking,
+/// a labelled gesture recognised, the frames showing the hand bent.
+#[test]
+fn every_recording_format_drives_the_viewer() {
+    for (format, extension) in [("glove", "csv"), ("joints", "jsonl"), ("landmarks", "jsonl")] {
+        let (path, labels) = synthesize(&format!("recorded-{format}-rec"), format, extension);
+        let labelled: Vec<&str> = labels["holds"].as_array().unwrap().iter().map(|h| h["gesture"].as_str().unwrap()).collect();
+        let server = start(&format!("recorded-{format}"), &["--input", path.to_str().unwrap()]);
+        let mut viewer = connect(&server);
+        assert_eq!(text(&mut viewer)["input"]["source"], path.display().to_string());
+        let deadline = Instant::now() + Duration::from_secs(60);
+        loop {
+            let m = next_text(&mut viewer);
+            if m["tracking"] == "tracking" && m["gesture"].as_str().is_some_and(|g| labelled.contains(&g) && g != "open_palm") {
+                break;
+            }
+            assert!(Instant::now() < deadline, "{format}: none of {labelled:?} recognised: {m}");
         }
-        assert!(Instant::now() < deadline, "{m}");
+        let f = next_frame(&mut viewer);
+        assert!(f.angles.iter().any(|a| a.to_degrees() > 30.0), "{format}: the hand follows the recording");
     }
 }
 

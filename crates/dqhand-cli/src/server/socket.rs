@@ -83,10 +83,11 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                 Ok(Message::Binary(_)) => send_error(&mut ws, "binary messages are not commands; send JSON text").map_err(io)?,
                 Ok(Message::Close(_)) => return Ok(()),
                 Ok(_) => {}
-                Err(e) => match read_failure(&mut ws, e) {
-                    Some(end) => return end,
-                    None => {}
-                },
+                Err(e) => {
+                    if let Some(end) = read_failure(&mut ws, e) {
+                        return end;
+                    }
+                }
             }
         }
         let now = Instant::now();
