@@ -9,9 +9,9 @@ use std::cell::Cell;
 use std::sync::Arc;
 
 use dqhand::engine::Engine;
-use dqhand::gesture::{GestureSet, HandFeatures, JointPositions, Recognizer, Sequence};
+use dqhand::gesture::{GestureSet, HandFeatures, Recognizer, Sequence};
 use dqhand::hand::{build, HandParams, Side};
-use dqhand::kinematics::{JointModel, Pose};
+use dqhand::kinematics::{JointModel, JointPositions, Pose};
 use dqhand::skin::MethodSet;
 use dqhand::input::InputConfig;
 use dqhand::interaction::synthetic::{generate, SyntheticParams};

@@ -6,9 +6,9 @@
 use std::sync::{Arc, OnceLock};
 
 use dqhand::engine::Engine;
-use dqhand::gesture::{Event, EventKind, Feature, Finger, GestureSet, HandFeatures, JointPositions, Recognizer, GESTURES};
+use dqhand::gesture::{Event, EventKind, Feature, Finger, GestureSet, HandFeatures, Recognizer, GESTURES};
 use dqhand::hand::{build, HandParams, Side};
-use dqhand::kinematics::{JointModel, Pose};
+use dqhand::kinematics::{JointModel, JointPositions, Pose};
 use dqhand::math::DualQuat;
 use dqhand::{Error, GestureProblem};
 use glam::{Quat, Vec3};

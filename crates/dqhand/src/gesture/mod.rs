@@ -4,14 +4,12 @@
 
 mod definitions;
 mod features;
-mod joint_positions;
 mod library;
 mod recognizer;
 mod sequence;
 
 pub use definitions::{Comparison, Condition, GestureDefinition, GestureSet};
 pub use features::{Feature, FeatureKind, Finger, HandFeatures};
-pub use joint_positions::JointPositions;
 pub use library::{gesture, Gesture, GESTURES};
 pub use recognizer::{Event, EventKind, Events, Recognizer};
 pub use sequence::{Keyframe, Sequence};

@@ -27,7 +27,7 @@ use glam::{Affine3A, Mat3, Quat, Vec3};
 use super::record::{JOINT_COUNT, LANDMARK_COUNT};
 use super::{mediapipe, RejectKind, Rejection};
 use crate::hand::Side;
-use crate::kinematics::{webxr, HandRig, Motion, Pose, RigDof};
+use crate::kinematics::{webxr, HandRig, JointPositions, Motion, Pose, RigDof};
 use crate::math::DualQuat;
 
 /// Tracked thumb-to-fingertip gap below which the virtual tips are brought to the same gap.
@@ -91,13 +91,7 @@ impl Retargeter {
     /// [`crate::Error::MissingJoint`] naming a WebXR joint the skeleton lacks.
     pub fn new(rig: &HandRig) -> crate::Result<Self> {
         let skeleton = rig.skeleton();
-        let mut index = [0; JOINT_COUNT];
-        for (i, name) in webxr::JOINT_NAMES.iter().enumerate() {
-            index[i] = skeleton.find(name).ok_or_else(|| crate::Error::MissingJoint {
-                joint: (*name).into(),
-                needed_for: "retargeting tracked hands needs all 25 WebXR joints",
-            })?;
-        }
+        let index = *JointPositions::new(skeleton)?.indices();
         let rest_world = skeleton.rest_world();
         let rest = |i: usize| Vec3::from(rest_world[index[i]].translation);
         let positions: [Vec3; JOINT_COUNT] = core::array::from_fn(rest);

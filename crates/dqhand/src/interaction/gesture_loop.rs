@@ -10,11 +10,11 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::engine::Engine;
-use crate::gesture::{Events, GestureSet, HandFeatures, JointPositions, Recognizer};
+use crate::gesture::{Events, GestureSet, HandFeatures, Recognizer};
 use crate::hand::Side;
 use super::CommandTable;
 use crate::input::{Action, GloveMapper, InputConfig, InputPipeline, Record, Rejection};
-use crate::kinematics::JointModel;
+use crate::kinematics::{JointModel, JointPositions};
 use crate::model::Model;
 use crate::Result;
 

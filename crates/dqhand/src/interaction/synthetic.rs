@@ -16,10 +16,10 @@ use std::sync::Arc;
 use glam::{Affine3A, Quat, Vec3};
 
 use crate::engine::Engine;
-use crate::gesture::{gesture, JointPositions, GESTURES};
+use crate::gesture::{gesture, GESTURES};
 use crate::hand::{HandParams, Side};
 use crate::input::{mediapipe, Calibration, GloveSample, HandData, JointSet, MappingTable, MountingOffset, Record, RigidPose, TrackedJoint};
-use crate::kinematics::{JointModel, Pose};
+use crate::kinematics::{JointModel, JointPositions, Pose};
 use crate::math::DualQuat;
 use crate::Result;
 

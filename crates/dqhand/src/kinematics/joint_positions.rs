@@ -1,11 +1,10 @@
-//! The 25 WebXR joint positions of a posed skeleton, the input of [`HandFeatures`]: the
-//! joint indices are resolved once per skeleton, so each frame only copies translations.
-//!
-//! [`HandFeatures`]: super::HandFeatures
+//! The 25 WebXR joints of a skeleton: their indices, resolved once per skeleton (for
+//! retargeting), and their positions in a posed skeleton, copied each frame (the input of
+//! the gesture features).
 
 use glam::{Affine3A, Vec3};
 
-use crate::kinematics::{webxr, Skeleton};
+use super::{webxr, Skeleton};
 use crate::{Error, Result};
 
 /// Where the WebXR joints sit in one skeleton.
@@ -27,7 +26,7 @@ impl JointPositions {
         for (slot, name) in indices.iter_mut().zip(webxr::JOINT_NAMES) {
             *slot = skeleton
                 .find(name)
-                .ok_or_else(|| Error::MissingJoint { joint: name.to_owned(), needed_for: "gesture features need the 25 WebXR hand joints" })?;
+                .ok_or_else(|| Error::MissingJoint { joint: name.to_owned(), needed_for: "gesture features and retargeting need the 25 WebXR hand joints" })?;
         }
         Ok(Self { indices })
     }
