@@ -149,7 +149,7 @@ impl GestureSet {
         Self::from_json(include_str!("../../data/gestures.json"), "gestures.json (built-in)").expect("the built-in gestures.json parses")
     }
 
-    /// Reads definitions from a JSON file ([module docs](self)).
+    /// Reads definitions from a JSON file (see the module docs).
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be read, else as [`Self::from_json`].

@@ -81,7 +81,7 @@ impl FeatureKind {
     }
 }
 
-/// One named feature ([module docs](self) list them).
+/// One named feature (the module docs list them).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Feature {
     /// Curl of a finger, 0 straight … 1 fully curled.

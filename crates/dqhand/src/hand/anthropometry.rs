@@ -43,7 +43,7 @@ const MCP_ACROSS: [f32; 4] = [0.33, 0.10, -0.12, -0.32];
 const SPREAD_DEG: [f32; 4] = [9.0, 1.0, -7.0, -15.0];
 
 /// Hand length and breadth from the 25 WebXR joint positions of a hand (any pose, any
-/// place): the inverse of [`Anatomy::new`]'s proportions, so measuring a hand it built gives
+/// place): the inverse of the proportions `Anatomy::new` builds with, so measuring a hand it built gives
 /// back its length and breadth.
 ///
 /// * length: the middle finger's proximal + intermediate + distal bones, which do not change

@@ -1,15 +1,15 @@
 //! The built-in anatomical hand: a parametric left or right hand from two measurements.
 //!
 //! The pipeline, one file each:
-//! * [`anthropometry`]: the 20-bone skeleton (25 WebXR joints with the tips) and the finger
+//! * `anthropometry`: the 20-bone skeleton (25 WebXR joints with the tips) and the finger
 //!   breadths, as fractions of hand length and breadth from published anthropometry;
-//! * [`shape`]: the skin as an implicit surface: anatomical parts per bone (phalanges with
+//! * `shape`: the skin as an implicit surface: anatomical parts per bone (phalanges with
 //!   knuckles, pads and nails, metacarpals forming a palm that narrows to the wrist, thenar
 //!   and hypothenar eminences) blended by smooth minima;
-//! * [`tessellation`]: that surface meshed (surface nets), simplified to an exact vertex count
+//! * `tessellation`: that surface meshed (surface nets), simplified to an exact vertex count
 //!   (meshoptimizer), relaxed and projected back onto the surface: one closed, 2-manifold
 //!   mesh, 8,668 vertices by default (the paper's Table 2);
-//! * [`weights`]: skin weights from each bone's parts, at most four per vertex.
+//! * `weights`: skin weights from each bone's parts, at most four per vertex.
 //!
 //! UVs are a planar projection onto the palm plane (u across the hand, v along it), the same
 //! for the back and the palm: seamless, so glTF's vertex count is the mesh's.
