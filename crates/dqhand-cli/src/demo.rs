@@ -3,6 +3,7 @@
 
 use std::net::{IpAddr, SocketAddr, TcpListener, UdpSocket};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicUsize;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -59,7 +60,8 @@ pub struct Args {
     /// Take live records on this UDP port, one JSON record per datagram, at --host.
     #[arg(long)]
     udp: Option<u16>,
-    /// Append every live record taken (UDP, the /input WebSocket) to this file, JSON lines.
+    /// Record every live record taken (UDP, the /input WebSocket) to this file (JSON lines,
+    /// replacing the file, each record written out as it is taken).
     #[arg(long)]
     record: Option<PathBuf>,
     #[command(flatten)]
@@ -108,9 +110,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// The live input: the recording played, or the UDP port, or only the `/input` WebSocket
 /// (always open), each record recognised and every viewer following.
 fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> anyhow::Result<Arc<Feed>> {
-    let gestures = Some(gesture_set(args.gestures_file.as_deref(), true)?.expect("recognition on"));
+    let gestures = gesture_set(args.gestures_file.as_deref(), true)?.expect("recognition on");
+    let mut config = args.common.config()?;
+    if args.common.config.is_none() {
+        // The default commands, for the gestures there are (another gesture file may lack them).
+        config.actions.retain(|a| gestures.gestures().iter().any(|g| g.name() == a.gesture));
+    }
     let mapper = Some(args.common.mapper(args.joint_model)?);
-    let gesture_loop = GestureLoop::new(Arc::clone(model), args.joint_model, mapper, args.common.config()?, gestures)?;
+    let gesture_loop = GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?.with_commands()?;
+    if let (Some(input), Some(record)) = (&args.input, &args.record) {
+        if input.canonicalize().ok() == record.canonicalize().ok() {
+            anyhow::bail!("{}: --record would replace the recording being played", record.display());
+        }
+    }
     let records = LiveRecords::new(&args.common, args.record.as_deref())?;
     let udp = match args.udp {
         Some(port) => {
@@ -125,7 +137,9 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
         (None, None) => "WebSocket /input".to_owned(),
     };
     let announce = args.input.is_some() || udp.is_some();
-    let feed = Arc::new(Feed { input: LiveInput::new(gesture_loop, source.clone(), announce), records });
+    let feed = Arc::new(Feed { input: LiveInput::new(gesture_loop, source.clone(), announce), records, clients: AtomicUsize::new(0) });
+    let reporter = Arc::clone(&feed);
+    std::thread::spawn(move || reporter.report());
     if let Some(path) = &args.input {
         RecordingReader::open(path, args.format, &args.common)?; // fail now, not in the thread
         let (feed, path, format, common) = (Arc::clone(&feed), path.clone(), args.format, args.common.clone());

@@ -4,6 +4,7 @@
 use std::io::ErrorKind;
 use std::net::UdpSocket;
 use std::path::Path;
+use std::sync::atomic::AtomicUsize;
 use std::time::{Duration, Instant};
 
 use dqhand::input::{Record, Rejection};
@@ -16,7 +17,17 @@ use crate::recording::{Format, InputArgs, RecordingReader};
 pub struct Feed {
     pub input: LiveInput,
     pub records: LiveRecords,
+    /// `/input` connections open now (each holds a thread; see [`MAX_INPUT_CLIENTS`]).
+    pub clients: AtomicUsize,
 }
+
+/// `/input` connections at once; more are refused (one hand takes one sender at a time).
+pub const MAX_INPUT_CLIENTS: usize = 4;
+/// The longest pause between two records of a played recording, seconds; a longer one is
+/// played as this long (a recording may stop for minutes, or claim a year between records).
+const MAX_PAUSE_S: f64 = 5.0;
+/// How often the demo logs new refusals (one line per kind).
+const REPORT_PERIOD: Duration = Duration::from_secs(5);
 
 impl Feed {
     /// Takes one datagram or message: decoded, given to the input, recorded if taken.
@@ -28,9 +39,7 @@ impl Feed {
             self.input.reject(rejection.clone());
             return Err(rejection);
         }
-        self.input.push(record)?;
-        self.records.keep(record);
-        Ok(())
+        self.input.push(record, |r| self.records.keep(r))
     }
 
     /// Receives datagrams forever (until the socket fails).
@@ -50,34 +59,55 @@ impl Feed {
 
     /// Plays a recording in real time, from its first record's time, over and over: each
     /// pass follows the previous one by its last interval between records, so the input's
-    /// clock runs on and the hand does not drop out between passes.
+    /// clock runs on and the hand does not drop out between passes. Pauses longer than
+    /// [`MAX_PAUSE_S`] are shortened to it; unreadable records are counted on the first pass.
     pub fn play(&self, path: &Path, format: Option<Format>, args: &InputArgs) -> anyhow::Result<()> {
         let start = Instant::now();
         let mut record = self.records.blank();
-        let mut shift = 0.0;
+        let (mut shift, mut pass) = (0.0, 0);
         loop {
             let mut reader = RecordingReader::open(path, format, args)?;
-            let (mut first, mut last, mut interval) = (None::<f64>, None::<f64>, FIRST_INTERVAL);
+            let (mut first, mut last, mut interval, mut played) = (None::<f64>, None::<f64>, FIRST_INTERVAL, 0.0);
             while let Some(read) = reader.next(&mut record)? {
                 if let Err(rejection) = read {
-                    self.input.reject(rejection.at(path.display()));
+                    if pass == 0 {
+                        self.input.reject(rejection.at(path.display()));
+                    }
                     continue;
                 }
-                let first = *first.get_or_insert(record.time);
-                if let Some(previous) = last.filter(|&p| record.time > p) {
-                    interval = record.time - previous;
+                let t = record.time;
+                first.get_or_insert(t);
+                // Out of order: played at the time of the one before, and refused by the input.
+                if let Some(previous) = last.filter(|&p| t > p) {
+                    interval = (t - previous).min(MAX_PAUSE_S);
+                    played += interval;
                 }
-                last = Some(record.time);
-                record.time += shift - first;
-                if let Some(wait) = Duration::from_secs_f64(record.time.max(0.0)).checked_sub(start.elapsed()) {
+                last = Some(t);
+                record.time = shift + played;
+                if let Some(wait) = Duration::try_from_secs_f64(record.time).ok().and_then(|due| due.checked_sub(start.elapsed())) {
                     std::thread::sleep(wait);
                 }
-                let _ = self.input.push(&record); // refusals are counted and shown
+                let _ = self.input.push(&record, |_| {}); // refusals are counted and shown
             }
-            let (Some(first), Some(last)) = (first, last) else {
+            if first.is_none() {
                 anyhow::bail!("{}: no record to play", path.display());
-            };
-            shift += last - first + interval;
+            }
+            shift += played + interval;
+            pass += 1;
+        }
+    }
+
+    /// Logs the refusals on stderr, one line per kind, every few seconds when there are new
+    /// ones (the viewers show the totals).
+    pub fn report(&self) {
+        let mut reported = 0;
+        loop {
+            std::thread::sleep(REPORT_PERIOD);
+            let (taken, refused, lines) = self.input.summary();
+            if refused > reported {
+                crate::live::log_refusals("input", taken, refused, &lines);
+                reported = refused;
+            }
         }
     }
 }

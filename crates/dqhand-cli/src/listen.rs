@@ -26,7 +26,8 @@ pub struct Args {
     /// Address to receive on. The default takes datagrams from this machine only.
     #[arg(long, default_value = "127.0.0.1")]
     host: IpAddr,
-    /// Append every record taken to this file (JSON lines, flushed record by record).
+    /// Record every record taken to this file (JSON lines, replacing the file, each record
+    /// written out as it is taken).
     #[arg(long)]
     record: Option<PathBuf>,
     #[command(flatten)]
@@ -71,12 +72,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let start = Instant::now();
     let (mut reported, mut last_report) = (0, start);
     while args.seconds.is_none_or(|s| start.elapsed().as_secs_f64() < s) {
-        let arrival = start.elapsed().as_secs_f64();
         match socket.recv_from(&mut buf) {
             Ok((n, _)) => match live.decode(&buf[..n], &mut record) {
                 // A refusal by the loop is counted there.
                 Ok(()) => {
-                    if let Ok(events) = gesture_loop.push(&record, Some(arrival)) {
+                    if let Ok(events) = gesture_loop.push(&record, Some(start.elapsed().as_secs_f64())) {
                         let mut out = stdout.lock();
                         for event in events {
                             serde_json::to_writer(&mut out, &event)?;
@@ -91,8 +91,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted) => {}
             Err(e) => return Err(e).context(format!("udp {address}")),
         }
-        let now = gesture_loop.pipeline().stream_time(start.elapsed().as_secs_f64());
-        gesture_loop.advance(now);
+        gesture_loop.advance(start.elapsed().as_secs_f64());
         let state = gesture_loop.pipeline().tracking();
         if state != tracking {
             eprintln!("tracking: {}", state.as_str());
@@ -111,8 +110,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// The records taken and refused so far, one line per kind of refusal.
 fn summarise(gesture_loop: &GestureLoop) {
     let pipeline = gesture_loop.pipeline();
-    for line in pipeline.rejections().summary() {
-        eprintln!("dqhand: udp: {line}");
-    }
-    eprintln!("{} records taken, {} rejected", pipeline.accepted(), pipeline.rejections().total());
+    let lines: Vec<String> = pipeline.rejections().summary().collect();
+    crate::live::log_refusals("udp", pipeline.accepted(), pipeline.rejections().total(), &lines);
 }

@@ -24,7 +24,8 @@ pub struct LiveRecords {
 }
 
 impl LiveRecords {
-    /// Records of `args`' default side and glove, recorded to `record` if given.
+    /// Records of `args`' default side and glove, recorded to `record` if given (a new file,
+    /// replacing one that is there).
     pub fn new(args: &InputArgs, record: Option<&Path>) -> anyhow::Result<Self> {
         let sensors = args.table()?.layout().sensors().iter().map(|s| s.name.clone()).collect();
         let recorder = record.map(Recorder::create).transpose()?;
@@ -50,6 +51,14 @@ impl LiveRecords {
             r.append(record, &self.sensors);
         }
     }
+}
+
+/// Logs the records taken and refused so far on stderr, the refusals one line per kind.
+pub fn log_refusals(source: &str, taken: u64, refused: u64, lines: &[String]) {
+    for line in lines {
+        eprintln!("dqhand: {source}: {line}");
+    }
+    eprintln!("dqhand: {source}: {taken} records taken, {refused} rejected");
 }
 
 /// A recording being written: one JSON line per record, each written whole and handed to

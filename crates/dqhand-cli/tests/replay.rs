@@ -173,7 +173,7 @@ fn listen_takes_udp_records_prints_events_and_records_what_it_took() {
             10 => drop(socket.send_to(b"{\"t\": 0.1, \"joints\": {\"wrist\"", &address)),
             20 => drop(socket.send_to(lines[5].as_bytes(), &address)), // time going backwards
             30 => drop(socket.send_to(lines[31].replace("\"wrist\"", "\"wrist-bone\"").as_bytes(), &address)),
-            40 => drop(socket.send_to(&vec![b' '; 20_000], &address)),
+            40 => drop(socket.send_to(&vec![b'x'; 20_000], &address)),
             _ => {}
         }
         socket.send_to(line.as_bytes(), &address).unwrap();
@@ -189,10 +189,11 @@ fn listen_takes_udp_records_prints_events_and_records_what_it_took() {
     for needle in ["1 record rejected (malformed)", "1 record rejected (unknown name)", "1 record rejected (out of order)", "1 record rejected (too large)", "tracking: tracking", "tracking: lost"] {
         assert!(rest.contains(needle), "{needle:?} not in {rest}");
     }
-    let taken = format!("{} records taken, 4 rejected", lines.len());
-    assert!(rest.contains(&taken), "{taken:?} not in {rest}");
+    // Loopback UDP may drop a datagram on a loaded machine: count what was taken.
+    let taken: usize = rest.lines().find_map(|l| l.strip_suffix(" records taken, 4 rejected")).and_then(|l| l.rsplit(' ').next()?.parse().ok()).unwrap_or_else(|| panic!("no total in {rest}"));
+    assert!(taken * 20 >= lines.len() * 19, "{taken} of {} records taken", lines.len());
     let recording = std::fs::read_to_string(&recorded).unwrap();
-    assert_eq!(recording.lines().count(), lines.len(), "every record taken is recorded, nothing else");
+    assert_eq!(recording.lines().count(), taken, "every record taken is recorded, nothing else");
     let replayed = dqhand(&["replay", "--input", recorded.to_str().unwrap(), "--gestures", "--hand", "left"]);
     assert_eq!(events(&replayed), live, "the recording replays to the events seen live");
 }

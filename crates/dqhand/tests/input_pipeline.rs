@@ -181,3 +181,37 @@ fn glove_and_tracker_records_pose_the_hand() {
     let paper = GloveMapper::new(&table, &calibration, JointModel::Paper).unwrap();
     assert!(InputPipeline::new(&rig(), Some(paper), unfiltered()).is_err());
 }
+
+/// A live sender whose clock jumps ahead is refused; "lost" follows the arrival clock, so no
+/// capture time holds the hand in "tracking"; once lost, a sender that restarted its clock at
+/// zero (or another sender) is taken as a new stream.
+#[test]
+fn live_streams_jump_restart_and_go_lost_by_the_arrival_clock() {
+    let config = unfiltered();
+    let grace = config.grace_s;
+    let mut p = InputPipeline::new(&rig(), None, config).unwrap();
+    let fist = gesture("fist").unwrap().pose(JointModel::Full);
+    let open = gesture("open_palm").unwrap().pose(JointModel::Full);
+    // Arrival = capture + 100 s; one record 20 ms faster than the others is still taken.
+    p.push(&joints_record(5.0, &fist), Some(105.0)).unwrap();
+    p.push(&joints_record(5.1, &fist), Some(105.08)).unwrap();
+    let jump = p.push(&joints_record(1e300, &open), Some(105.2)).unwrap_err();
+    assert_eq!(jump.kind, RejectKind::OutOfRange, "{jump}");
+    assert!(jump.to_string().contains("ahead of the stream's clock"), "{jump}");
+    p.push(&joints_record(5.2, &fist), Some(105.2)).unwrap();
+    // Records that stop: lost after the grace time on the arrival clock.
+    p.advance(105.2 + grace * 0.5);
+    assert_eq!(p.tracking(), Tracking::Tracking);
+    p.advance(105.2 + grace * 1.5);
+    assert_eq!(p.tracking(), Tracking::Lost);
+    // The sender restarts at t = 0: a new stream, taken, and the hand follows it.
+    p.push(&joints_record(0.0, &open), Some(300.0)).unwrap();
+    assert_eq!(p.tracking(), Tracking::Tracking);
+    for k in 1..40 {
+        let t = f64::from(k) / 60.0;
+        p.push(&joints_record(t, &open), Some(300.0 + t)).unwrap();
+    }
+    assert!(max_diff_deg(p.pose(), &open) < 0.5, "the new stream drives the hand");
+    // While tracking, a second sender's clock is refused (out of order), not mixed in.
+    assert_eq!(p.push(&joints_record(0.1, &fist), Some(300.7)).unwrap_err().kind, RejectKind::OutOfOrder);
+}

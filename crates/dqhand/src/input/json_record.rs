@@ -139,6 +139,7 @@ impl<'de: 'a, 'a, V: Deserialize<'de> + Copy + Default, const N: usize> Deserial
 /// # Errors
 /// As [`parse_record`]; `TooLarge` beyond [`MAX_RECORD_BYTES`], `Malformed` if not UTF-8.
 pub fn parse_message<S: AsRef<str>>(bytes: &[u8], default_side: Side, glove_sensors: &[S], out: &mut Record) -> Result<(), Rejection> {
+    let bytes = bytes.trim_ascii();
     if bytes.len() > MAX_RECORD_BYTES {
         return Err(Rejection::new(RejectKind::TooLarge, format!("record of {} bytes (at most {MAX_RECORD_BYTES})", bytes.len())));
     }
@@ -376,7 +377,7 @@ impl<R: BufRead> JsonRecordReader<R> {
                 let bytes = self.line.len() + skip_line(&mut self.reader)?;
                 return Ok(Some(Err(Rejection::new(RejectKind::TooLarge, format!("{at}: {bytes} bytes (at most {MAX_RECORD_BYTES})")))));
             }
-            if self.line.iter().all(u8::is_ascii_whitespace) {
+            if std::str::from_utf8(&self.line).is_ok_and(|text| text.trim().is_empty()) {
                 continue;
             }
             return Ok(Some(parse_message(&self.line, self.default_side, &self.glove_sensors, out).map_err(|r| r.at(at))));

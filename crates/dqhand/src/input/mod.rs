@@ -26,7 +26,7 @@ pub use glove_layout::{GloveLayout, Sensor, SensorKind, RAW_MAX};
 pub use glove_mapper::GloveMapper;
 pub use glove_mapping::{Coupling, MappingEntry, MappingTable};
 pub use one_euro::{Filtered, OneEuro, OneEuroFilter, OneEuroParams, OneEuroRotation, OneEuroVec3};
-pub use pipeline::{InputPipeline, Tracking};
+pub use pipeline::{InputPipeline, Tracking, MAX_LEAD_S};
 pub use record::{GloveSample, HandData, JointSet, Record, RigidPose, TrackedJoint, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 pub use rejection::{RejectKind, Rejection, Rejections};
 pub use retarget::{Retargeter, CONTACT_FADE, CONTACT_FULL};

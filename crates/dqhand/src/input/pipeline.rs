@@ -4,6 +4,14 @@
 //! the hand holds its last pose, is marked "tracking lost" after the grace time, and blends
 //! back smoothly when they return.
 //!
+//! A live stream is timed by two clocks: the records' capture times and their local arrival.
+//! The stream's clock offset is its fastest delivery (smallest `arrival − capture`); a record
+//! slower than that by `max_latency_s` is late, one more than [`MAX_LEAD_S`] ahead of it is a
+//! jump of the sender's clock and out of range. "Tracking lost" is judged on the arrival
+//! clock, so no capture time can hold the hand in "tracking". Once lost, a record that does
+//! not fit the old stream (out of order, late, ahead) starts a new one: a sender that
+//! restarted with its clock at zero, or another sender, is taken after `grace_s`.
+//!
 //! Every per-record buffer is made up front: [`InputPipeline::push`] allocates nothing.
 
 use glam::Vec3;
@@ -12,6 +20,10 @@ use super::record::JOINT_COUNT;
 use super::{GloveMapper, HandData, InputConfig, OneEuro, OneEuroRotation, OneEuroVec3, Record, RejectKind, Rejection, Rejections, Retargeter};
 use crate::kinematics::{HandRig, Pose};
 use crate::math::DualQuat;
+
+/// How far ahead of the stream's clock a live record may claim to be, seconds: beyond it the
+/// sender's clock jumped (a faster delivery gains milliseconds, not a second).
+pub const MAX_LEAD_S: f64 = 1.0;
 
 /// Whether the hand follows the user.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,8 +57,10 @@ pub struct InputPipeline {
     angle_filters: Vec<OneEuro>,
     position_filter: OneEuroVec3,
     rotation_filter: OneEuroRotation,
-    /// Time of the last good record.
+    /// Capture time of the last good record.
     last_time: Option<f64>,
+    /// Arrival time of the last good live record.
+    last_arrival: Option<f64>,
     /// Smallest `arrival − capture time` seen on a live stream: the stream's clock offset.
     clock_offset: Option<f64>,
     state: Tracking,
@@ -82,6 +96,7 @@ impl InputPipeline {
             position_filter: OneEuroVec3::new(config.position_filter),
             rotation_filter: OneEuroRotation::new(config.rotation_filter),
             last_time: None,
+            last_arrival: None,
             clock_offset: None,
             state: Tracking::Waiting,
             recovering: None,
@@ -143,21 +158,14 @@ impl InputPipeline {
         self.rejections.add(rejection);
     }
 
-    /// Marks the hand lost if no good record came for the grace time before `now` (in the
-    /// records' clock; for a live stream, [`Self::stream_time`] of the arrival time).
+    /// Marks the hand lost if no good record came for the grace time before `now`: the local
+    /// arrival clock of [`Self::push`] on a live stream, the records' clock for a file.
     pub fn advance(&mut self, now: f64) {
-        if let (Tracking::Tracking, Some(last)) = (self.state, self.last_time) {
+        if let (Tracking::Tracking, Some(last)) = (self.state, self.last_arrival.or(self.last_time)) {
             if now - last > self.config.grace_s {
                 self.state = Tracking::Lost;
             }
         }
-    }
-
-    /// The records' clock at local `arrival` time (seconds), from the stream's clock offset;
-    /// `arrival` itself before any live record.
-    #[must_use]
-    pub fn stream_time(&self, arrival: f64) -> f64 {
-        arrival - self.clock_offset.unwrap_or(0.0)
     }
 
     /// Takes one record: from a file with `arrival` `None`, live with its local arrival time
@@ -175,24 +183,13 @@ impl InputPipeline {
 
     fn take(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
         let t = record.time;
-        let at = |kind, what: String| Rejection::new(kind, format!("record at t = {t} s: {what}"));
-        if let Some(last) = self.last_time {
-            if t <= last {
-                return Err(at(RejectKind::OutOfOrder, format!("not after the previous record ({last} s)")));
-            }
-            if t - last < 1.0 / self.config.max_rate_hz {
-                return Err(at(RejectKind::Flood, format!("{:.2} ms after the previous record (at most {} per second)", (t - last) * 1e3, self.config.max_rate_hz)));
-            }
+        if arrival.is_some() && self.state == Tracking::Lost && self.fit(t, arrival).is_err() {
+            (self.last_time, self.last_arrival, self.clock_offset) = (None, None, None); // a new stream
         }
-        if let Some(arrival) = arrival {
-            let offset = arrival - t;
-            let fastest = self.clock_offset.map_or(offset, |o| o.min(offset));
-            if offset - fastest > self.config.max_latency_s {
-                return Err(at(RejectKind::Late, format!("arrived {:.0} ms late", (offset - fastest) * 1e3)));
-            }
-            self.clock_offset = Some(fastest);
-        }
+        let fastest = self.fit(t, arrival)?;
         self.solve(record)?;
+        self.clock_offset = fastest;
+        self.last_arrival = arrival;
         let dt = self.last_time.map_or(0.0, |last| (t - last) as f32);
         let resume = self.state != Tracking::Tracking;
         self.filter(dt, resume);
@@ -215,6 +212,31 @@ impl InputPipeline {
         self.last_time = Some(t);
         self.accepted += 1;
         Ok(())
+    }
+
+    /// Whether a record captured at `t` (arriving at `arrival`, live) continues the stream:
+    /// after the previous record and not faster than the rate bound, and live, neither late
+    /// nor ahead. Returns the stream's clock offset with it.
+    fn fit(&self, t: f64, arrival: Option<f64>) -> Result<Option<f64>, Rejection> {
+        let at = |kind, what: String| Rejection::new(kind, format!("record at t = {t} s: {what}"));
+        if let Some(last) = self.last_time {
+            if t <= last {
+                return Err(at(RejectKind::OutOfOrder, format!("not after the previous record ({last} s)")));
+            }
+            if t - last < 1.0 / self.config.max_rate_hz {
+                return Err(at(RejectKind::Flood, format!("{:.2} ms after the previous record (at most {} per second)", (t - last) * 1e3, self.config.max_rate_hz)));
+            }
+        }
+        let Some(arrival) = arrival else { return Ok(self.clock_offset) };
+        let offset = arrival - t;
+        let Some(fastest) = self.clock_offset else { return Ok(Some(offset)) };
+        if offset - fastest > self.config.max_latency_s {
+            return Err(at(RejectKind::Late, format!("arrived {:.0} ms late", (offset - fastest) * 1e3)));
+        }
+        if fastest - offset > MAX_LEAD_S {
+            return Err(at(RejectKind::OutOfRange, format!("{:.1} s ahead of the stream's clock (the sender's clock jumped)", fastest - offset)));
+        }
+        Ok(Some(fastest.min(offset)))
     }
 
     /// The record's pose into `self.solved` (angles untouched by a tracker-only record).

@@ -34,19 +34,27 @@ pub struct GestureLoop {
 impl GestureLoop {
     /// A loop posing `model` with `joint_model`; `gestures` turns recognition on.
     ///
-    /// With recognition on, the configuration's `actions` become the loop's commands.
-    ///
     /// # Errors
-    /// As [`Engine::with_joint_model`], [`InputPipeline::new`], [`JointPositions::new`] and
-    /// [`CommandTable::new`].
+    /// As [`Engine::with_joint_model`], [`InputPipeline::new`] and [`JointPositions::new`].
     pub fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>) -> Result<Self> {
         let engine = Engine::with_joint_model(model, joint_model)?;
         let rig = engine.rig().expect("an engine with a joint model has a rig");
         let pipeline = InputPipeline::new(rig, glove, config)?;
         let joints = JointPositions::new(engine.skeleton())?;
         let side = pipeline.retargeter().side();
-        let commands = gestures.as_ref().map(|set| CommandTable::new(&pipeline.config().actions, set)).transpose()?;
-        Ok(Self { pipeline, engine, joints, positions: [Vec3::ZERO; 25], side, recognizer: gestures.map(Recognizer::new), commands, action: None })
+        Ok(Self { pipeline, engine, joints, positions: [Vec3::ZERO; 25], side, recognizer: gestures.map(Recognizer::new), commands: None, action: None })
+    }
+
+    /// The loop with the configuration's `actions` as its commands ([`Self::action`]), where
+    /// gestures drive a viewer; without recognition there are none.
+    ///
+    /// # Errors
+    /// As [`CommandTable::new`]: an action naming a gesture the loop does not recognise.
+    pub fn with_commands(mut self) -> Result<Self> {
+        if let Some(recognizer) = &self.recognizer {
+            self.commands = Some(CommandTable::new(&self.pipeline.config().actions, recognizer.set())?);
+        }
+        Ok(self)
     }
 
     /// Takes one record (`arrival`: see [`InputPipeline::push`]): poses the virtual hand and,

@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 
 use super::Session;
-use crate::gesture::EventKind;
+use crate::gesture::{Event, EventKind};
 use crate::input::{Action, Record, Rejection, Tracking};
 use crate::interaction::GestureLoop;
 use crate::kinematics::JointModel;
@@ -122,11 +122,13 @@ impl LiveInput {
         }
     }
 
-    /// Takes one record arriving now.
+    /// Takes one record arriving now; `taken` sees it once the loop has taken it, in the order
+    /// records are taken (under the input's lock: recording it there keeps a recording in
+    /// that order when several sources send at once).
     ///
     /// # Errors
     /// The record's refusal (counted, and reported to the viewers in the totals).
-    pub fn push(&self, record: &Record) -> Result<(), Rejection> {
+    pub fn push(&self, record: &Record, taken: impl FnOnce(&Record)) -> Result<(), Rejection> {
         let arrival = self.clock();
         let mut guard = self.lock();
         let State { gesture_loop, log, logged } = &mut *guard;
@@ -141,6 +143,7 @@ impl LiveInput {
         for e in gesture_loop.push(record, Some(arrival))? {
             add(Entry::Event { t: e.t, event: e.event, gesture: index(e.gesture) });
         }
+        taken(record);
         if let (Some(action), Some(gesture)) = (gesture_loop.action(), gesture_loop.gesture()) {
             add(Entry::Action { t: record.time, gesture: index(gesture), action });
         }
@@ -150,6 +153,14 @@ impl LiveInput {
     /// Counts a record refused before it got here (unreadable, too large).
     pub fn reject(&self, rejection: Rejection) {
         self.lock().gesture_loop.reject(rejection);
+    }
+
+    /// The records taken so far, and the refusals, one line per kind (for a log).
+    #[must_use]
+    pub fn summary(&self) -> (u64, u64, Vec<String>) {
+        let state = self.lock();
+        let pipeline = state.gesture_loop.pipeline();
+        (pipeline.accepted(), pipeline.rejections().total(), pipeline.rejections().summary().collect())
     }
 
     /// A viewer's view of the input, from now on (earlier events are not replayed to it).
@@ -164,8 +175,7 @@ impl LiveInput {
     pub fn update(&self, session: &mut Session, view: &mut InputView) -> InputUpdate {
         let arrival = self.clock();
         let mut state = self.lock();
-        let time = state.gesture_loop.pipeline().stream_time(arrival);
-        state.gesture_loop.advance(time);
+        state.gesture_loop.advance(arrival);
         let pipeline = state.gesture_loop.pipeline();
         let (accepted, rejected) = (pipeline.accepted(), pipeline.rejections().total());
         let mut update = InputUpdate::default();
@@ -185,13 +195,7 @@ impl LiveInput {
         let (mut events, mut actions) = (Vec::new(), Vec::new());
         for entry in new {
             match *entry {
-                Entry::Event { t, event, gesture } => {
-                    let event = match event {
-                        EventKind::Start => "start",
-                        EventKind::End => "end",
-                    };
-                    events.push(json!({ "t": t, "event": event, "gesture": self.gestures[gesture] }));
-                }
+                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &self.gestures[gesture] })),
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
                     actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action.as_str() }));
