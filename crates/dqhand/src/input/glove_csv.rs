@@ -21,6 +21,7 @@ use std::io::{self, BufRead, Write};
 use glam::{Quat, Vec3};
 
 use super::glove_layout::check_raw;
+use super::record::unit_as_read;
 use super::{GloveSample, HandData, MappingTable, Record, RejectKind, Rejection, RigidPose, MAX_GLOVE_SENSORS};
 use crate::hand::Side;
 use crate::{Error, Result};
@@ -241,8 +242,8 @@ fn check_time(time: f64) -> Result<(), Rejection> {
     Ok(())
 }
 
-/// The tracker pose of `px, py, pz, qx, qy, qz, qw`, its quaternion normalised unless it
-/// is unit to within rounding (so a written pose reads back bit for bit).
+/// The tracker pose of `px, py, pz, qx, qy, qz, qw`, its quaternion made unit
+/// ([`unit_as_read`]).
 fn tracker_pose(v: [f32; 7]) -> Result<RigidPose, Rejection> {
     if let Some(k) = v.iter().position(|x| !x.is_finite()) {
         return Err(Rejection::new(RejectKind::NonFinite, format!("{} = {} is not finite", TRACKER_COLUMNS[k], v[k])));
@@ -252,8 +253,7 @@ fn tracker_pose(v: [f32; 7]) -> Result<RigidPose, Rejection> {
     if (length - 1.0).abs() > QUAT_LENGTH_TOLERANCE {
         return Err(Rejection::new(RejectKind::OutOfRange, format!("tracker quaternion {:?} has length {length}, not 1", q.to_array())));
     }
-    let orientation = if (length - 1.0).abs() > 1e-6 { q / length } else { q };
-    Ok(RigidPose { position: Vec3::new(v[0], v[1], v[2]), orientation })
+    Ok(RigidPose { position: Vec3::new(v[0], v[1], v[2]), orientation: unit_as_read(q, length) })
 }
 
 /// Appends records to a glove CSV, one flushed row each, so a recording survives a crash

@@ -30,7 +30,7 @@ use glam::{Quat, Vec3};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 
-use super::record::{JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
+use super::record::{unit_as_read, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 use super::{openxr, GloveSample, HandData, JointSet, RejectKind, Rejection, Record, RigidPose, TrackedJoint};
 use crate::hand::Side;
 use crate::kinematics::webxr;
@@ -292,10 +292,11 @@ fn orientation(q: [f32; 4], label: impl Fn() -> String) -> Result<Quat, Rejectio
     if !v.is_finite() {
         return Err(Rejection::new(RejectKind::NonFinite, format!("{}: orientation {q:?} is not finite", label())));
     }
-    if (v.length() - 1.0).abs() > UNIT_TOLERANCE {
+    let length = v.length();
+    if (length - 1.0).abs() > UNIT_TOLERANCE {
         return Err(Rejection::new(RejectKind::OutOfRange, format!("{}: orientation {q:?} is not a unit quaternion", label())));
     }
-    Ok(v.normalize())
+    Ok(unit_as_read(v, length))
 }
 
 /// Writes `record` as one JSON line (joints keyed by WebXR name; glove keyed by

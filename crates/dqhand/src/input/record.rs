@@ -16,6 +16,20 @@ pub const MAX_GLOVE_SENSORS: usize = 24;
 pub const JOINT_COUNT: usize = webxr::JOINT_NAMES.len();
 /// Number of MediaPipe hand landmarks.
 pub const LANDMARK_COUNT: usize = 21;
+/// Largest difference of a read quaternion's length from 1 that is rounding in the file.
+const UNIT_ROUNDING: f32 = 1e-6;
+
+/// A quaternion read from a file or message (`length` its length, already checked to be near
+/// 1), made unit: scaled when it is off by more than rounding, else kept bit for bit, so that
+/// what a writer wrote reads back equal (normalising a normalised quaternion can move its last
+/// bits).
+pub(crate) fn unit_as_read(q: Quat, length: f32) -> Quat {
+    if (length - 1.0).abs() > UNIT_ROUNDING {
+        q / length
+    } else {
+        q
+    }
+}
 
 /// A 6-DOF pose: the wrist tracker's, or a tracked joint's.
 #[derive(Clone, Copy, Debug, PartialEq)]
