@@ -8,6 +8,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
+use dqhand::interaction::benchmark::{LoggedEvent, RecognitionScore};
+use dqhand::interaction::synthetic::Label;
+
 fn temp_dir(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("dqhand-replay-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -31,35 +34,34 @@ fn synthesize(dir: &Path, format: &str, extension: &str, extra: &[&str]) -> (Pat
     (path, labels)
 }
 
-fn events(out: &Output) -> Vec<(f64, String, String)> {
+fn events(out: &Output) -> Vec<LoggedEvent> {
     events_in(&String::from_utf8_lossy(&out.stdout))
 }
 
-fn events_in(stdout: &str) -> Vec<(f64, String, String)> {
-    stdout
-        .lines()
-        .map(|l| {
-            let v: serde_json::Value = serde_json::from_str(l).unwrap();
-            (v["t"].as_f64().unwrap(), v["event"].as_str().unwrap().to_owned(), v["gesture"].as_str().unwrap().to_owned())
-        })
-        .collect()
+fn events_in(stdout: &str) -> Vec<LoggedEvent> {
+    stdout.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
 }
 
-/// Every labelled hold starts within 150 ms of the pose being reached; idle motion starts
-/// nothing.
+/// The events scored against the labels (as `dqhand gesture-bench` scores them).
+fn score(events: &[LoggedEvent], labels: &serde_json::Value) -> RecognitionScore {
+    let holds: Vec<Label> = serde_json::from_value(labels["holds"].clone()).unwrap();
+    let idle = (labels["idle"][0].as_f64().unwrap(), labels["idle"][1].as_f64().unwrap());
+    RecognitionScore::new(&holds, idle, events)
+}
+
+/// Every labelled hold starts within 150 ms of the pose being reached; idle motion causes no
+/// event.
 fn check_recognition(out: &Output, labels: &serde_json::Value) {
     check_events(&events(out), labels);
 }
 
-fn check_events(events: &[(f64, String, String)], labels: &serde_json::Value) {
-    for hold in labels["holds"].as_array().unwrap() {
-        let (gesture, reached) = (hold["gesture"].as_str().unwrap(), hold["reached"].as_f64().unwrap());
-        let start = events.iter().find(|(t, e, g)| e == "start" && g == gesture && *t > reached - 0.4 && *t <= reached + 0.15);
-        assert!(start.is_some(), "{gesture} reached at {reached} s not recognised within 150 ms: {events:?}");
+fn check_events(events: &[LoggedEvent], labels: &serde_json::Value) {
+    let score = score(events, labels);
+    assert_eq!(score.holds.len(), labels["holds"].as_array().unwrap().len());
+    for hold in &score.holds {
+        assert!(hold.in_time(), "{} reached at {} s not recognised within 150 ms: {hold:?}\n{events:?}", hold.gesture, hold.reached);
     }
-    let idle = labels["idle"][0].as_f64().unwrap() + 0.3;
-    let spurious: Vec<_> = events.iter().filter(|(t, e, _)| e == "start" && *t > idle).collect();
-    assert!(spurious.is_empty(), "idle motion started {spurious:?}");
+    assert_eq!(score.spurious, 0, "idle motion caused events: {events:?}");
 }
 
 #[test]
@@ -86,12 +88,10 @@ fn a_glove_recording_prints_its_finger_gestures() {
     let (path, labels) = synthesize(&dir, "glove", "csv", &["--seed", "4", "--side", "right"]);
     let out = dqhand(&["replay", "--input", path.to_str().unwrap(), "--gestures"]);
     let events = events(&out);
+    let score = score(&events, &labels);
     // The 5DT has no thumb CMC flexion or thumb-tip sensing: only the finger-defined gestures.
-    for hold in labels["holds"].as_array().unwrap() {
-        let (gesture, reached) = (hold["gesture"].as_str().unwrap(), hold["reached"].as_f64().unwrap());
-        if ["fist", "point", "victory", "three", "four"].contains(&gesture) {
-            assert!(events.iter().any(|(t, e, g)| e == "start" && g == gesture && (*t - reached).abs() < 0.5), "{gesture} at {reached}: {events:?}");
-        }
+    for hold in score.holds.iter().filter(|h| ["fist", "point", "victory", "three", "four"].contains(&h.gesture.as_str())) {
+        assert!(hold.latency_s.is_some_and(|l| l < 0.5), "{} at {}: {hold:?}\n{events:?}", hold.gesture, hold.reached);
     }
 }
 

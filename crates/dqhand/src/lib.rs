@@ -16,6 +16,7 @@
 //! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
 //!   join in later issues);
 //! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
+//!   synthetic labelled sequences, and the loop's measures on them;
 //! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
 //! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!

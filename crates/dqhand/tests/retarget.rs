@@ -9,6 +9,7 @@ use std::sync::OnceLock;
 use dqhand::gesture::gesture;
 use dqhand::hand::{HandParams, Side};
 use dqhand::input::{Retargeter, JOINT_COUNT, CONTACT_FULL};
+use dqhand::interaction::benchmark::{close_pinch, thumb_index_gap, AngleError};
 use dqhand::kinematics::{webxr, HandRig, JointModel, Limits, Pose};
 use dqhand::math::DualQuat;
 use dqhand::model::Model;
@@ -49,9 +50,10 @@ fn pose_in_limits(joint_model: JointModel) -> impl Strategy<Value = Pose> {
     ranges.prop_map(|deg| Pose { wrist: None, angles: deg.into_iter().map(f32::to_radians).collect() })
 }
 
-fn max_error_deg(a: &Pose, b: &Pose) -> (f32, f32) {
-    let errors: Vec<f32> = a.angles.iter().zip(&b.angles).map(|(x, y)| (x - y).abs().to_degrees()).collect();
-    (errors.iter().sum::<f32>() / errors.len() as f32, errors.iter().copied().fold(0.0, f32::max))
+/// Mean and largest angle error, degrees (the measure `dqhand gesture-bench` reports).
+fn max_error_deg(truth: &Pose, solved: &Pose) -> (f64, f32) {
+    let e = AngleError::between(truth, solved);
+    (e.mean_deg(), e.max_deg())
 }
 
 proptest! {
@@ -162,13 +164,10 @@ fn a_tracked_pinch_closes_the_virtual_pinch() {
     for (length, breadth) in [(0.19, 0.085), (0.17, 0.09), (0.21, 0.08)] {
         let user = hand(length, breadth, Side::Right);
         let pose = gesture("pinch").unwrap().pose(JointModel::Full);
-        let mut tracked = positions(&user, JointModel::Full, &pose);
         // The user's thumb tip rests 3 mm from the index tip.
-        let (thumb, index) = (tracked[4], tracked[9]);
-        tracked[4] = index + (thumb - index).normalize() * 0.003;
+        let tracked = close_pinch(&positions(&user, JointModel::Full, &pose), 0.003);
         let solved = retarget(JointModel::Full, &tracked, Side::Right);
-        let virtual_tips = positions(ours(), JointModel::Full, &solved);
-        let gap = tip_gap(&virtual_tips, 9);
+        let gap = thumb_index_gap(&positions(ours(), JointModel::Full, &solved));
         assert!(gap <= 0.005, "{length}×{breadth}: virtual gap {} mm", gap * 1e3);
         assert!(rig.dofs().len() == solved.angles.len());
     }

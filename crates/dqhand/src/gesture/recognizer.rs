@@ -14,12 +14,12 @@
 //! change was first seen, i.e. `min_hold_s` plus up to one frame (0.1 s + 11 ms at 90 Hz with
 //! the built-in set); the events carry that update's time.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{GestureSet, HandFeatures};
 
 /// Whether a gesture started or ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum EventKind {
     /// The gesture became current.

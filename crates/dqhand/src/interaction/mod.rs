@@ -2,6 +2,7 @@
 //! interaction: records from the user's hand drive the virtual hand (what you see is what you
 //! do) and its gestures, recognised on the virtual hand, act as commands.
 
+pub mod benchmark;
 mod command_table;
 mod gesture_loop;
 pub mod synthetic;

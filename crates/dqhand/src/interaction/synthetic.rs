@@ -14,6 +14,7 @@
 use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec3};
+use serde::{Deserialize, Serialize};
 
 use crate::engine::Engine;
 use crate::gesture::{gesture, GESTURES};
@@ -82,8 +83,9 @@ impl Default for SyntheticParams {
     }
 }
 
-/// One labelled hold: `gesture` is shown from `reached` to `until` (seconds).
-#[derive(Clone, Debug, PartialEq)]
+/// One labelled hold: `gesture` is shown from `reached` to `until` (seconds); as JSON in
+/// the labels file beside a synthesized recording.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Label {
     /// The gesture's name.
     pub gesture: String,

@@ -1,0 +1,122 @@
+//! Gesture events scored against the labels of a sequence: was each held gesture recognised
+//! within [`RECOGNITION_DEADLINE_S`] of its pose being reached, how long it took, what was
+//! shown instead when it was not, and how many events idle motion caused.
+
+use serde::{Deserialize, Serialize};
+
+use crate::gesture::{Event, EventKind};
+use crate::interaction::synthetic::Label;
+
+/// Seconds after a pose is reached by which its gesture must have started (the 150 ms).
+pub const RECOGNITION_DEADLINE_S: f64 = 0.15;
+
+/// Slack on the deadline: label and record times are sums of decimal seconds, and a rounding
+/// error of a nanosecond does not make a start late.
+const TIME_ROUNDING_S: f64 = 1e-9;
+
+/// A gesture event kept beyond the update that reported it; reads and writes the JSON of
+/// [`Event`] (`{"t": 1.25, "event": "start", "gesture": "fist"}`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoggedEvent {
+    /// Time of the update that reported it, seconds.
+    pub t: f64,
+    /// Start or end.
+    pub event: EventKind,
+    /// The gesture's name.
+    pub gesture: String,
+}
+
+impl From<Event<'_>> for LoggedEvent {
+    fn from(e: Event<'_>) -> Self {
+        Self { t: e.t, event: e.event, gesture: e.gesture.to_owned() }
+    }
+}
+
+/// What became of one labelled hold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoldOutcome {
+    /// The gesture held.
+    pub gesture: String,
+    /// When its pose was reached, seconds.
+    pub reached: f64,
+    /// Seconds from the pose being reached to its gesture's start event: the first one after
+    /// the move to the pose began and before the hold ended. Negative when recognised during
+    /// the move; `None` when not recognised during the hold at all.
+    pub latency_s: Option<f64>,
+    /// The gesture current at the deadline by the events, `None` for none: what was shown
+    /// instead when it is not the hold's.
+    pub shown_at_deadline: Option<String>,
+}
+
+impl HoldOutcome {
+    /// Whether the gesture started by the deadline.
+    #[must_use]
+    pub fn in_time(&self) -> bool {
+        self.latency_s.is_some_and(|l| l <= RECOGNITION_DEADLINE_S + TIME_ROUNDING_S)
+    }
+}
+
+/// One sequence's events scored against its labels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecognitionScore {
+    /// Each hold, in label order.
+    pub holds: Vec<HoldOutcome>,
+    /// Events during the idle motion other than the end of the last hold's gesture: each is a
+    /// command the user did not give.
+    pub spurious: usize,
+    /// Seconds of idle motion.
+    pub idle_s: f64,
+}
+
+impl RecognitionScore {
+    /// Scores `events` (in time order) against the `labels` of a sequence (in time order; a
+    /// hold's move begins where the previous hold ends) and its idle stretch `idle` (seconds
+    /// from, to).
+    #[must_use]
+    pub fn new(labels: &[Label], idle: (f64, f64), events: &[LoggedEvent]) -> Self {
+        let mut holds = Vec::with_capacity(labels.len());
+        let mut move_start = f64::NEG_INFINITY;
+        for label in labels {
+            let start = events
+                .iter()
+                .find(|e| e.event == EventKind::Start && e.gesture == label.gesture && e.t > move_start && e.t <= label.until);
+            let deadline = label.reached + RECOGNITION_DEADLINE_S + TIME_ROUNDING_S;
+            holds.push(HoldOutcome {
+                gesture: label.gesture.clone(),
+                reached: label.reached,
+                latency_s: start.map(|e| e.t - label.reached),
+                shown_at_deadline: current_at(events, deadline).map(str::to_owned),
+            });
+            move_start = label.until;
+        }
+        let mut excused = labels.last().map(|l| l.gesture.as_str());
+        let mut spurious = 0;
+        for e in events.iter().filter(|e| e.t >= idle.0 && e.t <= idle.1) {
+            if e.event == EventKind::End && excused == Some(e.gesture.as_str()) {
+                excused = None;
+            } else {
+                spurious += 1;
+            }
+        }
+        Self { holds, spurious, idle_s: idle.1 - idle.0 }
+    }
+
+    /// Holds whose gesture started by the deadline.
+    #[must_use]
+    pub fn in_time(&self) -> usize {
+        self.holds.iter().filter(|h| h.in_time()).count()
+    }
+}
+
+/// The gesture current after the events up to `time`.
+fn current_at(events: &[LoggedEvent], time: f64) -> Option<&str> {
+    let mut current = None;
+    for e in events.iter().take_while(|e| e.t <= time) {
+        match e.event {
+            EventKind::Start => current = Some(e.gesture.as_str()),
+            EventKind::End if current == Some(e.gesture.as_str()) => current = None,
+            EventKind::End => {}
+        }
+    }
+    current
+}
