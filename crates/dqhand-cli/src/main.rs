@@ -8,6 +8,7 @@ mod bench_stream;
 mod calibrate;
 mod demo;
 mod feed;
+mod gesture_bench;
 mod hand;
 mod info;
 mod listen;
@@ -56,6 +57,9 @@ enum Command {
     Calibrate(calibrate::Args),
     /// Write a synthetic, labelled recording of the gesture library (from our own kinematics).
     Synthesize(synthesize::Args),
+    /// Measure the gesture loop on synthetic labelled sequences: recognition rate and latency,
+    /// spurious events in idle motion, retargeting error, time per record.
+    GestureBench(gesture_bench::Args),
 }
 
 fn main() {
@@ -71,6 +75,7 @@ fn main() {
         Command::Listen(a) => listen::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Synthesize(a) => synthesize::run(&a),
+        Command::GestureBench(a) => gesture_bench::run(&a),
     };
     if let Err(e) = result {
         eprintln!("dqhand: error: {e:#}");

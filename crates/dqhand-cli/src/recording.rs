@@ -2,14 +2,14 @@
 //! calibration, which configuration and gesture definitions.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use dqhand::gesture::GestureSet;
 use dqhand::hand::Side;
-use dqhand::input::json_record::JsonRecordReader;
-use dqhand::input::{Calibration, GloveCsvReader, GloveMapper, InputConfig, MappingTable, Record, Rejection};
+use dqhand::input::json_record::{write_record, JsonRecordReader};
+use dqhand::input::{Calibration, GloveCsvReader, GloveCsvWriter, GloveMapper, InputConfig, MappingTable, Record, Rejection};
 use dqhand::kinematics::JointModel;
 
 /// The file formats of recordings.
@@ -115,3 +115,26 @@ impl RecordingReader {
     }
 }
 
+/// Writes `records` to `path`: a glove CSV with tracker and hand columns for the glove of
+/// `table`, else JSON lines.
+pub fn write_recording(path: &Path, records: &[Record], table: Option<&MappingTable>) -> anyhow::Result<()> {
+    let write = || -> std::io::Result<()> {
+        let mut out = BufWriter::new(File::create(path)?);
+        match table {
+            Some(table) => {
+                let mut w = GloveCsvWriter::new(out, table, true, true)?;
+                for r in records {
+                    w.write(r)?;
+                }
+                Ok(())
+            }
+            None => {
+                for r in records {
+                    write_record(&mut out, r, &[] as &[&str])?;
+                }
+                out.flush()
+            }
+        }
+    };
+    write().with_context(|| path.display().to_string())
+}

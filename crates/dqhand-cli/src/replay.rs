@@ -10,6 +10,7 @@ use std::time::Instant;
 use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::input::{Record, Tracking};
+use dqhand::interaction::benchmark::Distribution;
 use dqhand::interaction::GestureLoop;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
@@ -107,8 +108,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     eprintln!("{}: {records} records, {} taken, {} rejected{}", args.input.display(), pipeline.accepted(), pipeline.rejections().total(), if pipeline.tracking() == Tracking::Lost { ", tracking lost at the end" } else { "" });
     if args.stats {
-        times_us.sort_by(f64::total_cmp);
-        let median = times_us.get(times_us.len() / 2).copied().unwrap_or(0.0);
+        let median = Distribution::of(&mut times_us).map_or(0.0, |d| d.median);
         eprintln!("{:.0} records per second, {median:.1} µs per taken record (median: read, filter, retarget, FK, features, recogniser)", records as f64 / elapsed);
         if !sizes.is_empty() {
             let mut lengths: Vec<f32> = sizes.iter().map(|s| s.0).collect();

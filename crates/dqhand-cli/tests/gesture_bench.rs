@@ -1,0 +1,74 @@
+//! `dqhand gesture-bench` through the real command: a small fixed-seed run reports every
+//! measure, and its accuracy figures meet the targets (correctness, not timing: the
+//! timings are only checked to be there).
+
+use std::process::Command;
+
+use serde_json::Value;
+
+fn bench(args: &[&str]) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).arg("gesture-bench").args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn number(v: &Value, what: &str) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("{what} is not a number: {v}"))
+}
+
+#[test]
+fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
+    let r = bench(&["--json", "--seed", "3", "--sequences", "2"]);
+    assert!(r["synthetic"].as_str().unwrap().contains("not captured from a person"));
+    assert_eq!((r["seed"].as_u64(), r["sequences_per_source"].as_u64()), (Some(3), Some(2)));
+    assert!(["debug", "release"].contains(&r["build"].as_str().unwrap()));
+    let sources = r["sources"].as_array().unwrap();
+    let names: Vec<&str> = sources.iter().map(|s| s["source"].as_str().unwrap()).collect();
+    assert_eq!(names, ["joints", "landmarks", "glove 5dt-14", "glove cyberglove-18"]);
+    for s in sources {
+        let name = s["source"].as_str().unwrap();
+        assert_eq!(s["holds"], 26, "{name}: 2 sequences of 13 holds");
+        for key in ["rate", "idle_minutes", "spurious_per_minute", "records_per_s"] {
+            number(&s[key], &format!("{name} {key}"));
+        }
+        for key in ["median", "p95", "max"] {
+            number(&s["latency_ms"][key], &format!("{name} latency {key}"));
+            assert!(number(&s["push_us"][key], &format!("{name} push {key}")) > 0.0);
+        }
+        assert_eq!(s["gestures"].as_object().unwrap().len(), 12, "{name}: every built-in gesture");
+        assert!((number(&s["idle_minutes"], "idle") - 1.0).abs() < 0.05, "{name}: 2 × 30 s of idle motion");
+        assert_eq!(s["glove_dofs_not_driven"].as_array().unwrap().is_empty(), !name.starts_with("glove"));
+    }
+    // Hand tracking: every hold recognised in time, idle motion quiet.
+    for s in &sources[..2] {
+        let name = s["source"].as_str().unwrap();
+        assert!(number(&s["rate"], name) >= 0.98 && s["rate_pass"] == true, "{name}: {s}");
+        assert!(number(&s["spurious_per_minute"], name) <= 1.0 && s["spurious_pass"] == true, "{name}: {s}");
+        assert!(number(&s["latency_ms"]["max"], name) <= 150.0, "{name}: {s}");
+    }
+    // Our own hand's noise-free joints come back within the 1° (much better, in fact).
+    let own = &r["retarget"]["own_hand"];
+    assert!(number(&own["scores"]["mean_deg"], "mean") <= 1.0 && own["mean_pass"] == true, "{own}");
+    for who in [&own["scores"], &r["retarget"]["users_hands"]] {
+        assert!(who["records"].as_u64().unwrap() > 1000 && who["refused"] == 0, "{who}");
+        assert!(who["contacts"].as_u64().unwrap() > 0, "near pinches are closed into contacts: {who}");
+        assert!(number(&who["max_contact_excess_mm"], "excess") < 0.5, "{who}");
+    }
+    let speed = &r["speed"];
+    assert!(number(&speed["push_us"]["median"], "push") > 0.0 && number(&speed["records_per_s"], "records/s") > 0.0);
+    assert_eq!(speed["records"], sources.iter().map(|s| s["records"].as_u64().unwrap()).sum::<u64>());
+}
+
+#[test]
+fn the_table_names_the_targets_and_says_a_debug_build_is_not_timed() {
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["gesture-bench", "--sequences", "1"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in ["recognition:", "target ≥ 98 %", "spurious/min", "retargeting", "target mean ≤ 1°", "thumb–index contacts", "GestureLoop::push", "records/s"] {
+        assert!(text.contains(needle), "{needle:?} not in\n{text}");
+    }
+    assert_eq!(text.contains("debug build: the timings below are not meaningful"), cfg!(debug_assertions), "{text}");
+    let bad = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["gesture-bench", "--sequences", "0"]).output().unwrap();
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--sequences must be at least 1"));
+}
