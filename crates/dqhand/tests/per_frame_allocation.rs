@@ -2,7 +2,8 @@
 //! kinematics → skinning transforms → deformation with each method), with buffers made once
 //! beforehand; and so does a viewer session's frame (playback, three methods, heat map,
 //! encoding), and a live record through the gesture loop (check, retarget, filter,
-//! kinematics, features, recogniser, commands) into the input every viewer follows.
+//! kinematics, features, recogniser, commands) into the input every viewer follows, and a
+//! good JSON record read from a file or a datagram.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -128,4 +129,24 @@ fn a_live_record_and_a_viewer_update_without_news_allocate_nothing() {
         assert!(input.update(&mut session, &mut view).message.is_none());
     }
     assert_eq!(allocations() - before, 0, "allocations during 30 viewer updates without news");
+}
+
+#[test]
+fn reading_a_good_json_record_allocates_nothing() {
+    use dqhand::input::json_record::{write_record, JsonRecordReader};
+    let synthetic = generate(&SyntheticParams { seed: 4, holds: 2, idle_s: 0.5, ..SyntheticParams::default() }).unwrap();
+    let mut text = Vec::new();
+    for r in &synthetic.records {
+        write_record(&mut text, r, &[] as &[&str]).unwrap();
+    }
+    let mut reader = JsonRecordReader::new(std::io::Cursor::new(text), Side::Right, Vec::new());
+    let mut record = synthetic.records[0];
+    reader.next_record(&mut record).unwrap().unwrap().unwrap();
+    let before = allocations();
+    let mut read = 0;
+    while let Some(r) = reader.next_record(&mut record).unwrap() {
+        r.unwrap();
+        read += 1;
+    }
+    assert_eq!(allocations() - before, 0, "allocations reading {read} joints records");
 }

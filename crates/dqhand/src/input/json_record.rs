@@ -47,7 +47,7 @@ const UNIT_TOLERANCE: f32 = 0.1;
 struct Line<'a> {
     t: f64,
     #[serde(default, borrow)]
-    hand: Option<Cow<'a, str>>,
+    hand: Option<Name<'a>>,
     #[serde(default, borrow)]
     joints: Option<Entries<'a, JointJson, 26>>,
     #[serde(default)]
@@ -73,6 +73,29 @@ struct JointJson {
 struct PoseJson {
     p: [f32; 3],
     q: [f32; 4],
+}
+
+/// A key borrowed from the line (serde's `Cow<str>` would copy every one); owned only when
+/// the key had escapes.
+struct Name<'a>(Cow<'a, str>);
+
+impl<'de: 'a, 'a> Deserialize<'de> for Name<'a> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct NameVisitor;
+        impl<'de> Visitor<'de> for NameVisitor {
+            type Value = Cow<'de, str>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a name")
+            }
+            fn visit_borrowed_str<E: de::Error>(self, v: &'de str) -> Result<Self::Value, E> {
+                Ok(Cow::Borrowed(v))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                Ok(Cow::Owned(v.to_owned()))
+            }
+        }
+        deserializer.deserialize_str(NameVisitor).map(Name)
+    }
 }
 
 /// Up to `N` values, keyed by name (a JSON object) or in order (an array), kept on the stack.
@@ -115,7 +138,7 @@ impl<'de: 'a, 'a, V: Deserialize<'de> + Copy + Default, const N: usize> Deserial
             }
             fn visit_map<M: MapAccess<'de>>(self, mut map: M) -> Result<Self::Value, M::Error> {
                 let mut out = Entries::new();
-                while let Some(name) = map.next_key::<Cow<'a, str>>()? {
+                while let Some(Name(name)) = map.next_key()? {
                     let value = map.next_value()?;
                     out.push(Some(name), value)?;
                 }
@@ -171,7 +194,7 @@ pub fn parse_record<S: AsRef<str>>(line: &str, default_side: Side, glove_sensors
     if parsed.t < 0.0 {
         return Err(Rejection::new(RejectKind::OutOfRange, format!("t: {} is negative", parsed.t)));
     }
-    let side = match parsed.hand.as_deref() {
+    let side = match parsed.hand.as_ref().map(|h| h.0.as_ref()) {
         None => default_side,
         Some("left") => Side::Left,
         Some("right") => Side::Right,
@@ -356,7 +379,7 @@ pub struct JsonRecordReader<R> {
 impl<R: BufRead> JsonRecordReader<R> {
     /// A reader of `reader`; see [`parse_record`] for the arguments.
     pub fn new(reader: R, default_side: Side, glove_sensors: Vec<String>) -> Self {
-        Self { reader, line: Vec::new(), number: 0, default_side, glove_sensors }
+        Self { reader, line: Vec::with_capacity(MAX_RECORD_BYTES + 1), number: 0, default_side, glove_sensors }
     }
 
     /// The next record into `out`: `None` at the end, else `Ok` or the line's rejection
@@ -373,15 +396,15 @@ impl<R: BufRead> JsonRecordReader<R> {
                 return Ok(None);
             }
             self.number += 1;
-            let at = format!("line {}", self.number);
+            let number = self.number; // named in a refusal only: a good line allocates nothing
             if self.line.len() as u64 >= limit && self.line.last() != Some(&b'\n') {
                 let bytes = self.line.len() + skip_line(&mut self.reader)?;
-                return Ok(Some(Err(Rejection::new(RejectKind::TooLarge, format!("{at}: {bytes} bytes (at most {MAX_RECORD_BYTES})")))));
+                return Ok(Some(Err(Rejection::new(RejectKind::TooLarge, format!("line {number}: {bytes} bytes (at most {MAX_RECORD_BYTES})")))));
             }
             if std::str::from_utf8(&self.line).is_ok_and(|text| text.trim().is_empty()) {
                 continue;
             }
-            return Ok(Some(parse_message(&self.line, self.default_side, &self.glove_sensors, out).map_err(|r| r.at(at))));
+            return Ok(Some(parse_message(&self.line, self.default_side, &self.glove_sensors, out).map_err(|r| r.at(format_args!("line {number}")))));
         }
     }
 }

@@ -19,8 +19,9 @@
 //! **Contacts survive.** Different proportions move fingertips apart that touch on the user's
 //! hand, so when the tracked thumb tip is within [`CONTACT_FULL`] of a fingertip, a small
 //! damped-least-squares IK on the thumb (and, weighted less, that finger) brings the virtual
-//! tips to the tracked gap; between [`CONTACT_FULL`] and [`CONTACT_FADE`] the correction fades
-//! out, so the hand never jumps.
+//! tips to the tracked gap less [`CONTACT_MARGIN`] (the IK stops within 0.1 mm, so the virtual
+//! gap is never wider than the tracked one); between [`CONTACT_FULL`] and [`CONTACT_FADE`] the
+//! correction fades out, so the hand never jumps.
 
 use glam::{Affine3A, Mat3, Quat, Vec3};
 
@@ -34,6 +35,9 @@ use crate::math::DualQuat;
 pub const CONTACT_FULL: f32 = 0.01;
 /// Gap above which no contact correction is made; it fades out linearly from [`CONTACT_FULL`].
 pub const CONTACT_FADE: f32 = 0.02;
+/// How much closer than the tracked gap the contact IK aims, metres: more than its stopping
+/// tolerance, so a tracked gap is an upper bound of the virtual one.
+pub const CONTACT_MARGIN: f32 = 0.0003;
 
 /// WebXR indices of the wrist and the knuckles that span the palm frame.
 const WRIST: usize = 0;
@@ -274,10 +278,11 @@ impl Retargeter {
         buffer[..count].copy_from_slice(&out.angles);
         let start = buffer;
         let angles = &mut buffer[..count];
-        let residual = |s: &Self, a: &[f32]| s.tip(0, a) - s.tip(finger, a) - gap;
-        for _ in 0..12 {
+        let aim = gap * ((gap.length() - CONTACT_MARGIN).max(0.0) / gap.length().max(f32::MIN_POSITIVE));
+        let residual = |s: &Self, a: &[f32]| s.tip(0, a) - s.tip(finger, a) - aim;
+        for _ in 0..16 {
             let e = residual(self, angles);
-            if e.length() < 2e-4 {
+            if e.length() < 1e-4 {
                 break;
             }
             // J W Jᵀ for the damped least-squares step.
