@@ -56,6 +56,33 @@ fn a_start_outside_the_hold_is_not_its_recognition() {
 }
 
 #[test]
+fn a_start_that_flickers_off_or_is_replaced_by_the_deadline_is_not_in_time() {
+    let labels = [label("fist", 0.9, 1.9), label("point", 2.3, 3.3)];
+    let events = [
+        event(0.8, Start, "fist"),   // during the move …
+        event(0.85, End, "fist"),    // … gone before the pose is reached
+        event(1.3, Start, "fist"),   // back 400 ms late
+        event(2.35, End, "fist"),    //
+        event(2.35, Start, "point"), // in time …
+        event(2.4, End, "point"),    // … replaced 100 ms after the pose
+        event(2.4, Start, "three"),  //
+    ];
+    let score = RecognitionScore::new(&labels, (5.0, 10.0), &events);
+    let outcomes: Vec<_> = score.holds.iter().map(|h| (h.in_time(), h.shown_at_deadline.as_deref())).collect();
+    assert_eq!(outcomes, [(false, None), (false, Some("three"))]);
+    assert!((score.holds[0].latency_s.unwrap() - 0.4).abs() < 1e-9, "the late start is the latency");
+    assert_eq!(score.in_time(), 0);
+}
+
+#[test]
+fn only_the_gesture_shown_when_idle_begins_may_end_unpunished() {
+    let labels = [label("fist", 0.9, 1.9)];
+    // The fist ended before idle began: its start and end in idle are both spurious.
+    let events = [event(1.0, Start, "fist"), event(2.0, End, "fist"), event(3.0, Start, "fist"), event(4.0, End, "fist")];
+    assert_eq!(RecognitionScore::new(&labels, (2.5, 10.0), &events).spurious, 2);
+}
+
+#[test]
 fn idle_events_are_spurious_except_the_end_of_the_last_hold() {
     let labels = [label("fist", 0.9, 1.9)];
     let idle = (2.3, 62.3);
@@ -77,7 +104,7 @@ fn logged_events_read_the_json_events_are_written_as() {
 }
 
 #[test]
-fn distributions_are_nearest_rank() {
+fn distributions_take_the_sample_at_the_rounded_rank() {
     let mut samples: Vec<f64> = (1..=20).rev().map(f64::from).collect();
     let d = Distribution::of(&mut samples).unwrap();
     assert_eq!((d.count, d.median, d.p95, d.max), (20, 11.0, 19.0, 20.0));

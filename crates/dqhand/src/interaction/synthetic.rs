@@ -203,10 +203,12 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         time += params.hold_s;
         keys.push((time, pose, None));
     }
-    // Idle: relaxed shapes drifting slowly.
-    let idle_start = time + params.move_s;
+    // Idle: relaxed shapes drifting slowly, from when the hand has reached the first one (the
+    // move out of the last hold is a move, not idle motion).
+    let mut idle_start = f64::INFINITY;
     while time < idle_start + params.idle_s {
         time += rng.uniform(1.0, 2.0);
+        idle_start = idle_start.min(time);
         let mut pose = relaxed(&mut rng);
         let turn = Quat::from_axis_angle(rng.unit(), (rng.uniform(-1.0, 1.0) * f64::from(params.wrist_turn_deg)).to_radians() as f32);
         pose.wrist = Some(DualQuat::from_rotation_translation(turn * rest_rotation, rest_translation + rng.unit() * 0.05));

@@ -3,7 +3,8 @@
 
 use serde::Serialize;
 
-/// Count, median, 95th percentile and maximum of a set of samples (nearest rank).
+/// Count, median, 95th percentile and maximum of a set of samples: the sample at rank
+/// `round((n − 1) q)` of the sorted ones (for an even count, the upper of the middle two).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Distribution {
     /// Number of samples.

@@ -39,9 +39,10 @@ pub struct HoldOutcome {
     pub gesture: String,
     /// When its pose was reached, seconds.
     pub reached: f64,
-    /// Seconds from the pose being reached to its gesture's start event: the first one after
-    /// the move to the pose began and before the hold ended. Negative when recognised during
-    /// the move; `None` when not recognised during the hold at all.
+    /// Seconds from the pose being reached to the start event of its gesture: when the
+    /// gesture is shown at the deadline, the start that made it current (negative when
+    /// recognised during the move); otherwise the first start after the deadline and before
+    /// the hold ended (late); `None` when neither.
     pub latency_s: Option<f64>,
     /// The gesture current at the deadline by the events, `None` for none: what was shown
     /// instead when it is not the hold's.
@@ -49,10 +50,11 @@ pub struct HoldOutcome {
 }
 
 impl HoldOutcome {
-    /// Whether the gesture started by the deadline.
+    /// Whether the gesture started by the deadline and is still shown then (a start that
+    /// flickered off, or one replaced by another gesture, is not a recognition).
     #[must_use]
     pub fn in_time(&self) -> bool {
-        self.latency_s.is_some_and(|l| l <= RECOGNITION_DEADLINE_S + TIME_ROUNDING_S)
+        self.shown_at_deadline.as_deref() == Some(self.gesture.as_str()) && self.latency_s.is_some_and(|l| l <= RECOGNITION_DEADLINE_S + TIME_ROUNDING_S)
     }
 }
 
@@ -61,8 +63,8 @@ impl HoldOutcome {
 pub struct RecognitionScore {
     /// Each hold, in label order.
     pub holds: Vec<HoldOutcome>,
-    /// Events during the idle motion other than the end of the last hold's gesture: each is a
-    /// command the user did not give.
+    /// Events during the idle motion other than the end of the gesture shown when it began:
+    /// each is a command the user did not give.
     pub spurious: usize,
     /// Seconds of idle motion.
     pub idle_s: f64,
@@ -71,25 +73,27 @@ pub struct RecognitionScore {
 impl RecognitionScore {
     /// Scores `events` (in time order) against the `labels` of a sequence (in time order; a
     /// hold's move begins where the previous hold ends) and its idle stretch `idle` (seconds
-    /// from, to).
+    /// from, to: from when the hand has settled into idle motion).
     #[must_use]
     pub fn new(labels: &[Label], idle: (f64, f64), events: &[LoggedEvent]) -> Self {
         let mut holds = Vec::with_capacity(labels.len());
-        let mut move_start = f64::NEG_INFINITY;
         for label in labels {
-            let start = events
-                .iter()
-                .find(|e| e.event == EventKind::Start && e.gesture == label.gesture && e.t > move_start && e.t <= label.until);
             let deadline = label.reached + RECOGNITION_DEADLINE_S + TIME_ROUNDING_S;
+            let shown = current_at(events, deadline);
+            let starts = |e: &&LoggedEvent| e.event == EventKind::Start && e.gesture == label.gesture;
+            let start = if shown == Some(label.gesture.as_str()) {
+                events.iter().filter(starts).take_while(|e| e.t <= deadline).last()
+            } else {
+                events.iter().filter(starts).find(|e| e.t > deadline && e.t <= label.until)
+            };
             holds.push(HoldOutcome {
                 gesture: label.gesture.clone(),
                 reached: label.reached,
                 latency_s: start.map(|e| e.t - label.reached),
-                shown_at_deadline: current_at(events, deadline).map(str::to_owned),
+                shown_at_deadline: shown.map(str::to_owned),
             });
-            move_start = label.until;
         }
-        let mut excused = labels.last().map(|l| l.gesture.as_str());
+        let mut excused = current_at(events, idle.0);
         let mut spurious = 0;
         for e in events.iter().filter(|e| e.t >= idle.0 && e.t <= idle.1) {
             if e.event == EventKind::End && excused == Some(e.gesture.as_str()) {
