@@ -26,6 +26,8 @@ pub const MAX_INPUT_CLIENTS: usize = 4;
 /// The longest pause between two records of a played recording, seconds; a longer one is
 /// played as this long (a recording may stop for minutes, or claim a year between records).
 const MAX_PAUSE_S: f64 = 5.0;
+/// How far a played recording may fall behind its schedule before it plays on from now.
+const MAX_BEHIND: Duration = Duration::from_millis(50);
 /// How often the demo logs new refusals (one line per kind).
 const REPORT_PERIOD: Duration = Duration::from_secs(5);
 
@@ -84,8 +86,16 @@ impl Feed {
                 }
                 last = Some(t);
                 record.time = shift + played;
-                if let Some(wait) = Duration::try_from_secs_f64(record.time).ok().and_then(|due| due.checked_sub(start.elapsed())) {
-                    std::thread::sleep(wait);
+                let now = start.elapsed();
+                match Duration::try_from_secs_f64(record.time) {
+                    Ok(due) if due > now => std::thread::sleep(due - now),
+                    // Behind (this thread was not scheduled): play on from now, as a sender
+                    // that paused would, rather than send stale records the input refuses.
+                    Ok(due) if now - due > MAX_BEHIND => {
+                        let behind = (now - due).as_secs_f64();
+                        (shift, record.time) = (shift + behind, record.time + behind);
+                    }
+                    _ => {}
                 }
                 let _ = self.input.push(&record, |_| {}); // refusals are counted and shown
             }
