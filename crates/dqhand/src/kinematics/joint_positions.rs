@@ -15,9 +15,7 @@ pub struct JointPositions {
 }
 
 impl JointPositions {
-    /// Resolves the 25 WebXR joints of `skeleton` (e.g. [`Engine::skeleton`]).
-    ///
-    /// [`Engine::skeleton`]: crate::engine::Engine::skeleton
+    /// Resolves the 25 WebXR joints of `skeleton`.
     ///
     /// # Errors
     /// [`Error::MissingJoint`] naming the first WebXR joint the skeleton lacks.
@@ -38,9 +36,7 @@ impl JointPositions {
     }
 
     /// The joints' world positions, metres, from the skeleton's world transforms (e.g.
-    /// [`Engine::world`]). Allocates nothing.
-    ///
-    /// [`Engine::world`]: crate::engine::Engine::world
+    /// the engine's). Allocates nothing.
     ///
     /// # Panics
     /// If `world` is shorter than the skeleton these indices were resolved on.
