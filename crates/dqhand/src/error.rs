@@ -102,6 +102,14 @@ pub enum Error {
         /// What is wrong; match on it to tell the kinds apart.
         problem: GestureProblem,
     },
+    /// A scene file is malformed: the file, then the object and field.
+    #[error("{file}: {problem}")]
+    Scene {
+        /// The file's path.
+        file: String,
+        /// What is wrong; match on it to tell the kinds apart.
+        problem: SceneProblem,
+    },
     /// A name (joint, DOF, node, method, joint model, gesture) is not known; lists the valid ones.
     #[error("unknown {kind} {name:?}; valid: {valid}")]
     UnknownName {
@@ -111,6 +119,77 @@ pub enum Error {
         name: String,
         /// The valid names, comma-separated.
         valid: String,
+    },
+}
+
+/// What is wrong in a scene file ([`Error::Scene`]); each names the object (or gesture) and
+/// the field.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneProblem {
+    /// The text is not JSON of the expected shape: serde's message names an unknown or
+    /// missing field, with line and column.
+    #[error("not a valid scene: {0}")]
+    Json(String),
+    /// Two objects have the same name.
+    #[error("object {0:?} is defined twice")]
+    DuplicateName(String),
+    /// A shape that is not `sphere`, `box`, `cylinder` or `mesh`.
+    #[error("object {object:?}: unknown shape {shape:?}; valid: sphere, box, cylinder, mesh")]
+    UnknownShape {
+        /// The object.
+        object: String,
+        /// The shape given.
+        shape: String,
+    },
+    /// A parameter the shape needs is absent.
+    #[error("object {object:?}: a {shape} needs {field}")]
+    Missing {
+        /// The object.
+        object: String,
+        /// The parameter.
+        field: &'static str,
+        /// The shape.
+        shape: String,
+    },
+    /// A parameter of another shape is given.
+    #[error("object {object:?}: a {shape} takes no {field}")]
+    NotForShape {
+        /// The object.
+        object: String,
+        /// The parameter.
+        field: &'static str,
+        /// The shape.
+        shape: String,
+    },
+    /// A number is NaN or infinite.
+    #[error("object {object:?}: {field} is not a finite number")]
+    NotFinite {
+        /// The object (or the table, or a gesture).
+        object: String,
+        /// The field.
+        field: &'static str,
+    },
+    /// A number outside its range: a size or mass not positive, friction negative,
+    /// restitution outside 0–1, a rotation far from unit length.
+    #[error("object {object:?}: {field} {value} is not {range}")]
+    OutOfRange {
+        /// The object (or a gesture).
+        object: String,
+        /// The field.
+        field: &'static str,
+        /// The value given.
+        value: f32,
+        /// What it must be.
+        range: &'static str,
+    },
+    /// A mesh file that is not there.
+    #[error("object {object:?}: mesh file {} not found", file.display())]
+    MeshFile {
+        /// The object.
+        object: String,
+        /// The file, resolved against the scene's folder.
+        file: std::path::PathBuf,
     },
 }
 

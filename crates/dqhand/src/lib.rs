@@ -9,6 +9,7 @@
 //! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
 //! * [`model`] — a skeleton and the mesh bound to it;
 //! * [`collision`] — collision proxies per bone (paper 4.2);
+//! * [`scene`] — the objects and table of the manipulation loop, from scene files;
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
 //! * [`input`] — records from gloves, trackers and hand tracking, turned into poses;
@@ -36,7 +37,8 @@ pub mod kinematics;
 pub mod math;
 pub mod metrics;
 pub mod model;
+pub mod scene;
 pub mod skin;
 pub mod stream;
 
-pub use error::{Error, GestureProblem, Result};
+pub use error::{Error, GestureProblem, Result, SceneProblem};

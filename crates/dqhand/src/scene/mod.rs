@@ -1,0 +1,6 @@
+//! The scene of the manipulation loop (paper Figure 9): the objects the hand picks up and
+//! the table they stand on, read from a scene file.
+
+mod scene_file;
+
+pub use scene_file::{ObjectShape, Scene, SceneAction, SceneCommand, SceneObject, Table, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
