@@ -102,6 +102,10 @@ pub enum Error {
         /// What is wrong; match on it to tell the kinds apart.
         problem: GestureProblem,
     },
+    /// An object's mesh is unusable: not OBJ, unreadable, no triangle with an area,
+    /// coordinates that are not finite, indices out of range.
+    #[error("{0}")]
+    ObjectMesh(String),
     /// A scene file is malformed: the file, then the object and field.
     #[error("{file}: {problem}")]
     Scene {
@@ -278,7 +282,7 @@ impl Error {
     #[must_use]
     pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
         match self {
-            Error::Io { .. } | Error::File { .. } | Error::OutputFormat(_) | Error::GestureDefinition { .. } => self,
+            Error::Io { .. } | Error::File { .. } | Error::OutputFormat(_) | Error::GestureDefinition { .. } | Error::Scene { .. } => self,
             other => Error::File { path: path.into(), problem: Box::new(other) },
         }
     }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use dqhand::scene::{ObjectShape, Scene, SceneCommand, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
+use dqhand::scene::{ObjectMesh, ObjectShape, Scene, SceneCommand, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
 use dqhand::{Error, SceneProblem};
 use glam::{Quat, Vec3};
 
@@ -95,4 +95,53 @@ fn bad_scenes_name_the_object_and_the_field() {
     assert!(matches!(problem(&ball(r#", "restitution": 2"#)).0, SceneProblem::OutOfRange { field: "restitution", .. }));
     let missing = Scene::load(Path::new("/no/such/scene.json")).unwrap_err().to_string();
     assert!(missing.starts_with("/no/such/scene.json: "), "{missing}");
+}
+
+fn teapot_path() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/objects/teapot.obj")
+}
+
+/// The committed Utah teapot reads as a mesh of its size (12 cm tall, 24.5 cm spout to handle,
+/// base on y = 0); its pole triangles without area are dropped, said in a warning.
+#[test]
+fn the_teapot_reads_as_a_mesh() {
+    let mesh = ObjectMesh::load(&teapot_path()).unwrap();
+    let (lo, hi) = mesh.vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    assert!((lo.y).abs() < 1e-6 && (hi.y - 0.12).abs() < 1e-3 && ((hi - lo).x - 0.245).abs() < 1e-3, "{lo} {hi}");
+    assert!(mesh.triangles.len() > 3000 && mesh.triangles.len() <= 4032, "{}", mesh.triangles.len());
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        assert!((b - a).cross(c - a).length() > 0.0);
+    }
+    let dropped = 4032 - mesh.triangles.len();
+    assert_eq!(mesh.warnings.iter().any(|w| w.contains(&format!("{dropped} triangles without area dropped"))), dropped > 0, "{:?}", mesh.warnings);
+}
+
+/// Degenerate meshes: flat ones collide as surfaces (a warning), ones without a triangle of
+/// any area, with non-finite coordinates or indices out of range are refused with the reason,
+/// and a file that is not OBJ or not there is named.
+#[test]
+fn degenerate_meshes_are_repaired_or_refused_with_a_reason() {
+    let plate = ObjectMesh::from_triangles(vec![Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::new(1.0, 0.0, 1.0)], &[0, 2, 1, 1, 2, 3]).unwrap();
+    assert_eq!(plate.triangles.len(), 2);
+    assert!(plate.warnings.iter().any(|w| w.contains("flat (no volume)")), "{:?}", plate.warnings);
+    let refused = |vertices: Vec<Vec3>, indices: &[u32]| ObjectMesh::from_triangles(vertices, indices).unwrap_err().to_string();
+    assert!(refused(vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0], &[0, 1, 2]).contains("no triangle with an area"));
+    assert!(refused(vec![Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)], &[0, 1, 2]).contains("vertex 2 is not finite"));
+    assert!(refused(vec![Vec3::ZERO, Vec3::X, Vec3::Y], &[0, 1, 3]).contains("index 3 beyond the 3 vertices"));
+    assert!(refused(vec![Vec3::ZERO, Vec3::X, Vec3::Y], &[0, 1]).contains("2 indices do not make whole triangles"));
+    let dir = std::env::temp_dir().join(format!("dqhand-object-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let points = dir.join("points.obj");
+    std::fs::write(&points, "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2 3\n").unwrap();
+    let e = ObjectMesh::load(&points).unwrap_err().to_string();
+    assert!(e.starts_with(&points.display().to_string()) && e.contains("no triangle with an area"), "{e}");
+    let bad_index = dir.join("bad-index.obj");
+    std::fs::write(&bad_index, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").unwrap();
+    let e = ObjectMesh::load(&bad_index).unwrap_err().to_string();
+    assert!(e.starts_with(&bad_index.display().to_string()), "{e}");
+    let e = ObjectMesh::load(Path::new("teapot.stl")).unwrap_err().to_string();
+    assert!(e.starts_with("teapot.stl: not an OBJ file"), "{e}");
+    let e = ObjectMesh::load(Path::new("/no/such/teapot.obj")).unwrap_err().to_string();
+    assert!(e.starts_with("/no/such/teapot.obj"), "{e}");
 }

@@ -90,7 +90,7 @@ pub enum ObjectShape {
         /// Metres, along +Y.
         height: f32,
     },
-    /// A triangle mesh (`.glb`, `.gltf` or `.obj`).
+    /// A triangle mesh (an `.obj` file; read with [`super::ObjectMesh::load`]).
     Mesh {
         /// The file, resolved against the scene file's folder.
         file: PathBuf,
