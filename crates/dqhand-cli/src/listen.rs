@@ -15,7 +15,7 @@ use dqhand::interaction::GestureLoop;
 use dqhand::kinematics::JointModel;
 
 use crate::live::{LiveRecords, MAX_DATAGRAM_BYTES};
-use crate::recording::InputArgs;
+use crate::recording::{GestureArgs, InputArgs};
 
 /// Arguments of `dqhand listen`.
 #[derive(clap::Args)]
@@ -32,12 +32,8 @@ pub struct Args {
     record: Option<PathBuf>,
     #[command(flatten)]
     common: InputArgs,
-    /// Recognise gestures and print their events.
-    #[arg(long)]
-    gestures: bool,
-    /// Gesture definitions to use instead of the built-in ones (implies --gestures).
-    #[arg(long)]
-    gestures_file: Option<PathBuf>,
+    #[command(flatten)]
+    recognition: GestureArgs,
     /// Stop after this many seconds (default: run until interrupted; the recording is
     /// complete either way).
     #[arg(long)]
@@ -57,7 +53,7 @@ const REPORT_PERIOD: Duration = Duration::from_secs(5);
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = Arc::new(args.model.load()?);
-    let gestures = crate::recording::gesture_set(args.gestures_file.as_deref(), args.gestures)?;
+    let gestures = args.recognition.set()?;
     let mapper = Some(args.common.mapper(args.joint_model)?);
     let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.common.config()?, gestures)?;
     let live = LiveRecords::new(&args.common, args.record.as_deref())?;

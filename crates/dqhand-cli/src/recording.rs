@@ -75,8 +75,26 @@ impl InputArgs {
     }
 }
 
-/// The gesture definitions of `--gestures-file`, else the built-in ones when recognition
-/// is `on`, else none.
+/// Whether and what to recognise, for the commands where recognition is optional.
+#[derive(clap::Args, Clone, Debug)]
+pub struct GestureArgs {
+    /// Recognise gestures and print their events.
+    #[arg(long)]
+    pub gestures: bool,
+    /// Gesture definitions to use instead of the built-in ones (implies --gestures).
+    #[arg(long)]
+    pub gestures_file: Option<PathBuf>,
+}
+
+impl GestureArgs {
+    /// The definitions to recognise, `None` with recognition off.
+    pub fn set(&self) -> anyhow::Result<Option<GestureSet>> {
+        gesture_set(self.gestures_file.as_deref(), self.gestures)
+    }
+}
+
+/// The gesture definitions of `file`, else the built-in ones when recognition is `on`, else
+/// none.
 pub fn gesture_set(file: Option<&Path>, on: bool) -> anyhow::Result<Option<GestureSet>> {
     Ok(match (file, on) {
         (Some(path), _) => Some(GestureSet::load(path)?),

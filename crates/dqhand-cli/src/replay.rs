@@ -15,7 +15,7 @@ use dqhand::interaction::GestureLoop;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
 
-use crate::recording::{Format, InputArgs, RecordingReader};
+use crate::recording::{Format, GestureArgs, InputArgs, RecordingReader};
 
 /// Arguments of `dqhand replay`.
 #[derive(clap::Args)]
@@ -28,12 +28,8 @@ pub struct Args {
     format: Option<Format>,
     #[command(flatten)]
     common: InputArgs,
-    /// Recognise gestures and print their events.
-    #[arg(long)]
-    gestures: bool,
-    /// Gesture definitions to use instead of the built-in ones (implies --gestures).
-    #[arg(long)]
-    gestures_file: Option<PathBuf>,
+    #[command(flatten)]
+    recognition: GestureArgs,
     /// Write the retargeted pose of every record here (JSON lines: `t`, `tracking` and a
     /// pose file's `model`, `wrist`, `angles_deg`).
     #[arg(long)]
@@ -51,7 +47,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = Arc::new(args.model.load()?);
-    let gestures = crate::recording::gesture_set(args.gestures_file.as_deref(), args.gestures)?;
+    let gestures = args.recognition.set()?;
     let mapper = Some(args.common.mapper(args.joint_model)?);
     let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
     let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.common.config()?, gestures)?;
