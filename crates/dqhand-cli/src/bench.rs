@@ -174,6 +174,5 @@ impl Animation {
 }
 
 fn percentile(s: &mut [f64], q: f64) -> f64 {
-    s.sort_by(f64::total_cmp);
-    s[((s.len() - 1) as f64 * q).round() as usize]
+    dqhand::math::quantile(s, q).expect("frames were timed")
 }

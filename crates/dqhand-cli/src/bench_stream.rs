@@ -65,9 +65,9 @@ pub fn run(model: Model, seconds: f64, json_out: bool) -> anyhow::Result<()> {
                 break elapsed;
             }
         };
-        engine_us.sort_by(f64::total_cmp);
-        let pick = |q: f64| engine_us[((engine_us.len() - 1) as f64 * q).round() as usize];
-        rows.push((r, frames as f64 / elapsed, pick(0.5), pick(0.9), bytes as f64 / elapsed / (1024.0 * 1024.0)));
+        let mut pick = |q: f64| dqhand::math::quantile(&mut engine_us, q).expect("frames arrived");
+        let (median, p90) = (pick(0.5), pick(0.9));
+        rows.push((r, frames as f64 / elapsed, median, p90, bytes as f64 / elapsed / (1024.0 * 1024.0)));
     }
     if json_out {
         let runs: Vec<_> = rows

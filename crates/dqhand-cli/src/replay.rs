@@ -14,6 +14,7 @@ use dqhand::interaction::benchmark::Distribution;
 use dqhand::interaction::GestureLoop;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
+use dqhand::math::quantile;
 
 use crate::recording::{Format, GestureArgs, InputArgs, RecordingReader};
 
@@ -106,12 +107,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.stats {
         let median = Distribution::of(&mut times_us).map_or(0.0, |d| d.median);
         eprintln!("{:.0} records per second, {median:.1} µs per taken record (median: read, filter, retarget, FK, features, recogniser)", records as f64 / elapsed);
-        if !sizes.is_empty() {
-            let mut lengths: Vec<f32> = sizes.iter().map(|s| s.0).collect();
-            let mut breadths: Vec<f32> = sizes.iter().map(|s| s.1).collect();
-            lengths.sort_by(f32::total_cmp);
-            breadths.sort_by(f32::total_cmp);
-            let (l, b) = (lengths[lengths.len() / 2], breadths[breadths.len() / 2]);
+        let mut lengths: Vec<f32> = sizes.iter().map(|s| s.0).collect();
+        let mut breadths: Vec<f32> = sizes.iter().map(|s| s.1).collect();
+        if let (Some(l), Some(b)) = (quantile(&mut lengths, 0.5), quantile(&mut breadths, 0.5)) {
             eprintln!("user's hand: length {l:.3} m, breadth {b:.3} m (build it: dqhand hand --length {l:.3} --breadth {b:.3})");
         }
     }

@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use super::glove_layout::RAW_MAX;
 use super::{GloveSample, MappingTable, SensorKind};
+use crate::math::quantile;
 use crate::{Error, Result};
 
 /// Least spread of a sensor's values (raw units, 5th to 95th percentile) over a calibration
@@ -257,10 +258,9 @@ fn refuse_still(still: &[&str]) -> Result<()> {
     )))
 }
 
-/// The `p` quantile (0–1) of `values` by nearest rank; sorts `values`. `values` is not empty.
+/// The `p` quantile (0–1) of `values` ([`quantile`]); sorts `values`. `values` is not empty.
 fn percentile(values: &mut [f32], p: f32) -> f32 {
-    values.sort_by(f32::total_cmp);
-    values[((values.len() - 1) as f32 * p).round() as usize]
+    quantile(values, f64::from(p)).expect("not empty")
 }
 
 fn median(values: &mut [f32]) -> f32 {

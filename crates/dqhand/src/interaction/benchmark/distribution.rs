@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 
-/// Count, median, 95th percentile and maximum of a set of samples: the sample at rank
-/// `round((n − 1) q)` of the sorted ones (for an even count, the upper of the middle two).
+use crate::math::quantile;
+
+/// Count, median, 95th percentile and maximum of a set of samples (by [`quantile`]'s rule).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Distribution {
     /// Number of samples.
@@ -21,10 +22,8 @@ impl Distribution {
     /// The distribution of `samples`, which it sorts; `None` when there are none.
     #[must_use]
     pub fn of(samples: &mut [f64]) -> Option<Self> {
-        let last = samples.len().checked_sub(1)?;
-        samples.sort_by(f64::total_cmp);
-        let at = |q: f64| samples[(last as f64 * q).round() as usize];
-        Some(Self { count: samples.len(), median: at(0.5), p95: at(0.95), max: samples[last] })
+        let (median, p95, max) = (quantile(samples, 0.5)?, quantile(samples, 0.95)?, quantile(samples, 1.0)?);
+        Some(Self { count: samples.len(), median, p95, max })
     }
 
     /// The same distribution in another unit (`factor` 1000: seconds to milliseconds).
