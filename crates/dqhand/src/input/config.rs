@@ -70,18 +70,6 @@ pub enum Action {
     ToggleHeatmap,
 }
 
-impl Action {
-    /// The name in the configuration and in the viewer's messages.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::NextMethod => "next_method",
-            Self::SplitView => "split_view",
-            Self::ToggleHeatmap => "toggle_heatmap",
-        }
-    }
-}
-
 impl Default for InputConfig {
     fn default() -> Self {
         Self {

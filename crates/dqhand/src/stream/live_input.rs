@@ -96,6 +96,11 @@ impl LiveInput {
         Self { source: source.into(), announce, gestures, joint_model, start: Instant::now(), state: Mutex::new(state) }
     }
 
+    /// The index of the gesture called `name` in the recognised set.
+    fn index(&self, name: &str) -> Option<usize> {
+        self.gestures.iter().position(|g| g == name)
+    }
+
     /// Seconds since the input was made: the arrival clock of its records.
     fn clock(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
@@ -139,7 +144,7 @@ impl LiveInput {
             log.push_back(entry);
             *logged += 1;
         };
-        let index = |name: &str| self.gestures.iter().position(|g| g == name).expect("events name gestures of the set");
+        let index = |name: &str| self.index(name).expect("events name gestures of the set");
         for e in gesture_loop.push(record, Some(arrival))? {
             add(Entry::Event { t: e.t, event: e.event, gesture: index(e.gesture) });
         }
@@ -198,12 +203,12 @@ impl LiveInput {
                 Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &self.gestures[gesture] })),
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
-                    actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action.as_str() }));
+                    actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action }));
                 }
             }
         }
         view.next = state.logged;
-        let gesture = state.gesture_loop.gesture().and_then(|g| self.gestures.iter().position(|n| n == g));
+        let gesture = state.gesture_loop.gesture().and_then(|g| self.index(g));
         let sent = Sent { tracking: pipeline.tracking(), gesture, accepted, rejected, at: arrival };
         let due = match view.sent {
             None => true,
