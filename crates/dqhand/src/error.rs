@@ -138,6 +138,9 @@ pub enum SceneProblem {
     /// Two objects have the same name.
     #[error("object {0:?} is defined twice")]
     DuplicateName(String),
+    /// An object asked for by name (a grasp script's) is not in the scene.
+    #[error("no object called {0:?}")]
+    NoObject(String),
     /// A shape that is not `sphere`, `box`, `cylinder` or `mesh`.
     #[error("object {object:?}: unknown shape {shape:?}; valid: sphere, box, cylinder, mesh")]
     UnknownShape {

@@ -56,7 +56,7 @@ fn a_scene_reads_with_its_defaults() {
     assert!((cube.rotation.length() - 1.0).abs() < 1e-6 && cube.rotation.angle_between(Quat::from_rotation_y(45f32.to_radians())) < 1e-4);
     assert_eq!((cube.friction, cube.restitution), (0.8, 0.1));
     assert_eq!(scene.object("mug").unwrap().shape, ObjectShape::Cylinder { radius: 0.04, height: 0.1 });
-    assert_eq!(scene.object("teapot").unwrap().shape, ObjectShape::Mesh { file: dir.join("teapot.obj") }, "relative to the scene file");
+    assert_eq!(scene.object("teapot").unwrap().shape, ObjectShape::Mesh { file: dir.join("teapot.obj"), scale: 1.0 }, "relative to the scene file");
     assert_eq!((scene.actions[0].gesture.as_str(), scene.actions[0].hold_s, scene.actions[0].action), ("open_palm", 1.0, SceneCommand::Reset));
     // No table, no actions: both optional.
     let bare = parse(r#"{"objects": []}"#).unwrap();

@@ -1,9 +1,17 @@
 //! Collision layer (paper 4.2): simplified shapes that stand in for the skin when the hand
-//! touches the scene.
+//! touches the scene, and the queries between them and the scene's objects.
 //!
-//! For now the per-bone proxies, fitted to a skinned mesh and exported with it; the queries
-//! against scene objects (continuous collision detection) build on them.
+//! * [`proxy`](fit_proxies) — one convex proxy per bone, fitted to a skinned mesh;
+//! * [`HandProxies`] and [`ObjectColliders`] — the hand's and the scene's shapes, built once;
+//! * [`ContactConstraint`] — continuous collision detection of the hand's motion against the
+//!   objects, which gives the rendered hand (it never sinks in) and its contacts.
 
+mod contact_constraint;
+mod hand_proxies;
+mod object_colliders;
 mod proxy;
 
+pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S};
+pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
+pub use object_colliders::{ObjectCollider, ObjectColliders};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};

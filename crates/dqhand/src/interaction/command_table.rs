@@ -1,32 +1,72 @@
-//! Gestures as commands: the configuration's table of held gestures and the viewer actions
-//! they trigger (the paper's "gestures act as commands"), each once per hold.
+//! Gestures as commands: a table of held gestures and the commands they trigger (the
+//! paper's "gestures act as commands"), each once per hold: the input configuration's viewer
+//! actions, a scene file's scene actions.
 
 use crate::gesture::{Event, EventKind, GestureSet};
 use crate::input::{Action, GestureAction};
+use crate::scene::{SceneAction, SceneCommand};
 use crate::{Error, Result};
+
+/// One row of a command table: a gesture, how long it is held, and its command.
+pub trait CommandRow {
+    /// The command it triggers.
+    type Command: Copy;
+    /// The gesture's name.
+    fn gesture(&self) -> &str;
+    /// Seconds it must be held.
+    fn hold_s(&self) -> f32;
+    /// The command.
+    fn command(&self) -> Self::Command;
+}
+
+impl CommandRow for GestureAction {
+    type Command = Action;
+    fn gesture(&self) -> &str {
+        &self.gesture
+    }
+    fn hold_s(&self) -> f32 {
+        self.hold_s
+    }
+    fn command(&self) -> Action {
+        self.action
+    }
+}
+
+impl CommandRow for SceneAction {
+    type Command = SceneCommand;
+    fn gesture(&self) -> &str {
+        &self.gesture
+    }
+    fn hold_s(&self) -> f32 {
+        self.hold_s
+    }
+    fn command(&self) -> SceneCommand {
+        self.action
+    }
+}
 
 /// Watches the gesture events and fires each row's action once, when its gesture has been
 /// held for the row's `hold_s` since it started. A gesture released and made again fires again.
 #[derive(Clone, Debug)]
-pub struct CommandTable {
-    rows: Vec<GestureAction>,
+pub struct CommandTable<R> {
+    rows: Vec<R>,
     /// The held gesture's first row, since when, and which rows have fired during this hold
     /// (bit per row); `None` while no gesture with a row is held.
     held: Option<(usize, f64, u64)>,
 }
 
-impl CommandTable {
+impl<R: CommandRow + Clone> CommandTable<R> {
     /// The table of `actions` over `set`'s gestures.
     ///
     /// # Errors
     /// [`Error::Config`] naming a row whose gesture `set` does not define, or a table of
     /// more than 64 rows.
-    pub fn new(actions: &[GestureAction], set: &GestureSet) -> Result<Self> {
+    pub fn new(actions: &[R], set: &GestureSet) -> Result<Self> {
         if actions.len() > 64 {
             return Err(Error::Config(format!("actions: {} rows (at most 64)", actions.len())));
         }
-        if let Some(a) = actions.iter().find(|a| !set.gestures().iter().any(|g| g.name() == a.gesture)) {
-            return Err(Error::Config(format!("actions: {:?} is not a gesture of the definitions in use", a.gesture)));
+        if let Some(a) = actions.iter().find(|a| !set.gestures().iter().any(|g| g.name() == a.gesture())) {
+            return Err(Error::Config(format!("actions: {:?} is not a gesture of the definitions in use", a.gesture())));
         }
         Ok(Self { rows: actions.to_vec(), held: None })
     }
@@ -34,22 +74,22 @@ impl CommandTable {
     /// Takes one update's gesture `events` at `time_s` and returns the action due now, if
     /// any (the first due row; another due at the same time follows on the next update).
     /// Allocates nothing.
-    pub fn update<'a>(&mut self, time_s: f64, events: impl IntoIterator<Item = Event<'a>>) -> Option<Action> {
+    pub fn update<'a>(&mut self, time_s: f64, events: impl IntoIterator<Item = Event<'a>>) -> Option<R::Command> {
         for e in events {
             self.held = match e.event {
-                EventKind::Start => self.rows.iter().position(|r| r.gesture == e.gesture).map(|row| (row, e.t, 0)),
+                EventKind::Start => self.rows.iter().position(|r| r.gesture() == e.gesture).map(|row| (row, e.t, 0)),
                 EventKind::End => None,
             };
         }
         let (first, since, fired) = self.held.as_mut()?;
-        let gesture = &self.rows[*first].gesture;
+        let gesture = self.rows[*first].gesture();
         let (i, row) = self
             .rows
             .iter()
             .enumerate()
-            .find(|(i, r)| r.gesture == *gesture && *fired & (1 << i) == 0 && time_s - *since >= f64::from(r.hold_s))?;
+            .find(|(i, r)| r.gesture() == gesture && *fired & (1 << i) == 0 && time_s - *since >= f64::from(r.hold_s()))?;
         *fired |= 1 << i;
-        Some(row.action)
+        Some(row.command())
     }
 }
 
@@ -57,7 +97,7 @@ impl CommandTable {
 mod tests {
     use super::*;
 
-    fn table(rows: &[(&str, f32, Action)]) -> CommandTable {
+    fn table(rows: &[(&str, f32, Action)]) -> CommandTable<GestureAction> {
         let actions: Vec<_> = rows.iter().map(|&(g, hold_s, action)| GestureAction { gesture: g.into(), hold_s, action }).collect();
         CommandTable::new(&actions, &GestureSet::builtin()).unwrap()
     }

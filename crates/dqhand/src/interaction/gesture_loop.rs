@@ -13,7 +13,7 @@ use crate::engine::Engine;
 use crate::gesture::{Events, GestureSet, HandFeatures, Recognizer};
 use crate::hand::Side;
 use super::CommandTable;
-use crate::input::{Action, GloveMapper, InputConfig, InputPipeline, Record, Rejection};
+use crate::input::{Action, GestureAction, GloveMapper, InputConfig, InputPipeline, Record, Rejection};
 use crate::kinematics::{JointModel, JointPositions};
 use crate::model::Model;
 use crate::Result;
@@ -26,7 +26,7 @@ pub struct GestureLoop {
     positions: [Vec3; 25],
     side: Side,
     recognizer: Option<Recognizer>,
-    commands: Option<CommandTable>,
+    commands: Option<CommandTable<GestureAction>>,
     /// The command the last record triggered.
     action: Option<Action>,
 }
@@ -119,6 +119,12 @@ impl GestureLoop {
     #[must_use]
     pub fn joint_positions(&self) -> &[Vec3; 25] {
         &self.positions
+    }
+
+    /// The engine that poses the virtual hand.
+    #[must_use]
+    pub fn engine(&self) -> &Engine {
+        &self.engine
     }
 
     /// The engine that poses the virtual hand (kinematics only; skin it with

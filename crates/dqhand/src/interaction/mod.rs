@@ -5,7 +5,10 @@
 pub mod benchmark;
 mod command_table;
 mod gesture_loop;
+mod manipulation_loop;
+pub mod grasp_script;
 pub mod synthetic;
 
-pub use command_table::CommandTable;
+pub use command_table::{CommandRow, CommandTable};
 pub use gesture_loop::GestureLoop;
+pub use manipulation_loop::ManipulationLoop;

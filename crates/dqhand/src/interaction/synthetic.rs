@@ -257,12 +257,7 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         }
         let record_hand = match &params.format {
             SyntheticFormat::Joints => {
-                let mut set = JointSet::new();
-                for (i, (&j, p)) in joints.indices().iter().zip(&positions).enumerate() {
-                    let (_, rotation, _) = world[j].to_scale_rotation_translation();
-                    set.set(i, TrackedJoint { position: *p, orientation: Some(rotation.normalize()), radius: 0.0 });
-                }
-                HandData::Joints(set)
+                HandData::Joints(joint_set(world, &joints, &positions))
             }
             SyntheticFormat::Landmarks => HandData::Landmarks(mediapipe::WEBXR_INDEX.map(|w| positions[w])),
             SyntheticFormat::Glove(_) => {
@@ -281,6 +276,17 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         truth.push(pose.clone());
     }
     Ok(Synthetic { hand, records, truth, labels, idle: (idle_start, end) })
+}
+
+/// The tracked joints a hand tracker would report for joint transforms `world`: `positions`
+/// (the joints' own, or with noise) and the joints' orientations.
+pub(crate) fn joint_set(world: &[Affine3A], joints: &JointPositions, positions: &[Vec3; 25]) -> JointSet {
+    let mut set = JointSet::new();
+    for (i, (&j, p)) in joints.indices().iter().zip(positions).enumerate() {
+        let (_, rotation, _) = world[j].to_scale_rotation_translation();
+        set.set(i, TrackedJoint { position: *p, orientation: Some(rotation.normalize()), radius: 0.0 });
+    }
+    set
 }
 
 /// A relaxed hand: every finger half curled (neither extended nor curled), the thumb loose

@@ -10,7 +10,8 @@
 //!     {"name": "cube", "shape": "box", "size": [0.05, 0.05, 0.05], "position": [0, 0.775, -0.3],
 //!      "rotation": [0, 0.383, 0, 0.924], "mass": 0.1, "friction": 0.8, "restitution": 0.1},
 //!     {"name": "mug", "shape": "cylinder", "radius": 0.04, "height": 0.1, "position": [-0.1, 0.8, -0.3], "mass": 0.3},
-//!     {"name": "teapot", "shape": "mesh", "file": "teapot.obj", "position": [0, 0.75, -0.45], "mass": 0.6}
+//!     {"name": "teapot", "shape": "mesh", "file": "teapot.obj", "scale": 0.6,
+//!      "position": [0, 0.75, -0.45], "mass": 0.6}
 //!   ],
 //!   "actions": [{"gesture": "open_palm", "hold_s": 1.0, "action": "reset"}]
 //! }
@@ -19,7 +20,8 @@
 //! Every field is checked when the file is read, and the first problem is named with its
 //! object and field: unknown fields, a missing shape parameter, a non-positive size or mass,
 //! a friction or restitution out of range, a rotation far from unit length, NaN, two objects
-//! of one name, a mesh file that is not there. A mesh path is relative to the scene file.
+//! of one name, a mesh file that is not there. A mesh path is relative to the scene file; its
+//! optional `scale` (default 1) scales the file's coordinates.
 
 use std::path::{Path, PathBuf};
 
@@ -94,6 +96,8 @@ pub enum ObjectShape {
     Mesh {
         /// The file, resolved against the scene file's folder.
         file: PathBuf,
+        /// Uniform scale applied to the file's coordinates (files come in any unit).
+        scale: f32,
     },
 }
 
@@ -145,6 +149,8 @@ struct ObjectJson {
     height: Option<f32>,
     #[serde(default)]
     file: Option<PathBuf>,
+    #[serde(default)]
+    scale: Option<f32>,
     position: [f32; 3],
     #[serde(default)]
     rotation: Option<[f32; 4]>,
@@ -165,7 +171,7 @@ struct ActionJson {
 }
 
 /// Shape parameters each shape takes (the others must be absent).
-const SHAPES: [(&str, &[&str]); 4] = [("sphere", &["radius"]), ("box", &["size"]), ("cylinder", &["radius", "height"]), ("mesh", &["file"])];
+const SHAPES: [(&str, &[&str]); 4] = [("sphere", &["radius"]), ("box", &["size"]), ("cylinder", &["radius", "height"]), ("mesh", &["file", "scale"])];
 
 impl Scene {
     /// Reads a scene file.
@@ -222,10 +228,10 @@ fn object(o: ObjectJson, folder: &Path) -> std::result::Result<SceneObject, Scen
     let Some((_, parameters)) = SHAPES.iter().find(|(s, _)| *s == o.shape) else {
         return Err(SceneProblem::UnknownShape { object: o.name.clone(), shape: o.shape.clone() });
     };
-    let given = [("radius", o.radius.is_some()), ("size", o.size.is_some()), ("height", o.height.is_some()), ("file", o.file.is_some())];
+    let given = [("radius", o.radius.is_some()), ("size", o.size.is_some()), ("height", o.height.is_some()), ("file", o.file.is_some()), ("scale", o.scale.is_some())];
     for (field, present) in given {
         let wanted = parameters.contains(&field);
-        if wanted && !present {
+        if wanted && !present && field != "scale" {
             return Err(SceneProblem::Missing { object: o.name.clone(), field, shape: o.shape.clone() });
         }
         if present && !wanted {
@@ -245,7 +251,7 @@ fn object(o: ObjectJson, folder: &Path) -> std::result::Result<SceneObject, Scen
             if !file.is_file() {
                 return Err(SceneProblem::MeshFile { object: o.name.clone(), file });
             }
-            ObjectShape::Mesh { file }
+            ObjectShape::Mesh { file, scale: positive(name, "scale", o.scale.unwrap_or(1.0))? }
         }
     };
     let mut position = Vec3::ZERO;

@@ -1,0 +1,412 @@
+//! The rendered hand, constrained by contacts: the tracked hand may go inside an object, the
+//! hand the user sees does not.
+//!
+//! Two stages per frame, both continuous (a time of impact along the motion, never a test at
+//! the end of it only, so nothing fast or thin is passed through):
+//! 1. **Wrist.** The palm's proxies move rigidly from the last rendered wrist to the tracked
+//!    one (a screw: rotation about the wrist, translation of it); parry's nonlinear shape cast
+//!    gives the first time of impact with any object, and the wrist stops there, on the
+//!    surface. After [`SNAP_AFTER_S`] held back, the wrist jumps to a tracked pose that is
+//!    free again (the user has gone round the object, or tracking came back elsewhere).
+//! 2. **Fingers.** Each finger closes along its flexion, from open to the tracked angles, by
+//!    conservative advancement: the distance of its proxies to the objects over an upper bound
+//!    of how fast any of their points moves per unit of the closure gives a step that cannot
+//!    pass through anything. At the first contact the joints proximal to the touching phalanx
+//!    stop and the distal ones close on, so the finger wraps the object.
+//!
+//! The tracked pose is left as it is: the grasp logic reads it.
+
+use glam::{Affine3A, Vec3};
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::query::{self, NonlinearRigidMotion};
+
+use super::hand_proxies::pose_of;
+use super::{HandPart, HandProxies, ObjectColliders, FINGERS};
+use crate::kinematics::{forward_kinematics, HandRig, Limits, Motion, Pose, Transform};
+use crate::math::DualQuat;
+
+/// Proxies closer than this to an object touch it (m).
+pub const CONTACT_DISTANCE: f32 = 0.002;
+
+/// A finger stops closing this close to a surface (m): the proxies' margin keeps the skin off.
+const STOP_DISTANCE: f32 = 0.0004;
+
+/// Steps of conservative advancement per finger stage: enough to converge from any start; a
+/// finger that has not converged stays where it safely is.
+const MAX_ADVANCES: usize = 40;
+
+/// Seconds the rendered wrist may be held back before it jumps to a free tracked pose.
+pub const SNAP_AFTER_S: f64 = 0.5;
+
+/// A proxy touching an object in the rendered pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// The joint whose proxy touches.
+    pub joint: usize,
+    /// Its part of the hand.
+    pub part: HandPart,
+    /// Index of the object in the scene.
+    pub object: usize,
+    /// The nearest point of the object's surface (world).
+    pub point: Vec3,
+    /// The object's surface normal there, pointing at the hand (world, unit).
+    pub normal: Vec3,
+    /// Gap between proxy and surface (m; 0 or less when they overlap).
+    pub distance: f32,
+}
+
+/// How closed a finger is: the sum of its flexion angles (radians), tracked and rendered.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Closure {
+    /// The user's.
+    pub tracked: f32,
+    /// The rendered finger's, stopped by contact.
+    pub rendered: f32,
+}
+
+/// One finger's closing chain, resolved once.
+#[derive(Clone, Debug, Default)]
+struct FingerChain {
+    /// The DOFs that close it (flexion; the thumb's CMC abduction too), proximal first:
+    /// (index in the pose, joint it turns).
+    dofs: Vec<(usize, usize)>,
+    /// Its proxies: (index in [`HandProxies::colliders`], the last DOF (position in `dofs`)
+    /// that moves it, and per DOF an upper bound of the distance of its points from that
+    /// DOF's joint, 0 where the DOF does not move it).
+    proxies: Vec<(usize, usize, Vec<f32>)>,
+    /// The largest distance of any of its proxies' points from its first DOF's joint.
+    reach: f32,
+}
+
+/// Solves the rendered pose from the tracked one each frame; every buffer is allocated once.
+#[derive(Clone)]
+pub struct ContactConstraint {
+    proxies: HandProxies,
+    fingers: [FingerChain; 5],
+    locals: Vec<Transform>,
+    world: Vec<Affine3A>,
+    tracked_world: Vec<Affine3A>,
+    tracked: Pose,
+    rendered: Pose,
+    wrist: Option<DualQuat>,
+    held_back_since: Option<f64>,
+    contacts: Vec<Contact>,
+    closure: [Closure; 5],
+    near: Vec<usize>,
+}
+
+impl ContactConstraint {
+    /// A constraint for `proxies` on `rig`'s skeleton.
+    #[must_use]
+    pub fn new(proxies: HandProxies, rig: &HandRig) -> Self {
+        let skeleton = rig.skeleton();
+        let joints = skeleton.joints();
+        let rest = skeleton.rest_world();
+        let at = |j: usize| Vec3::from(rest[j].translation);
+        let is_ancestor = |a: usize, mut j: usize| loop {
+            if j == a {
+                return true;
+            }
+            match joints[j].parent {
+                Some(p) => j = p,
+                None => return false,
+            }
+        };
+        // Length of the chain from `a` down to `j`: no bend of the joints between can put
+        // `j` farther from `a` (triangle inequality).
+        let chain_length = |a: usize, mut j: usize| {
+            let mut length = 0.0;
+            while j != a {
+                let p = joints[j].parent.expect("a descendant");
+                length += at(j).distance(at(p));
+                j = p;
+            }
+            length
+        };
+        let fingers = core::array::from_fn(|f| {
+            // Flexion, and the thumb's opposition (CMC abduction), which also closes it.
+            let closes = |d: &crate::kinematics::Dof| d.motion == Motion::Flex || d.bone == "thumb-metacarpal";
+            let mut dofs: Vec<(usize, usize)> = rig
+                .model()
+                .dofs()
+                .zip(rig.dofs())
+                .enumerate()
+                .filter(|(_, (d, r))| closes(d) && HandPart::of(&joints[r.joint].name) == HandPart::Finger(f))
+                .map(|(i, (_, r))| (i, r.joint))
+                .collect();
+            let depth = |mut j: usize| {
+                let mut d = 0;
+                while let Some(p) = joints[j].parent {
+                    (j, d) = (p, d + 1);
+                }
+                d
+            };
+            dofs.sort_by_key(|&(_, j)| depth(j));
+            assert!(dofs.len() <= 4, "at most four closing DOFs per finger");
+            let mut reach: f32 = 0.0;
+            let proxies = proxies
+                .colliders()
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.part == HandPart::Finger(f))
+                .filter_map(|(i, p)| {
+                    let levers: Vec<f32> = dofs.iter().map(|&(_, j)| if is_ancestor(j, p.joint) { chain_length(j, p.joint) + p.extent } else { 0.0 }).collect();
+                    let last = levers.iter().rposition(|&l| l > 0.0)?;
+                    reach = reach.max(levers[0]);
+                    Some((i, last, levers))
+                })
+                .collect();
+            FingerChain { dofs, proxies, reach }
+        });
+        let n = skeleton.len();
+        Self {
+            contacts: Vec::with_capacity(proxies.colliders().len() * 4),
+            proxies,
+            fingers,
+            locals: skeleton.rest_locals(),
+            world: vec![Affine3A::IDENTITY; n],
+            tracked_world: vec![Affine3A::IDENTITY; n],
+            tracked: Pose::rest(rig.dofs().len()),
+            rendered: Pose::rest(rig.dofs().len()),
+            wrist: None,
+            held_back_since: None,
+            closure: [Closure::default(); 5],
+            near: Vec::new(),
+        }
+    }
+
+    /// Forgets the last rendered wrist: the next [`Self::solve`] starts from the tracked one
+    /// (after a reset, or when tracking comes back).
+    pub fn restart(&mut self) {
+        self.wrist = None;
+        self.held_back_since = None;
+    }
+
+    /// Takes the frame's `tracked` pose: its joint transforms ([`Self::tracked_world`]) and
+    /// finger closures ([`Self::closure`], tracked), which the grasp logic reads before the
+    /// rendered pose is solved. Allocates nothing.
+    pub fn track(&mut self, rig: &HandRig, limits: Limits, tracked: &Pose) {
+        self.tracked.clone_from(tracked);
+        rig.locals(tracked, limits, &mut self.locals);
+        forward_kinematics(rig.skeleton(), &self.locals, &mut self.tracked_world);
+        for (f, chain) in self.fingers.iter().enumerate() {
+            self.closure[f].tracked = chain.dofs.iter().map(|&(i, _)| tracked.angles[i]).sum();
+        }
+    }
+
+    /// Solves the rendered pose for the tracked pose of [`Self::track`] at time `now` (s)
+    /// against `objects`; `held`, the object in the hand, moves with the hand, so it does not
+    /// stop the wrist (the fingers still close on it). Allocates nothing once `near` has grown
+    /// to the scene.
+    pub fn solve(&mut self, rig: &HandRig, limits: Limits, objects: &ObjectColliders, held: Option<usize>, now: f64) {
+        if self.near.capacity() < objects.objects().len() {
+            self.near.reserve(objects.objects().len());
+        }
+        let tracked = &self.tracked;
+        let target = tracked.wrist.unwrap_or_else(|| rig.rest_wrist());
+        let wrist = self.solve_wrist(rig, target, objects, held, now);
+        self.wrist = Some(wrist);
+        self.rendered.clone_from(&self.tracked);
+        self.rendered.wrist = Some(wrist);
+        for f in 0..FINGERS.len() {
+            self.close_finger(rig, limits, f, objects);
+        }
+        self.forward(rig, limits);
+        self.find_contacts(objects);
+        for (f, chain) in self.fingers.iter().enumerate() {
+            self.closure[f].rendered = chain.dofs.iter().map(|&(i, _)| self.rendered.angles[i]).sum();
+        }
+    }
+
+    fn forward(&mut self, rig: &HandRig, limits: Limits) {
+        rig.locals(&self.rendered, limits, &mut self.locals);
+        forward_kinematics(rig.skeleton(), &self.locals, &mut self.world);
+    }
+
+    /// Stage 1: the first time of impact of the palm on its way to `target`.
+    fn solve_wrist(&mut self, rig: &HandRig, target: DualQuat, objects: &ObjectColliders, held: Option<usize>, now: f64) -> DualQuat {
+        let Some(start) = self.wrist else { return target };
+        let (r0, t0) = start.to_rotation_translation();
+        let (r1, t1) = target.to_rotation_translation();
+        let r1 = if r0.dot(r1) < 0.0 { -r1 } else { r1 };
+        let angvel = (r1 * r0.inverse()).to_scaled_axis();
+        let linvel = t1 - t0;
+        let start_affine = Affine3A::from_rotation_translation(r0, t0);
+        let to_wrist = self.tracked_world[rig.wrist()].inverse();
+        let mut toi: f32 = 1.0;
+        for p in self.proxies.colliders().iter().filter(|p| p.part == HandPart::Palm) {
+            let offset = to_wrist * self.tracked_world[p.joint];
+            let from = pose_of(&(start_affine * offset));
+            let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
+            // The arc a turning point sweeps bulges out of the two end boxes by at most
+            // radius · angle / 2.
+            let bulge = (offset.translation.length() + p.extent) * angvel.length().min(core::f32::consts::PI) / 2.0;
+            let swept = p.shape.compute_swept_aabb(&from, &to).loosened(bulge);
+            let motion = NonlinearRigidMotion::new(from, offset.inverse().transform_point3(Vec3::ZERO), linvel, angvel);
+            for (_, o) in objects.near(&swept, 0.0, held) {
+                let still = NonlinearRigidMotion::constant_position(o.pose);
+                if let Ok(Some(hit)) = query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false) {
+                    toi = toi.min(hit.time_of_impact);
+                }
+            }
+        }
+        if toi >= 1.0 {
+            self.held_back_since = None;
+            return target;
+        }
+        let since = *self.held_back_since.get_or_insert(now);
+        if now - since > SNAP_AFTER_S && self.palm_free(rig, target, objects, held) {
+            self.held_back_since = None;
+            return target;
+        }
+        DualQuat::from_rotation_translation(r0.slerp(r1, toi).normalize(), t0.lerp(t1, toi))
+    }
+
+    /// Whether the palm is clear of every object at wrist pose `wrist`.
+    fn palm_free(&self, rig: &HandRig, wrist: DualQuat, objects: &ObjectColliders, held: Option<usize>) -> bool {
+        let (r, t) = wrist.to_rotation_translation();
+        let at = Affine3A::from_rotation_translation(r, t) * self.tracked_world[rig.wrist()].inverse();
+        self.proxies.colliders().iter().filter(|p| p.part == HandPart::Palm).all(|p| {
+            let pose = pose_of(&(at * self.tracked_world[p.joint]));
+            let aabb = p.shape.compute_aabb(&pose);
+            objects.near(&aabb, 0.0, held).all(|(_, o)| !query::intersection_test(&pose, &*p.shape, &o.pose, &*o.surface).is_ok_and(|x| x.intersecting))
+        })
+    }
+
+    /// Stage 2 for finger `f`: conservative advancement of its closure.
+    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders) {
+        let chain = std::mem::take(&mut self.fingers[f]);
+        if chain.dofs.is_empty() {
+            self.fingers[f] = chain;
+            return;
+        }
+        // The closure runs from `start` to the tracked angles (`self.rendered` holds those).
+        let mut target = [0.0f32; 4];
+        let mut start = [0.0f32; 4];
+        for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+            target[k] = self.rendered.angles[i];
+            self.rendered.angles[i] = 0.0;
+        }
+        self.forward(rig, limits);
+        let root = Vec3::from(self.world[chain.dofs[0].1].translation);
+        let reach = Aabb::from_half_extents(root, Vec3::splat(chain.reach));
+        self.near.clear();
+        self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
+        let mut active = 0;
+        let mut s: f32 = 0.0;
+        if !self.near.is_empty() {
+            let set = |angles: &mut [f32], active: usize, s: f32, start: &[f32; 4], target: &[f32; 4]| {
+                for (k, &(i, _)) in chain.dofs.iter().enumerate().skip(active) {
+                    angles[i] = start[k] + (target[k] - start[k]) * s;
+                }
+            };
+            for _ in 0..MAX_ADVANCES {
+                set(&mut self.rendered.angles, active, s, &start, &target);
+                self.forward(rig, limits);
+                // The nearest moving proxy, and the largest step no point of any can overrun.
+                let mut nearest = (f32::INFINITY, 0);
+                let mut step = f32::INFINITY;
+                for (p, last, levers) in &chain.proxies {
+                    if *last < active {
+                        continue;
+                    }
+                    let proxy = &self.proxies.colliders()[*p];
+                    let pose = pose_of(&self.world[proxy.joint]);
+                    let mut d = f32::INFINITY;
+                    for &o in &self.near {
+                        let o = &objects.objects()[o];
+                        if let Ok(x) = query::distance(&pose, &*proxy.shape, &o.pose, &*o.surface) {
+                            d = d.min(x.distance);
+                        }
+                    }
+                    if d < nearest.0 {
+                        nearest = (d, *last);
+                    }
+                    let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
+                    if speed > 0.0 {
+                        step = step.min(d / speed);
+                    }
+                }
+                if nearest.0 <= STOP_DISTANCE {
+                    // Contact: the joints up to the touching phalanx stop here; the rest close on.
+                    for k in active..chain.dofs.len() {
+                        start[k] = self.rendered.angles[chain.dofs[k].0];
+                    }
+                    active = nearest.1 + 1;
+                    s = 0.0;
+                    if active >= chain.dofs.len() {
+                        break;
+                    }
+                    continue;
+                }
+                if s + step >= 1.0 {
+                    s = 1.0;
+                    break;
+                }
+                s += step;
+            }
+            set(&mut self.rendered.angles, active, s, &start, &target);
+        } else {
+            for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                self.rendered.angles[i] = target[k];
+            }
+        }
+        self.fingers[f] = chain;
+    }
+
+    fn find_contacts(&mut self, objects: &ObjectColliders) {
+        self.contacts.clear();
+        for p in self.proxies.colliders() {
+            let pose = pose_of(&self.world[p.joint]);
+            let aabb = p.shape.compute_aabb(&pose);
+            for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, None) {
+                if let Ok(Some(c)) = query::contact(&pose, &*p.shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
+                    let normal = (-c.normal1).normalize_or_zero();
+                    self.contacts.push(Contact { joint: p.joint, part: p.part, object: i, point: c.point2, normal, distance: c.dist });
+                }
+            }
+        }
+    }
+
+    /// The rendered pose of the last [`Self::solve`].
+    #[must_use]
+    pub fn rendered(&self) -> &Pose {
+        &self.rendered
+    }
+
+    /// The world transform of each joint in the rendered pose.
+    #[must_use]
+    pub fn world(&self) -> &[Affine3A] {
+        &self.world
+    }
+
+    /// The world transform of each joint in the tracked pose.
+    #[must_use]
+    pub fn tracked_world(&self) -> &[Affine3A] {
+        &self.tracked_world
+    }
+
+    /// The proxies touching objects in the rendered pose.
+    #[must_use]
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// How closed each finger is, tracked and rendered, thumb first.
+    #[must_use]
+    pub fn closure(&self) -> &[Closure; 5] {
+        &self.closure
+    }
+
+    /// Whether the rendered wrist is held back from the tracked one by an object.
+    #[must_use]
+    pub fn wrist_held_back(&self) -> bool {
+        self.held_back_since.is_some()
+    }
+
+    /// The proxies.
+    #[must_use]
+    pub fn proxies(&self) -> &HandProxies {
+        &self.proxies
+    }
+}

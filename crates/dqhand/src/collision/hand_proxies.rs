@@ -1,0 +1,107 @@
+//! The hand's collision proxies as persistent parry shapes, built once per hand: no query
+//! builds a shape. Each knows which part of the hand it belongs to, because the contact
+//! constraint moves the palm with the wrist and closes each finger on its own.
+
+use glam::{Affine3A, Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use super::{Proxy, ProxyShape};
+use crate::kinematics::Skeleton;
+
+/// The five fingers, in WebXR name order (the thumb first).
+pub const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "pinky"];
+
+/// The part of the hand a proxy belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HandPart {
+    /// The wrist and the four finger metacarpals: they move with the wrist.
+    Palm,
+    /// A finger's phalanges (index into [`FINGERS`]); the thumb's include its metacarpal,
+    /// which moves at the CMC joint.
+    Finger(usize),
+}
+
+impl HandPart {
+    /// The part of the joint called `name` (a WebXR name).
+    #[must_use]
+    pub fn of(name: &str) -> Self {
+        match FINGERS.iter().position(|f| name.starts_with(f)) {
+            Some(0) => HandPart::Finger(0),
+            Some(f) if name.contains("phalanx") => HandPart::Finger(f),
+            _ => HandPart::Palm,
+        }
+    }
+}
+
+/// One proxy as a parry shape.
+#[derive(Clone)]
+pub struct ProxyCollider {
+    /// Index of the joint whose frame carries it.
+    pub joint: usize,
+    /// The shape in that frame.
+    pub shape: SharedShape,
+    /// Which part of the hand.
+    pub part: HandPart,
+    /// The largest distance of a point of the shape from the joint's origin (m): bounds how
+    /// fast the shape moves when the joint turns.
+    pub extent: f32,
+}
+
+/// A rigid affine transform as a parry pose.
+#[must_use]
+pub fn pose_of(m: &Affine3A) -> Pose {
+    let rotation = Quat::from_mat3a(&m.matrix3).normalize();
+    Pose::from_parts(Vec3::from(m.translation), rotation)
+}
+
+/// The proxies of a hand as parry shapes.
+#[derive(Clone)]
+pub struct HandProxies {
+    colliders: Vec<ProxyCollider>,
+}
+
+impl HandProxies {
+    /// Shapes for `proxies` (fitted by [`super::fit_proxies`]) on `skeleton`'s joints.
+    #[must_use]
+    pub fn new(proxies: &[Proxy], skeleton: &Skeleton) -> Self {
+        let joints = skeleton.joints();
+        let colliders = proxies
+            .iter()
+            .filter_map(|p| {
+                let (shape, extent) = match &p.shape {
+                    ProxyShape::Capsule { start, end, radius } => {
+                        (SharedShape::capsule(*start, *end, *radius), start.length().max(end.length()) + radius)
+                    }
+                    ProxyShape::ConvexHull { points, triangles } => {
+                        let extent = points.iter().map(|q| q.length()).fold(0.0, f32::max);
+                        (SharedShape::convex_mesh(points.clone(), triangles)?, extent)
+                    }
+                };
+                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent })
+            })
+            .collect();
+        Self { colliders }
+    }
+
+    /// The proxies.
+    #[must_use]
+    pub fn colliders(&self) -> &[ProxyCollider] {
+        &self.colliders
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parts_follow_webxr_names() {
+        assert_eq!(HandPart::of("wrist"), HandPart::Palm);
+        assert_eq!(HandPart::of("index-finger-metacarpal"), HandPart::Palm);
+        assert_eq!(HandPart::of("thumb-metacarpal"), HandPart::Finger(0));
+        assert_eq!(HandPart::of("thumb-phalanx-distal"), HandPart::Finger(0));
+        assert_eq!(HandPart::of("ring-finger-phalanx-intermediate"), HandPart::Finger(3));
+        assert_eq!(HandPart::of("pinky-finger-phalanx-distal"), HandPart::Finger(4));
+    }
+}

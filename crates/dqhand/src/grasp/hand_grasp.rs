@@ -1,0 +1,247 @@
+//! The grasp state machine of one hand (see the module documentation for the rules).
+
+use glam::{Affine3A, Quat, Vec3};
+
+use crate::collision::{Closure, Contact, HandPart};
+use crate::math::rigid_fit;
+
+/// The thresholds of the grasp rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraspParams {
+    /// Least angle between the normals of two opposing contacts, degrees.
+    pub opposition_deg: f32,
+    /// How far past the rendered finger the tracked one must close to grasp, degrees.
+    pub press_deg: f32,
+    /// How far each grasping finger must open past its closure at the grasp to release,
+    /// degrees.
+    pub release_deg: f32,
+    /// Seconds after a release before the object can be grasped again.
+    pub cooldown_s: f64,
+    /// Seconds a held object survives a tracking loss.
+    pub loss_grace_s: f64,
+}
+
+impl Default for GraspParams {
+    fn default() -> Self {
+        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5 }
+    }
+}
+
+/// What a frame changed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GraspEvent {
+    /// The object was grasped.
+    Grasp {
+        /// Index of the object in the scene.
+        object: usize,
+    },
+    /// The object was let go, with this velocity (m/s, and rad/s as an axis times a rate).
+    Release {
+        /// Index of the object in the scene.
+        object: usize,
+        /// Linear velocity of the object's origin.
+        linvel: Vec3,
+        /// Angular velocity.
+        angvel: Vec3,
+    },
+}
+
+/// At most this many contact points hold an object (the first ones found).
+const MAX_ANCHORS: usize = 16;
+/// The wrist frame's points added to the contacts: origin and 5 cm along each axis, so that
+/// two contacts (a pinch) still fix the object's rotation.
+const WRIST_POINTS: [Vec3; 4] = [Vec3::ZERO, Vec3::new(0.05, 0.0, 0.0), Vec3::new(0.0, 0.05, 0.0), Vec3::new(0.0, 0.0, 0.05)];
+/// Frames of held poses kept for the release velocity.
+const HISTORY: usize = 4;
+
+#[derive(Clone, Debug)]
+struct Held {
+    object: usize,
+    wrist: usize,
+    /// (joint, point in the joint's frame): contacts and the wrist frame's points.
+    anchors: [(usize, Vec3); MAX_ANCHORS + 4],
+    count: usize,
+    /// The anchors in world space at the grasp (tracked pose).
+    reference: [Vec3; MAX_ANCHORS + 4],
+    current: [Vec3; MAX_ANCHORS + 4],
+    /// The object's pose at the grasp.
+    start: (Quat, Vec3),
+    /// The grasping fingers (thumb first) and the sum of their rendered closures then.
+    fingers: [bool; 5],
+    closure: f32,
+    lost_since: Option<f64>,
+    /// The object's pose this frame.
+    target: (Quat, Vec3),
+    /// The tracked wrist's last poses, newest last: (time, rotation, translation).
+    history: [(f64, Quat, Vec3); HISTORY],
+    filled: usize,
+}
+
+/// The grasp state of one hand over a scene's objects.
+#[derive(Clone, Debug)]
+pub struct Grasp {
+    params: GraspParams,
+    held: Option<Held>,
+    /// Per object, the time before which it cannot be grasped.
+    cooldown_until: Vec<f64>,
+}
+
+impl Grasp {
+    /// A hand holding nothing, in a scene of `objects` objects.
+    #[must_use]
+    pub fn new(params: GraspParams, objects: usize) -> Self {
+        Self { params, held: None, cooldown_until: vec![f64::NEG_INFINITY; objects] }
+    }
+
+    /// The thresholds.
+    #[must_use]
+    pub fn params(&self) -> &GraspParams {
+        &self.params
+    }
+
+    /// The object held, if any.
+    #[must_use]
+    pub fn held(&self) -> Option<usize> {
+        self.held.as_ref().map(|h| h.object)
+    }
+
+    /// Where the held object goes this frame: its rotation and translation.
+    #[must_use]
+    pub fn target(&self) -> Option<(Quat, Vec3)> {
+        self.held.as_ref().map(|h| h.target)
+    }
+
+    /// Lets go of everything at once, with no velocity and no cooldown (a scene reset).
+    pub fn clear(&mut self) {
+        self.held = None;
+        self.cooldown_until.fill(f64::NEG_INFINITY);
+    }
+
+    /// The first half of a frame at `now` (s), before the rendered hand is solved: the held
+    /// object follows the tracked joints `tracked_world` ([`Self::target`]), or is let go
+    /// because the fingers opened (`closure`, tracked) or tracking has been lost (`tracking`
+    /// false) for longer than the grace time. Allocates nothing.
+    pub fn follow(&mut self, now: f64, tracking: bool, closure: &[Closure; 5], tracked_world: &[Affine3A]) -> Option<GraspEvent> {
+        let held = self.held.as_mut()?;
+        if !tracking {
+            let since = *held.lost_since.get_or_insert(now);
+            return (now - since > self.params.loss_grace_s).then(|| self.release(now, false));
+        }
+        held.lost_since = None;
+        let closed: f32 = closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| c.tracked).sum();
+        let count = held.fingers.iter().filter(|g| **g).count() as f32;
+        if closed < held.closure - self.params.release_deg.to_radians() * count {
+            return Some(self.release(now, true));
+        }
+        let n = held.count;
+        for (c, &(j, local)) in held.current[..n].iter_mut().zip(&held.anchors[..n]) {
+            *c = tracked_world[j].transform_point3(local);
+        }
+        let (r, t) = rigid_fit(&held.reference[..n], &held.current[..n]);
+        held.target = ((r * held.start.0).normalize(), r * held.start.1 + t);
+        held.remember(now, &tracked_world[held.wrist]);
+        None
+    }
+
+    /// The second half of a frame, with the rendered hand solved: grasps an object when
+    /// nothing is held and the rules hold for the rendered pose's `contacts` and the fingers'
+    /// `closure`. `rendered_world` and `tracked_world` are both poses' joint transforms,
+    /// `wrist` the wrist joint, `objects` each object's pose. Allocates nothing.
+    #[allow(clippy::too_many_arguments)]
+    pub fn detect(
+        &mut self,
+        now: f64,
+        tracking: bool,
+        contacts: &[Contact],
+        closure: &[Closure; 5],
+        rendered_world: &[Affine3A],
+        tracked_world: &[Affine3A],
+        wrist: usize,
+        objects: &[(Quat, Vec3)],
+    ) -> Option<GraspEvent> {
+        if self.held.is_some() || !tracking {
+            return None;
+        }
+        let object = self.find_grasp(now, contacts, closure)?;
+        let mut held = Held {
+            object,
+            wrist,
+            anchors: [(0, Vec3::ZERO); MAX_ANCHORS + 4],
+            count: 0,
+            reference: [Vec3::ZERO; MAX_ANCHORS + 4],
+            current: [Vec3::ZERO; MAX_ANCHORS + 4],
+            start: objects[object],
+            fingers: [false; 5],
+            closure: 0.0,
+            lost_since: None,
+            target: objects[object],
+            history: [(now, Quat::IDENTITY, Vec3::ZERO); HISTORY],
+            filled: 0,
+        };
+        for c in contacts.iter().filter(|c| c.object == object).take(MAX_ANCHORS) {
+            held.anchors[held.count] = (c.joint, rendered_world[c.joint].inverse().transform_point3(c.point));
+            held.count += 1;
+            if let HandPart::Finger(f) = c.part {
+                held.fingers[f] = true;
+            }
+        }
+        for p in WRIST_POINTS {
+            held.anchors[held.count] = (wrist, p);
+            held.count += 1;
+        }
+        for i in 0..held.count {
+            let (j, local) = held.anchors[i];
+            held.reference[i] = tracked_world[j].transform_point3(local);
+        }
+        held.closure = closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| c.rendered).sum();
+        held.remember(now, &tracked_world[wrist]);
+        self.held = Some(held);
+        Some(GraspEvent::Grasp { object })
+    }
+
+    /// The object the contacts grasp, if any: a pressing thumb or palm contact and a pressing
+    /// finger contact on it, with opposing normals.
+    fn find_grasp(&self, now: f64, contacts: &[Contact], closure: &[Closure; 5]) -> Option<usize> {
+        let press = self.params.press_deg.to_radians();
+        let opposed = self.params.opposition_deg.to_radians().cos();
+        let pressing = |c: &Contact| match c.part {
+            HandPart::Palm => true,
+            HandPart::Finger(f) => closure[f].tracked - closure[f].rendered >= press,
+        };
+        let thumb_side = |c: &&Contact| matches!(c.part, HandPart::Palm | HandPart::Finger(0)) && pressing(c);
+        let finger = |c: &&Contact| matches!(c.part, HandPart::Finger(1..)) && pressing(c);
+        contacts.iter().filter(thumb_side).find_map(|a| {
+            let ok = now >= self.cooldown_until[a.object]
+                && contacts.iter().filter(finger).any(|b| b.object == a.object && a.normal.dot(b.normal) <= opposed);
+            ok.then_some(a.object)
+        })
+    }
+
+    fn release(&mut self, now: f64, moving: bool) -> GraspEvent {
+        let held = self.held.take().expect("releasing a held object");
+        self.cooldown_until[held.object] = now + self.params.cooldown_s;
+        // The object leaves with the hand's motion, not the fingers' (they are opening):
+        // the velocity of its origin as a point fixed to the wrist over the last frames.
+        let (t0, q0, p0) = held.history[HISTORY - held.filled];
+        let (t1, q1, p1) = held.history[HISTORY - 1];
+        let dt = (t1 - t0) as f32;
+        let (linvel, angvel) = if moving && dt > 0.0 {
+            let q1 = if q0.dot(q1) < 0.0 { -q1 } else { q1 };
+            let angvel = (q1 * q0.inverse()).to_scaled_axis() / dt;
+            ((p1 - p0) / dt + angvel.cross(held.target.1 - p1), angvel)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        GraspEvent::Release { object: held.object, linvel, angvel }
+    }
+}
+
+impl Held {
+    /// Keeps the tracked wrist's pose `wrist` at `now` for the release velocity.
+    fn remember(&mut self, now: f64, wrist: &Affine3A) {
+        let (_, q, p) = wrist.to_scale_rotation_translation();
+        self.history.rotate_left(1);
+        self.history[HISTORY - 1] = (now, q.normalize(), p);
+        self.filled = (self.filled + 1).min(HISTORY);
+    }
+}

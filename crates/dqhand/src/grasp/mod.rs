@@ -1,0 +1,23 @@
+//! Grasping heuristics: when the hand holds an object, where the held object goes, and when
+//! it is let go (the paper's "grasping heuristics", after Jacobs and Froehlich 2011 and
+//! Prachyabrued and Borst 2012, in the style of today's hand-tracking SDKs).
+//!
+//! * **Grasp.** The thumb (or the palm) and at least one other finger touch an object in
+//!   the rendered pose with opposing surface normals (an angle of more than
+//!   [`GraspParams::opposition_deg`] between them), and the user squeezes: each of those
+//!   fingers is tracked closed past where its rendered copy stopped on the surface by
+//!   [`GraspParams::press_deg`]. A pinch (thumb and index tips) is the same rule on a
+//!   small object.
+//! * **Hold.** The touching points are fixed in their bones (the tracked ones, which the
+//!   user moves), with four points of the wrist's frame; each frame the object takes the
+//!   best-fit rigid motion ([`crate::math::rigid_fit`]) of those points since the grasp.
+//! * **Release.** The grasping fingers open past their closure at the grasp by
+//!   [`GraspParams::release_deg`] each (hysteresis: between the two thresholds nothing
+//!   changes); the object is then not grasped again for [`GraspParams::cooldown_s`]. It
+//!   leaves with the hand's velocity over the last frames, so a throw flies.
+//! * **Tracking loss.** A held object stays where it is while tracking is lost, and drops
+//!   after [`GraspParams::loss_grace_s`].
+
+mod hand_grasp;
+
+pub use hand_grasp::{Grasp, GraspEvent, GraspParams};

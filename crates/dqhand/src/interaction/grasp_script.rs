@@ -1,0 +1,208 @@
+//! Scripted manipulation recordings, made from our own kinematics: approach an object, grasp
+//! it, lift, carry, put it down, let go and retract (the paper's Figure 9 sequences, and the
+//! set `dqhand grasp-bench` scores); and strikes, a flat hand driven through an object at a
+//! given speed, for tunnelling. They are labelled synthetic wherever they are written.
+//!
+//! The user's hand is the loop's own model, tracked without noise: what is measured is the
+//! manipulation loop, not the retargeting. The tracked hand goes into the object (the palm
+//! presses 1 cm into it, the fingers close as if it were not there), as a real user's does.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, Mat3, Quat, Vec3};
+use parry3d::query::Ray;
+
+use super::synthetic::joint_set;
+use crate::collision::ObjectColliders;
+use crate::engine::Engine;
+use crate::hand::Side;
+use crate::input::{HandData, Record};
+use crate::kinematics::{JointModel, JointPositions, Motion, Pose};
+use crate::math::DualQuat;
+use crate::model::Model;
+use crate::{Error, Result, SceneProblem};
+
+/// How far the tracked palm presses into the object, m.
+const PRESS_M: f32 = 0.01;
+/// Where the hand starts and ends, back from the grasp along the approach, m.
+const STANDOFF_M: f32 = 0.2;
+/// Carrying speed, m/s.
+const CARRY_SPEED: f32 = 0.5;
+
+/// One scripted grasp.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraspTask {
+    /// The object's name in the scene.
+    pub object: String,
+    /// The direction the palm moves and faces on the approach (world, unit).
+    pub approach: Vec3,
+    /// The direction the fingers point (world; made perpendicular to `approach`).
+    pub fingers: Vec3,
+    /// Approach speed, m/s.
+    pub speed: f32,
+    /// How high the object is lifted, m.
+    pub lift: f32,
+    /// The carry, m (world displacement after the lift).
+    pub carry: Vec3,
+    /// A pinch (thumb and index tips) instead of a whole-hand grasp.
+    pub pinch: bool,
+}
+
+/// When each stage of a scripted grasp happens, s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraspTimes {
+    /// The palm reaches the object.
+    pub reached: f64,
+    /// The fingers are closed.
+    pub closed: f64,
+    /// The carry begins (after the lift).
+    pub carry_start: f64,
+    /// The carry ends.
+    pub carry_end: f64,
+    /// The object is set down; the fingers begin to open.
+    pub release: f64,
+    /// The end of the recording.
+    pub end: f64,
+}
+
+/// A scripted recording.
+#[derive(Clone, Debug)]
+pub struct Script {
+    /// The records, one per frame.
+    pub records: Vec<Record>,
+    /// The tracked pose of each record (the `full` joint model).
+    pub truth: Vec<Pose>,
+    /// The stages.
+    pub times: GraspTimes,
+}
+
+/// Records per second.
+pub const RATE_HZ: f64 = 60.0;
+
+/// The hand in the frame of its wrist: where its palm's centre is, which way the palm faces
+/// and the fingers point.
+struct HandFrame {
+    palm: Vec3,
+    palmar: Vec3,
+    fingers: Vec3,
+}
+
+fn hand_frame(engine: &mut Engine, joints: &JointPositions) -> HandFrame {
+    let rig = engine.rig().expect("a joint-model engine").clone();
+    engine.pose(&Pose::rest(rig.dofs().len()));
+    let world = engine.world();
+    let to_wrist = world[rig.wrist()].inverse();
+    let p = joints.read(world).map(|p| to_wrist.transform_point3(p));
+    // WebXR order: 0 wrist, 11 middle proximal; palmar is the wrist's −Y.
+    let fingers = p[11].normalize();
+    let palmar = (-Vec3::Y - fingers * fingers.dot(-Vec3::Y)).normalize();
+    // The palm's surface: its thickness is about a third of a metacarpal's length.
+    let palm = p[11] * 0.55 + palmar * (p[11].length() * 0.3);
+    HandFrame { palm, palmar, fingers }
+}
+
+/// The closing shape (1) and the open one (0) of a grasp, angles of the `full` model.
+fn shape(closed: f32, pinch: bool) -> Pose {
+    let mut pose = Pose::rest(JointModel::Full.dof_count());
+    for (d, a) in JointModel::Full.dofs().zip(&mut pose.angles) {
+        let thumb = d.bone.starts_with("thumb");
+        let index = d.bone.starts_with("index");
+        let (open, shut) = match (d.bone, d.motion) {
+            ("thumb-metacarpal", Motion::Abd) => (15.0, 50.0),
+            ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
+            (_, Motion::Flex) if thumb => (0.0, 45.0),
+            (_, Motion::Flex) if pinch && !index => (20.0, 60.0),
+            (b, Motion::Flex) if b.ends_with("proximal") => (0.0, if pinch { 50.0 } else { 80.0 }),
+            (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, if pinch { 50.0 } else { 95.0 }),
+            (_, Motion::Flex) => (0.0, if pinch { 30.0 } else { 60.0 }),
+            (_, Motion::Abd) => (0.0, 0.0),
+        };
+        *a = (open + (shut - open) * closed as f64).to_radians() as f32;
+    }
+    pose
+}
+
+fn smooth(s: f64) -> f32 {
+    let s = s.clamp(0.0, 1.0);
+    (s * s * (3.0 - 2.0 * s)) as f32
+}
+
+/// A keyframe: time, palm position, closure.
+type Key = (f64, Vec3, f32);
+
+/// Records of `model` doing `task` in `scene` (called `file` in errors), whose objects are
+/// `objects`.
+///
+/// # Errors
+/// [`SceneProblem::NoObject`] if the scene has no object of the task's; as
+/// [`Engine::with_joint_model`].
+pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &GraspTask, side: Side) -> Result<Script> {
+    let object = objects
+        .objects()
+        .iter()
+        .find(|o| o.name == task.object)
+        .ok_or_else(|| Error::Scene { file: file.to_owned(), problem: SceneProblem::NoObject(task.object.clone()) })?;
+    let d = task.approach.normalize();
+    let f = (task.fingers - d * task.fingers.dot(d)).normalize();
+    // Where the palm meets the object: the surface point seen along the approach through
+    // the middle of its bounding box.
+    let centre = object.aabb().center();
+    let ray = Ray::new(centre - d, d);
+    let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
+    let contact = centre - d + d * toi;
+    let grasp_at = contact + d * PRESS_M;
+    let start = grasp_at - d * STANDOFF_M;
+    let lifted = grasp_at + Vec3::Y * task.lift;
+    let carried = lifted + task.carry;
+    let set_down = carried - Vec3::Y * task.lift;
+    let mut keys: Vec<Key> = Vec::new();
+    let mut t = 0.0;
+    let mut key = |dt: f64, p: Vec3, c: f32, keys: &mut Vec<Key>| {
+        t += dt;
+        keys.push((t, p, c));
+        t
+    };
+    key(0.0, start, 0.0, &mut keys);
+    key(0.3, start, 0.0, &mut keys);
+    let reached = key(f64::from(STANDOFF_M / task.speed), grasp_at, 0.0, &mut keys);
+    key(0.15, grasp_at, 0.0, &mut keys);
+    let closed = key(0.5, grasp_at, 1.0, &mut keys);
+    key(0.2, grasp_at, 1.0, &mut keys);
+    let carry_start = key(0.5, lifted, 1.0, &mut keys);
+    let carry_end = key(f64::from(task.carry.length() / CARRY_SPEED), carried, 1.0, &mut keys);
+    key(0.2, carried, 1.0, &mut keys);
+    key(0.5, set_down, 1.0, &mut keys);
+    let release = key(0.1, set_down, 1.0, &mut keys);
+    key(0.4, set_down, 0.0, &mut keys);
+    key(0.5, set_down - d * STANDOFF_M, 0.0, &mut keys);
+    let end = key(1.0, set_down - d * STANDOFF_M, 0.0, &mut keys);
+    let times = GraspTimes { reached, closed, carry_start, carry_end, release, end };
+    // The approach is at constant speed (its speed is the point); the rest eased.
+    let eased = |k: usize| k != 2;
+    let frames = (end * RATE_HZ).floor() as usize + 1;
+    let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
+    let joints = JointPositions::new(engine.skeleton())?;
+    let frame = hand_frame(&mut engine, &joints);
+    let rotation = {
+        let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
+        let world = Mat3::from_cols(d, f, d.cross(f));
+        Quat::from_mat3(&(world * hand.transpose())).normalize()
+    };
+    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times };
+    for i in 0..frames {
+        let t = i as f64 / RATE_HZ;
+        let k = keys.iter().rposition(|k| k.0 <= t).unwrap_or(0).min(keys.len() - 2);
+        let ((t0, p0, c0), (t1, p1, c1)) = (keys[k], keys[k + 1]);
+        let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+        let s = if eased(k + 1) { smooth(s) } else { s.clamp(0.0, 1.0) as f32 };
+        let palm = p0.lerp(p1, s);
+        let mut pose = shape(c0 + (c1 - c0) * s, task.pinch);
+        pose.wrist = Some(DualQuat::from_rotation_translation(rotation, palm - rotation * frame.palm));
+        engine.pose(&pose);
+        let world: &[Affine3A] = engine.world();
+        let positions = joints.read(world);
+        script.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None });
+        script.truth.push(pose);
+    }
+    Ok(script)
+}

@@ -1,0 +1,226 @@
+//! The 3D manipulation loop (paper Figure 1, right; Figure 9): records drive the tracked
+//! hand; its collision layer meets the scene's objects, which gives the rendered hand (it
+//! never sinks in) and its contacts; grasping heuristics pick objects up, carry them and let
+//! them go; the physics moves the rest. Gestures stay commands: the scene file's actions.
+//!
+//! One frame ([`ManipulationLoop::step`]) in order:
+//! 1. the tracked pose (records pushed since the last frame, tracking loss judged now);
+//! 2. the held object follows the tracked hand, or is released;
+//! 3. the rendered pose is solved against the objects where they now are;
+//! 4. a grasp is detected on the rendered contacts;
+//! 5. the physics steps (the held object moved by the hand), and the objects' poses are read.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+
+use super::{CommandTable, GestureLoop};
+use crate::collision::{fit_proxies, Contact, ContactConstraint, HandProxies, ObjectColliders, PROXY_MARGIN};
+use crate::engine::Engine;
+use crate::gesture::GestureSet;
+use crate::grasp::{Grasp, GraspEvent, GraspParams};
+use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
+use crate::kinematics::JointModel;
+use crate::model::Model;
+use crate::physics::ScenePhysics;
+use crate::scene::{Scene, SceneAction, SceneCommand};
+use crate::Result;
+
+/// The longest physics step taken at once, s: a stall in the records must not launch objects.
+const MAX_STEP_S: f64 = 1.0 / 30.0;
+
+/// One hand manipulating one scene.
+pub struct ManipulationLoop {
+    input: GestureLoop,
+    scene_commands: Option<CommandTable<SceneAction>>,
+    objects: ObjectColliders,
+    names: Vec<String>,
+    constraint: ContactConstraint,
+    grasp: Grasp,
+    physics: ScenePhysics,
+    rendered: Engine,
+    poses: Vec<(Quat, Vec3)>,
+    last: Option<f64>,
+    reset_due: bool,
+    was_tracking: bool,
+}
+
+impl ManipulationLoop {
+    /// A loop posing `model` with `joint_model` from records (as [`GestureLoop::new`]) in
+    /// `scene`. With `gestures`, the scene's actions are commands.
+    ///
+    /// # Errors
+    /// As [`GestureLoop::new`]; as [`ObjectColliders::new`] for the scene's meshes; a scene
+    /// action naming a gesture not recognised ([`CommandTable::new`]).
+    pub fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
+        let input = GestureLoop::new(model.clone(), joint_model, glove, config, gestures)?;
+        let scene_commands = match input.gestures() {
+            Some(set) if !scene.actions.is_empty() => Some(CommandTable::new(&scene.actions, set)?),
+            _ => None,
+        };
+        let rendered = Engine::with_joint_model(model.clone(), joint_model)?;
+        let rig = rendered.rig().expect("an engine with a joint model has a rig");
+        let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rig.skeleton());
+        let constraint = ContactConstraint::new(proxies, rig);
+        let objects = ObjectColliders::new(scene)?;
+        let physics = ScenePhysics::new(scene, &objects);
+        let n = scene.objects.len();
+        let poses = (0..n).map(|i| physics.pose(i)).collect();
+        Ok(Self {
+            input,
+            scene_commands,
+            names: scene.objects.iter().map(|o| o.name.clone()).collect(),
+            objects,
+            constraint,
+            grasp: Grasp::new(params, n),
+            physics,
+            rendered,
+            poses,
+            last: None,
+            reset_due: false,
+            was_tracking: false,
+        })
+    }
+
+    /// Takes one record (`arrival` as in [`GestureLoop::push`]); a scene action its gesture
+    /// completes is carried out at the next [`Self::step`]. Allocates nothing.
+    ///
+    /// # Errors
+    /// The record's refusal; the hand keeps its pose.
+    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> std::result::Result<(), Rejection> {
+        let events = self.input.push(record, arrival)?;
+        if let Some(table) = &mut self.scene_commands {
+            if table.update(record.time, events) == Some(SceneCommand::Reset) {
+                self.reset_due = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// Counts a record refused before it reached the loop.
+    pub fn reject(&mut self, rejection: Rejection) {
+        self.input.reject(rejection);
+    }
+
+    /// Puts every object back where the scene file has it, at rest, and lets go.
+    pub fn reset(&mut self) {
+        self.reset_due = true;
+    }
+
+    /// One frame at `now` (s; the records' clock): see the module documentation. Returns
+    /// the grasp or release it caused. Allocates nothing.
+    pub fn step(&mut self, now: f64) -> Option<GraspEvent> {
+        self.input.advance(now);
+        let dt = self.last.map_or(1.0 / 60.0, |last| (now - last).clamp(0.0, MAX_STEP_S));
+        self.last = Some(now);
+        if std::mem::take(&mut self.reset_due) {
+            self.physics.reset();
+            self.grasp.clear();
+            self.constraint.restart();
+            self.read_poses();
+        }
+        let tracking = self.tracking() == Tracking::Tracking;
+        if tracking && !self.was_tracking {
+            // Tracking came back (or began): the rendered hand starts from the tracked one.
+            self.constraint.restart();
+        }
+        self.was_tracking = tracking;
+        let engine = self.input.engine();
+        let rig = engine.rig().expect("a gesture loop's engine has a rig");
+        let limits = engine.limits();
+        self.constraint.track(rig, limits, self.input.pipeline().pose());
+        let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world());
+        if let Some((q, t)) = self.grasp.target() {
+            let held = self.grasp.held().expect("a target is a held object's");
+            self.objects.set_pose(held, q, t);
+            self.poses[held] = (q, t);
+        }
+        self.constraint.solve(rig, limits, &self.objects, self.grasp.held(), now);
+        if event.is_none() {
+            event = self.grasp.detect(now, tracking, self.constraint.contacts(), self.constraint.closure(), self.constraint.world(), self.constraint.tracked_world(), rig.wrist(), &self.poses);
+        }
+        if let Some(GraspEvent::Release { object, linvel, angvel }) = event {
+            self.physics.release(object, linvel, angvel);
+        }
+        if let Some((q, t)) = self.grasp.target() {
+            self.physics.hold(self.grasp.held().expect("a target is a held object's"), q, t);
+        }
+        self.physics.step(dt as f32);
+        self.read_poses();
+        self.rendered.pose(self.constraint.rendered());
+        event
+    }
+
+    fn read_poses(&mut self) {
+        for i in 0..self.poses.len() {
+            let (q, t) = self.physics.pose(i);
+            self.poses[i] = (q, t);
+            self.objects.set_pose(i, q, t);
+        }
+    }
+
+    /// Whether the hand is tracked.
+    #[must_use]
+    pub fn tracking(&self) -> Tracking {
+        self.input.pipeline().tracking()
+    }
+
+    /// The name of the object held, if any.
+    #[must_use]
+    pub fn held(&self) -> Option<&str> {
+        self.grasp.held().map(|i| self.names[i].as_str())
+    }
+
+    /// The rendered hand's contacts after the last frame.
+    #[must_use]
+    pub fn contacts(&self) -> &[Contact] {
+        self.constraint.contacts()
+    }
+
+    /// The objects' names, in scene order.
+    #[must_use]
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Each object's pose after the last frame (rotation, translation), in scene order.
+    #[must_use]
+    pub fn poses(&self) -> &[(Quat, Vec3)] {
+        &self.poses
+    }
+
+    /// The objects' shapes, where they are after the last frame.
+    #[must_use]
+    pub fn objects(&self) -> &ObjectColliders {
+        &self.objects
+    }
+
+    /// The physics (the table, velocities).
+    #[must_use]
+    pub fn physics(&self) -> &ScenePhysics {
+        &self.physics
+    }
+
+    /// The contact constraint (the tracked and rendered poses, finger closures).
+    #[must_use]
+    pub fn constraint(&self) -> &ContactConstraint {
+        &self.constraint
+    }
+
+    /// The engine posed with the rendered hand, to skin ([`Engine::skin`]).
+    pub fn rendered_mut(&mut self) -> &mut Engine {
+        &mut self.rendered
+    }
+
+    /// The engine posed with the rendered hand.
+    #[must_use]
+    pub fn rendered(&self) -> &Engine {
+        &self.rendered
+    }
+
+    /// The gesture loop under it (pipeline, recognised gesture).
+    #[must_use]
+    pub fn input(&self) -> &GestureLoop {
+        &self.input
+    }
+}

@@ -1,0 +1,7 @@
+//! Physics of the free objects (rapier3d): gravity, the table, friction and restitution. A
+//! held object is moved by the hand (kinematically, so it pushes what it meets) and handed
+//! back to the simulation with the hand's velocity when released.
+
+mod scene_physics;
+
+pub use scene_physics::{ScenePhysics, GRAVITY};

@@ -1,0 +1,142 @@
+//! The scene's rigid bodies in a rapier world.
+
+use glam::{Quat, Vec3};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle, RigidBodyType};
+use rapier3d::pipeline::PhysicsWorld;
+use parry3d::math::Pose;
+
+use crate::collision::ObjectColliders;
+use crate::scene::Scene;
+
+/// Gravity, m/s² along −Y.
+pub const GRAVITY: f32 = 9.81;
+
+/// Half the thickness of the table's slab, m.
+const TABLE_HALF_THICKNESS: f32 = 0.025;
+/// How far the table reaches past its objects, m, and its least half size.
+const TABLE_MARGIN: f32 = 0.3;
+const TABLE_MIN_HALF: [f32; 2] = [0.6, 0.4];
+
+/// The scene's free objects and table, simulated.
+pub struct ScenePhysics {
+    world: PhysicsWorld,
+    bodies: Vec<RigidBodyHandle>,
+    /// Where the file puts each object.
+    initial: Vec<Pose>,
+    held: Option<usize>,
+    table: Option<(f32, [f32; 2], [f32; 2])>,
+}
+
+impl ScenePhysics {
+    /// The objects of `scene` at rest where the file puts them (their solids from
+    /// `colliders`), on its table if it has one.
+    #[must_use]
+    pub fn new(scene: &Scene, colliders: &ObjectColliders) -> Self {
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vec3::new(0.0, -GRAVITY, 0.0);
+        world.integration_parameters.max_ccd_substeps = 4;
+        let mut bodies = Vec::with_capacity(scene.objects.len());
+        let mut initial = Vec::with_capacity(scene.objects.len());
+        for (o, c) in scene.objects.iter().zip(colliders.objects()) {
+            let pose = Pose::from_parts(o.position, o.rotation);
+            let body = RigidBodyBuilder::dynamic().pose(pose).ccd_enabled(true).build();
+            let collider = ColliderBuilder::new(c.solid.clone()).mass(o.mass).friction(o.friction).restitution(o.restitution).build();
+            let (handle, _) = world.insert(body, collider);
+            bodies.push(handle);
+            initial.push(pose);
+        }
+        let table = scene.table.map(|t| {
+            let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+            for c in colliders.objects() {
+                let aabb = c.aabb();
+                for (k, axis) in [0, 2].into_iter().enumerate() {
+                    lo[k] = lo[k].min(aabb.mins[axis]);
+                    hi[k] = hi[k].max(aabb.maxs[axis]);
+                }
+            }
+            if colliders.objects().is_empty() {
+                (lo, hi) = ([0.0; 2], [0.0; 2]);
+            }
+            let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
+            let half = [((hi[0] - lo[0]) / 2.0 + TABLE_MARGIN).max(TABLE_MIN_HALF[0]), ((hi[1] - lo[1]) / 2.0 + TABLE_MARGIN).max(TABLE_MIN_HALF[1])];
+            let slab = ColliderBuilder::cuboid(half[0], TABLE_HALF_THICKNESS, half[1])
+                .translation(Vec3::new(centre[0], t.height - TABLE_HALF_THICKNESS, centre[1]))
+                .friction(0.8)
+                .restitution(0.3)
+                .build();
+            world.insert_collider(slab, None);
+            (t.height, centre, half)
+        });
+        Self { world, bodies, initial, held: None, table }
+    }
+
+    /// The table's top: its height, centre (x, z) and half sizes (x, z), if there is one.
+    #[must_use]
+    pub fn table(&self) -> Option<(f32, [f32; 2], [f32; 2])> {
+        self.table
+    }
+
+    /// Object `i`'s pose: rotation and translation.
+    #[must_use]
+    pub fn pose(&self, i: usize) -> (Quat, Vec3) {
+        let p = self.world.bodies[self.bodies[i]].position();
+        (p.rotation, p.translation)
+    }
+
+    /// Object `i`'s linear and angular velocity.
+    #[must_use]
+    pub fn velocity(&self, i: usize) -> (Vec3, Vec3) {
+        let b = &self.world.bodies[self.bodies[i]];
+        (b.linvel(), b.angvel())
+    }
+
+    /// The object moved by the hand, if any.
+    #[must_use]
+    pub fn held(&self) -> Option<usize> {
+        self.held
+    }
+
+    /// Object `i` is in the hand: the next [`Self::step`] moves it to `rotation`,
+    /// `translation`, pushing what it meets on the way.
+    pub fn hold(&mut self, i: usize, rotation: Quat, translation: Vec3) {
+        if self.held != Some(i) {
+            if let Some(h) = self.held {
+                self.release(h, Vec3::ZERO, Vec3::ZERO);
+            }
+            self.world.bodies[self.bodies[i]].set_body_type(RigidBodyType::KinematicPositionBased, true);
+            self.held = Some(i);
+        }
+        self.world.bodies[self.bodies[i]].set_next_kinematic_position(Pose::from_parts(translation, rotation));
+    }
+
+    /// Object `i` leaves the hand with its origin moving at `linvel` and turning at `angvel`.
+    pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3) {
+        if self.held == Some(i) {
+            self.held = None;
+        }
+        let body = &mut self.world.bodies[self.bodies[i]];
+        body.set_body_type(RigidBodyType::Dynamic, true);
+        // The simulation moves the centre of mass; the hand gave the origin's velocity.
+        let lever = body.center_of_mass() - body.position().translation;
+        body.set_linvel(linvel + angvel.cross(lever), true);
+        body.set_angvel(angvel, true);
+    }
+
+    /// Every object back where the file puts it, at rest, none held.
+    pub fn reset(&mut self) {
+        self.held = None;
+        for (&h, &pose) in self.bodies.iter().zip(&self.initial) {
+            let body = &mut self.world.bodies[h];
+            body.set_body_type(RigidBodyType::Dynamic, true);
+            body.set_position(pose, true);
+            body.set_linvel(Vec3::ZERO, true);
+            body.set_angvel(Vec3::ZERO, true);
+        }
+    }
+
+    /// Advances the simulation by `dt` seconds.
+    pub fn step(&mut self, dt: f32) {
+        self.world.integration_parameters.dt = dt;
+        self.world.step();
+    }
+}
