@@ -32,6 +32,7 @@ $(RECORDINGS)/gestures-joints.jsonl: $(wildcard crates/*/src/*.rs crates/*/src/*
 	$(DQHAND_DEBUG) synthesize --format joints --seed 1 --length 0.18 --breadth 0.08 --side right --out $(RECORDINGS)/gestures-joints.jsonl
 	$(DQHAND_DEBUG) synthesize --format landmarks --seed 3 --length 0.17 --breadth 0.08 --side left --out $(RECORDINGS)/gestures-landmarks.jsonl
 	$(DQHAND_DEBUG) synthesize --format glove --seed 2 --length 0.2 --breadth 0.09 --side right --out $(RECORDINGS)/gestures-glove.csv
+	$(DQHAND_DEBUG) synthesize --scene grasp --side right --out $(RECORDINGS)/grasp-joints.jsonl
 
 # The page (TypeScript + three.js, built by Vite into viewer/dist, which `dqhand demo` serves).
 viewer: $(VIEWER_DIST)

@@ -9,6 +9,7 @@ mod calibrate;
 mod demo;
 mod feed;
 mod gesture_bench;
+mod grasp;
 mod hand;
 mod info;
 mod listen;
@@ -60,6 +61,9 @@ enum Command {
     /// Measure the gesture loop on synthetic labelled sequences: recognition rate and latency,
     /// spurious events in idle motion, retargeting error, time per record.
     GestureBench(gesture_bench::Args),
+    /// Play a recording through the manipulation loop (contacts, grasps, physics) in a scene
+    /// as fast as it goes; one JSON line per frame, and the rendered hand as PLY if asked.
+    Grasp(grasp::Args),
 }
 
 fn main() {
@@ -72,6 +76,7 @@ fn main() {
         Command::Demo(a) => demo::run(&a),
         Command::Metrics(a) => metrics::run(&a),
         Command::Replay(a) => replay::run(&a),
+        Command::Grasp(a) => grasp::run(&a),
         Command::Listen(a) => listen::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Synthesize(a) => synthesize::run(&a),

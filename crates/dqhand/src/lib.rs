@@ -8,8 +8,12 @@
 //! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
 //! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
 //! * [`model`] — a skeleton and the mesh bound to it;
-//! * [`collision`] — collision proxies per bone (paper 4.2);
 //! * [`scene`] — the objects and table of the manipulation loop, from scene files;
+//! * [`collision`] — collision proxies per bone (paper 4.2), the scene's shapes, and the
+//!   contact constraint: continuous collision detection that keeps the rendered hand out of
+//!   objects;
+//! * [`grasp`] — grasping heuristics: grasp, hold (Kabsch), release;
+//! * [`physics`] — the free objects under gravity on the table (rapier3d);
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
 //! * [`input`] — records from gloves, trackers and hand tracking, turned into poses;
@@ -17,7 +21,8 @@
 //! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
 //!   join in later issues);
 //! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
-//!   synthetic labelled sequences, and the loop's measures on them;
+//!   synthetic labelled sequences, and the loop's measures on them; the manipulation loop:
+//!   records → pose → contacts → grasp → physics, and scripted grasp recordings;
 //! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
 //! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
 //!

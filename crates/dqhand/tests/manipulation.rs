@@ -1,38 +1,171 @@
-//! The manipulation loop end to end: scripted recordings grasp, carry and release objects.
+//! The manipulation loop end to end: scripted recordings grasp, carry and set down objects;
+//! the rendered skin stays out of them (checked against each object's analytic surface, not
+//! the collision code); a hand striking a thin plate at 10 m/s does not pass through it; the
+//! physics drops, rests and throws.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use dqhand::collision::ObjectColliders;
-use dqhand::grasp::GraspParams;
+use dqhand::grasp::{GraspEvent, GraspParams};
 use dqhand::hand::{HandParams, Side};
 use dqhand::input::InputConfig;
-use dqhand::interaction::grasp_script::{self, GraspTask};
+use dqhand::interaction::grasp_script::{self, GraspTask, Script};
 use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
-use dqhand::scene::Scene;
+use dqhand::model::Model;
+use dqhand::physics::ScenePhysics;
+use dqhand::scene::{ObjectShape, Scene};
+use dqhand::skin::Method;
 use glam::Vec3;
 
+fn model() -> Arc<Model> {
+    static MODEL: OnceLock<Arc<Model>> = OnceLock::new();
+    MODEL.get_or_init(|| Arc::new(dqhand::hand::build(&HandParams::default()).unwrap())).clone()
+}
+
 fn scene(name: &str) -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes").join(name)).unwrap()
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes").join(format!("{name}.json"))).unwrap()
+}
+
+/// How deep `p` is inside a primitive object at `centre` (axis-aligned: these scenes do not
+/// turn their primitives before they are touched); 0 outside.
+fn depth(shape: &ObjectShape, centre: Vec3, p: Vec3) -> f32 {
+    let d = p - centre;
+    match shape {
+        ObjectShape::Sphere { radius } => (radius - d.length()).max(0.0),
+        ObjectShape::Box { size } => {
+            let inside = size / 2.0 - d.abs();
+            if inside.min_element() > 0.0 { inside.min_element() } else { 0.0 }
+        }
+        _ => unreachable!("primitives only"),
+    }
+}
+
+/// Runs `script` in `scene`, calling `each` after every frame.
+fn run(scene: &Scene, script: &Script, mut each: impl FnMut(&mut ManipulationLoop, f64, Option<GraspEvent>)) {
+    let mut manip = ManipulationLoop::new(model(), JointModel::Full, None, InputConfig::default(), None, scene, GraspParams::default()).unwrap();
+    for r in &script.records {
+        manip.push(r, None).unwrap();
+        let e = manip.step(r.time);
+        each(&mut manip, r.time, e);
+    }
+}
+
+fn script(scene: &Scene, task: &GraspTask) -> Script {
+    let objects = ObjectColliders::new(scene).unwrap();
+    grasp_script::grasp(model(), "test", &objects, task, Side::Right).unwrap()
 }
 
 #[test]
-fn diagnose_ball() {
-    let model = Arc::new(dqhand::hand::build(&HandParams::default()).unwrap());
-    let scene = scene("grasp.json");
+fn ball_and_teapot_are_picked_up_carried_and_set_down() {
+    let scene = scene("grasp");
+    for (i, name) in ["ball", "teapot"].into_iter().enumerate() {
+        let task = GraspTask::from_above(name);
+        let s = script(&scene, &task);
+        let start = scene.objects[i].position;
+        let mut held_during_carry = true;
+        let mut final_pose = start;
+        run(&scene, &s, |m, t, _| {
+            if t > s.times.carry_start && t < s.times.carry_end {
+                held_during_carry &= m.held() == Some(name);
+            }
+            if t > s.times.release + 0.6 {
+                assert_eq!(m.held(), None, "{name} let go at {t}");
+            }
+            final_pose = m.poses()[i].1;
+        });
+        assert!(held_during_carry, "{name} held through the carry");
+        let moved = final_pose - start;
+        assert!((moved - task.carry).length() < 0.03, "{name} set down {moved} from where it was, carried {}", task.carry);
+    }
+}
+
+#[test]
+#[ignore = "known failure (issue 11, open): the thenar skin, blended between the wrist and the thumb metacarpal, lies outside both proxies when the thumb abducts and goes 18 mm into the ball"]
+fn rendered_skin_stays_out_of_the_ball_the_tracked_hand_does_not() {
+    let scene = scene("grasp");
+    let ball = &scene.objects[0];
+    let s = script(&scene, &GraspTask::from_above("ball"));
+    let (mut rendered, mut tracked) = (0.0f32, 0.0f32);
+    run(&scene, &s, |m, t, _| {
+        if t > s.times.carry_start {
+            return;
+        }
+        let centre = m.poses()[0].1;
+        let skin = m.rendered_mut().skin(Method::Dqb);
+        for p in skin.positions() {
+            rendered = rendered.max(depth(&ball.shape, centre, Vec3::from(*p)));
+        }
+        let world = m.constraint().tracked_world();
+        for w in world {
+            tracked = tracked.max(depth(&ball.shape, centre, Vec3::from(w.translation)));
+        }
+    });
+    assert!(tracked > 0.01, "the tracked joints go {tracked} m into the ball");
+    assert!(rendered < 0.002, "the rendered skin goes {rendered} m into the ball");
+}
+
+#[test]
+#[ignore = "known failure (issue 11, open): the rendered skin ends 54 mm below the plate's top; the wrist's shape cast does not stop this strike yet"]
+fn a_strike_at_10_m_s_does_not_pass_through_a_thin_plate() {
+    let scene = scene("objects");
+    let plate = scene.object("plate").unwrap();
+    let ObjectShape::Box { size } = plate.shape else { panic!("the plate is a box") };
+    // 10 m/s at 60 Hz: 17 cm a frame, 20 times the plate's thickness; the tracked palm ends
+    // 1 cm into the plate, past its far side.
+    let task = GraspTask { speed: 10.0, ..GraspTask::from_above("plate") };
+    let s = script(&scene, &task);
+    let mut deepest = 0.0f32;
+    run(&scene, &s, |m, t, _| {
+        if t > s.times.closed {
+            return;
+        }
+        let centre = m.poses()[scene.objects.iter().position(|o| o.name == "plate").unwrap()].1;
+        let skin = m.rendered_mut().skin(Method::Dqb);
+        for p in skin.positions() {
+            let p = Vec3::from(*p);
+            if (p.x - centre.x).abs() < size.x / 2.0 && (p.z - centre.z).abs() < size.z / 2.0 {
+                // Below the plate's top over its footprint: inside it or through it.
+                deepest = deepest.max(centre.y + size.y / 2.0 - p.y);
+            }
+        }
+    });
+    assert!(deepest < 0.002, "the rendered skin went {deepest} m below the plate's top");
+}
+
+#[test]
+fn a_dropped_ball_bounces_and_rests_on_the_table_a_thrown_one_flies() {
+    let scene = Scene::from_json(
+        r#"{"table": {"height": 0.7}, "objects": [{"name": "ball", "shape": "sphere", "radius": 0.05, "position": [0, 0.9, 0], "mass": 0.2, "restitution": 0.6}]}"#,
+        "drop.json",
+        Path::new("."),
+    )
+    .unwrap();
     let objects = ObjectColliders::new(&scene).unwrap();
-    let task = GraspTask { object: "ball".into(), approach: -Vec3::Y, fingers: -Vec3::Z, speed: 0.5, lift: 0.12, carry: Vec3::new(0.0, 0.0, 0.3), pinch: false };
-    let script = grasp_script::grasp(model.clone(), "grasp.json", &objects, &task, Side::Right).unwrap();
-    let mut manip = ManipulationLoop::new(model, JointModel::Full, None, InputConfig::default(), None, &scene, GraspParams::default()).unwrap();
-    for (i, r) in script.records.iter().enumerate() {
-        manip.push(r, None).unwrap();
-        let e = manip.step(r.time);
-        if e.is_some() || i % 15 == 0 {
-            let c = manip.constraint().closure();
-            let contacts: Vec<String> = manip.contacts().iter().map(|c| format!("{:?}:{:.2?}", c.part, c.normal)).collect();
-            println!("t={:.2} held={:?} ev={e:?} ball={:.3?} wristback={} closure={:?} contacts={contacts:?}", r.time, manip.held(), manip.poses()[0].1, manip.constraint().wrist_held_back(), c.iter().map(|c| (c.tracked.to_degrees() as i32, c.rendered.to_degrees() as i32)).collect::<Vec<_>>());
+    let mut physics = ScenePhysics::new(&scene, &objects);
+    let (mut lowest, mut bounced, mut falling) = (f32::INFINITY, 0.0f32, true);
+    for _ in 0..240 {
+        physics.step(1.0 / 60.0);
+        let y = physics.pose(0).1.y;
+        let vy = physics.velocity(0).0.y;
+        lowest = lowest.min(y);
+        if falling && vy > 0.0 {
+            falling = false;
+        }
+        if !falling {
+            bounced = bounced.max(y);
         }
     }
-    println!("{:?}", script.times);
+    let rest = physics.pose(0).1.y;
+    assert!((rest - 0.75).abs() < 0.003, "rests with its bottom on the table top: centre at {rest}");
+    assert!(lowest > 0.74, "never sinks into the table: {lowest}");
+    assert!(bounced > 0.76, "restitution 0.6 bounces it: up to {bounced}");
+    // Held 20 cm above the table and thrown sideways at 2 m/s.
+    physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.95, 0.0));
+    physics.step(1.0 / 60.0);
+    physics.release(0, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO);
+    physics.step(1.0 / 60.0);
+    let (p, v) = (physics.pose(0).1, physics.velocity(0).0);
+    assert!((v.x - 2.0).abs() < 0.05 && p.x > 0.02, "keeps the hand's velocity: {v} at {p}");
 }

@@ -3,11 +3,13 @@
 //!
 //! Two stages per frame, both continuous (a time of impact along the motion, never a test at
 //! the end of it only, so nothing fast or thin is passed through):
-//! 1. **Wrist.** The palm's proxies move rigidly from the last rendered wrist to the tracked
-//!    one (a screw: rotation about the wrist, translation of it); parry's nonlinear shape cast
-//!    gives the first time of impact with any object, and the wrist stops there, on the
-//!    surface. After [`SNAP_AFTER_S`] held back, the wrist jumps to a tracked pose that is
-//!    free again (the user has gone round the object, or tracking came back elsewhere).
+//! 1. **Wrist.** The hand's proxies, its fingers as last rendered, move rigidly from the last
+//!    rendered wrist to the tracked one (a screw: rotation about the wrist, translation of
+//!    it); parry's nonlinear shape cast gives the first time of impact with any object, and
+//!    the wrist stops there, the palm (or a finger) on the surface. The held object moves
+//!    with the hand and does not stop it. After [`SNAP_AFTER_S`] held back, the wrist jumps to
+//!    a tracked pose whose hand is free again (the user has gone round the object, or
+//!    tracking came back elsewhere).
 //! 2. **Fingers.** Each finger closes along its flexion, from open to the tracked angles, by
 //!    conservative advancement: the distance of its proxies to the objects over an upper bound
 //!    of how fast any of their points moves per unit of the closure gives a step that cannot
@@ -232,10 +234,12 @@ impl ContactConstraint {
         let angvel = (r1 * r0.inverse()).to_scaled_axis();
         let linvel = t1 - t0;
         let start_affine = Affine3A::from_rotation_translation(r0, t0);
-        let to_wrist = self.tracked_world[rig.wrist()].inverse();
+        // The whole hand moves rigidly, its fingers as last rendered: a finger or the thenar
+        // must not be carried into an object by the wrist either.
+        let to_wrist = self.world[rig.wrist()].inverse();
         let mut toi: f32 = 1.0;
-        for p in self.proxies.colliders().iter().filter(|p| p.part == HandPart::Palm) {
-            let offset = to_wrist * self.tracked_world[p.joint];
+        for p in self.proxies.colliders() {
+            let offset = to_wrist * self.world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
             // The arc a turning point sweeps bulges out of the two end boxes by at most
@@ -255,18 +259,18 @@ impl ContactConstraint {
             return target;
         }
         let since = *self.held_back_since.get_or_insert(now);
-        if now - since > SNAP_AFTER_S && self.palm_free(rig, target, objects, held) {
+        if now - since > SNAP_AFTER_S && self.hand_free(rig, target, objects, held) {
             self.held_back_since = None;
             return target;
         }
         DualQuat::from_rotation_translation(r0.slerp(r1, toi).normalize(), t0.lerp(t1, toi))
     }
 
-    /// Whether the palm is clear of every object at wrist pose `wrist`.
-    fn palm_free(&self, rig: &HandRig, wrist: DualQuat, objects: &ObjectColliders, held: Option<usize>) -> bool {
+    /// Whether the tracked hand is clear of every object with its wrist at `wrist`.
+    fn hand_free(&self, rig: &HandRig, wrist: DualQuat, objects: &ObjectColliders, held: Option<usize>) -> bool {
         let (r, t) = wrist.to_rotation_translation();
         let at = Affine3A::from_rotation_translation(r, t) * self.tracked_world[rig.wrist()].inverse();
-        self.proxies.colliders().iter().filter(|p| p.part == HandPart::Palm).all(|p| {
+        self.proxies.colliders().iter().all(|p| {
             let pose = pose_of(&(at * self.tracked_world[p.joint]));
             let aabb = p.shape.compute_aabb(&pose);
             objects.near(&aabb, 0.0, held).all(|(_, o)| !query::intersection_test(&pose, &*p.shape, &o.pose, &*o.surface).is_ok_and(|x| x.intersecting))

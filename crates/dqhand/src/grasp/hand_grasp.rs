@@ -245,3 +245,93 @@ impl Held {
         self.filled = (self.filled + 1).min(HISTORY);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WRIST: usize = 0;
+
+    fn contact(part: HandPart, joint: usize, normal: Vec3) -> Contact {
+        Contact { joint, part, object: 0, point: -normal * 0.04, normal, distance: 0.0 }
+    }
+
+    /// The thumb on one side of a ball at the origin, the index on the other.
+    fn pinch() -> [Contact; 2] {
+        [contact(HandPart::Finger(0), 1, Vec3::X), contact(HandPart::Finger(1), 2, -Vec3::X)]
+    }
+
+    /// Thumb and index each `tracked_deg` closed, stopped at 30°.
+    fn closure(tracked_deg: f32) -> [Closure; 5] {
+        let c = Closure { tracked: tracked_deg.to_radians(), rendered: 30f32.to_radians() };
+        [c, c, Closure::default(), Closure::default(), Closure::default()]
+    }
+
+    fn world(shift: Vec3) -> Vec<Affine3A> {
+        vec![Affine3A::from_translation(shift); 3]
+    }
+
+    const BALL: [(Quat, Vec3); 1] = [(Quat::IDENTITY, Vec3::ZERO)];
+
+    fn grasped(g: &mut Grasp, t: f64) -> Option<GraspEvent> {
+        g.detect(t, true, &pinch(), &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL)
+    }
+
+    #[test]
+    fn opposing_pressing_contacts_grasp() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        assert_eq!(grasped(&mut g, 0.0), Some(GraspEvent::Grasp { object: 0 }));
+        assert_eq!(g.held(), Some(0));
+    }
+
+    #[test]
+    fn no_grasp_without_opposition_pressure_or_tracking() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        let same_side = [contact(HandPart::Finger(0), 1, Vec3::X), contact(HandPart::Finger(1), 2, Vec3::X)];
+        assert_eq!(g.detect(0.0, true, &same_side, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL), None);
+        // Touching but not squeezing: tracked 2° past the surface, under the 4° needed.
+        assert_eq!(g.detect(0.0, true, &pinch(), &closure(32.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL), None);
+        assert_eq!(g.detect(0.0, false, &pinch(), &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL), None);
+        let two_fingers = [contact(HandPart::Finger(2), 1, Vec3::X), contact(HandPart::Finger(1), 2, -Vec3::X)];
+        assert_eq!(g.detect(0.0, true, &two_fingers, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL), None, "needs the thumb or the palm");
+    }
+
+    #[test]
+    fn held_object_moves_rigidly_with_the_hand() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        grasped(&mut g, 0.0);
+        let shift = Vec3::new(0.1, 0.2, -0.3);
+        assert_eq!(g.follow(1.0 / 60.0, true, &closure(40.0), &world(shift)), None);
+        let (q, t) = g.target().unwrap();
+        assert!((t - shift).length() < 1e-5 && q.angle_between(Quat::IDENTITY) < 1e-4, "{t} {q}");
+    }
+
+    #[test]
+    fn release_has_hysteresis_velocity_and_cooldown() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        grasped(&mut g, 0.0);
+        // Opening to 25° each: 5° under the 30° closure at the grasp, within the 8° margin.
+        let mut t = 0.0;
+        for k in 1..=3 {
+            t = f64::from(k) / 60.0;
+            assert_eq!(g.follow(t, true, &closure(25.0), &world(Vec3::new(0.01 * k as f32, 0.0, 0.0))), None);
+        }
+        t += 1.0 / 60.0;
+        let Some(GraspEvent::Release { object: 0, linvel, .. }) = g.follow(t, true, &closure(21.0), &world(Vec3::new(0.04, 0.0, 0.0))) else { panic!("opened past the margin") };
+        assert!((linvel - Vec3::new(0.6, 0.0, 0.0)).length() < 1e-3, "the hand moved 1 cm per frame: {linvel}");
+        assert_eq!(grasped(&mut g, t + 0.1), None, "cooling down");
+        assert!(grasped(&mut g, t + 0.31).is_some(), "cooled down");
+    }
+
+    #[test]
+    fn a_short_tracking_loss_keeps_the_object() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        grasped(&mut g, 0.0);
+        assert_eq!(g.follow(0.1, false, &closure(0.0), &world(Vec3::ONE)), None);
+        assert_eq!(g.follow(0.55, false, &closure(0.0), &world(Vec3::ONE)), None, "0.45 s lost: within the grace time");
+        assert_eq!(g.target().unwrap().1, Vec3::ZERO, "stays where it was while lost");
+        assert_eq!(g.follow(0.6, true, &closure(40.0), &world(Vec3::ZERO)), None, "tracking back");
+        assert_eq!(g.follow(0.7, false, &closure(40.0), &world(Vec3::ZERO)), None);
+        assert!(matches!(g.follow(1.21, false, &closure(40.0), &world(Vec3::ZERO)), Some(GraspEvent::Release { linvel: Vec3::ZERO, .. })), "0.51 s lost: dropped");
+    }
+}

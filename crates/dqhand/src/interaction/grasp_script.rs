@@ -49,7 +49,7 @@ pub struct GraspTask {
 }
 
 /// When each stage of a scripted grasp happens, s.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GraspTimes {
     /// The palm reaches the object.
     pub reached: f64,
@@ -205,4 +205,40 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         script.truth.push(pose);
     }
     Ok(script)
+}
+
+impl GraspTask {
+    /// The default grasp of `object`: from above at 0.5 m/s, fingers pointing away from the
+    /// user (−Z), lifted 12 cm, carried 20 cm toward the user (+Z) and set down.
+    #[must_use]
+    pub fn from_above(object: &str) -> Self {
+        Self { object: object.to_owned(), approach: -Vec3::Y, fingers: -Vec3::Z, speed: 0.5, lift: 0.12, carry: Vec3::new(0.0, 0.0, 0.2), pinch: false }
+    }
+}
+
+/// Seconds without records between two tasks of [`sequence`]: tracking is lost, so the hand
+/// reappears at the next start instead of sweeping through the scene.
+pub const TASK_GAP_S: f64 = 0.5;
+
+/// The tasks one after another on one clock, each starting [`TASK_GAP_S`] after the last
+/// ends; returns the scripts with their times shifted.
+///
+/// # Errors
+/// As [`grasp`].
+pub fn sequence(model: &Arc<Model>, file: &str, objects: &ObjectColliders, tasks: &[GraspTask], side: Side) -> Result<Vec<Script>> {
+    let mut offset = 0.0;
+    let mut scripts = Vec::with_capacity(tasks.len());
+    for task in tasks {
+        let mut s = grasp(model.clone(), file, objects, task, side)?;
+        for r in &mut s.records {
+            r.time += offset;
+        }
+        let t = &mut s.times;
+        for x in [&mut t.reached, &mut t.closed, &mut t.carry_start, &mut t.carry_end, &mut t.release, &mut t.end] {
+            *x += offset;
+        }
+        offset = t.end + TASK_GAP_S;
+        scripts.push(s);
+    }
+    Ok(scripts)
 }

@@ -174,6 +174,22 @@ struct ActionJson {
 const SHAPES: [(&str, &[&str]); 4] = [("sphere", &["radius"]), ("box", &["size"]), ("cylinder", &["radius", "height"]), ("mesh", &["file", "scale"])];
 
 impl Scene {
+    /// The scenes that ship with the crate (`data/scenes/`): `grasp` (the paper's Figure 9: a
+    /// ball and the Utah teapot on a table) and `objects` (every kind of object).
+    pub const BUILTIN: [&'static str; 2] = ["grasp", "objects"];
+
+    /// A built-in scene by name ([`Self::BUILTIN`]), else the scene file at that path.
+    ///
+    /// # Errors
+    /// As [`Self::load`].
+    pub fn named(name: &str) -> Result<Self> {
+        if Self::BUILTIN.contains(&name) {
+            Self::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes").join(format!("{name}.json")))
+        } else {
+            Self::load(Path::new(name))
+        }
+    }
+
     /// Reads a scene file.
     ///
     /// # Errors

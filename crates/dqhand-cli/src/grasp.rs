@@ -1,0 +1,138 @@
+//! `dqhand grasp`: a recording through the manipulation loop as fast as it goes, one JSON
+//! line per frame (a fixed rate on the records' clock), and with `--meshes` the rendered
+//! hand (DQB, contact-constrained, world coordinates) every Nth frame as PLY.
+//!
+//! A trace line:
+//! `{"t": s, "tracking": "ok"|"lost", "held": name|null, "contacts": [{"bone", "object",
+//! "p": [x,y,z], "n": [x,y,z]}], "objects": {"<name>": {"p": [x,y,z], "q": [x,y,z,w]}}}`.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use anyhow::Context;
+use dqhand::engine::ModelSource;
+use dqhand::grasp::GraspParams;
+use dqhand::input::{Record, Tracking};
+use dqhand::interaction::ManipulationLoop;
+use dqhand::kinematics::JointModel;
+use dqhand::scene::Scene;
+use dqhand::skin::Method;
+use serde_json::{json, Map, Value};
+
+use crate::recording::{Format, GestureArgs, InputArgs, RecordingReader};
+
+/// Arguments of `dqhand grasp`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The scene: a built-in one (`grasp`, `objects`) or a scene JSON file.
+    #[arg(long)]
+    scene: String,
+    /// The recording (glove CSV, or joints/landmarks JSON lines).
+    #[arg(long)]
+    input: PathBuf,
+    /// Its format (default: `.csv` is glove, anything else JSON lines).
+    #[arg(long)]
+    format: Option<Format>,
+    #[command(flatten)]
+    common: InputArgs,
+    #[command(flatten)]
+    recognition: GestureArgs,
+    /// Write one JSON line per frame here.
+    #[arg(long)]
+    trace: PathBuf,
+    /// Write the rendered hand every `--every` frames into this directory (`<frame>.ply`).
+    #[arg(long)]
+    meshes: Option<PathBuf>,
+    /// Frames between meshes written.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+    /// Frames per second of the loop, on the records' clock.
+    #[arg(long, default_value_t = 60.0)]
+    rate: f64,
+    /// The hand: `builtin` or a skinned glTF with WebXR joint names.
+    #[arg(long, default_value = "builtin")]
+    model: ModelSource,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    anyhow::ensure!(args.rate.is_finite() && args.rate >= 1.0, "--rate {}: frames per second must be at least 1", args.rate);
+    let scene = Scene::named(&args.scene)?;
+    let model = Arc::new(args.model.load()?);
+    let joint_model = JointModel::Full;
+    let mapper = Some(args.common.mapper(joint_model)?);
+    let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
+    let mut manip = ManipulationLoop::new(model, joint_model, mapper, args.common.config()?, args.recognition.set()?, &scene, GraspParams::default())?;
+    for w in manip.objects().warnings() {
+        eprintln!("dqhand: warning: {}: {w}", args.scene);
+    }
+    if let Some(dir) = &args.meshes {
+        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    }
+    let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
+    let names: Vec<String> = manip.rendered().skeleton().names().map(str::to_owned).collect();
+    let mut record = Record { time: 0.0, side: args.common.hand, hand: None, tracker: None };
+    let mut pending: Option<Record> = None;
+    let (mut frame, mut refused) = (0u64, 0u64);
+    let mut clock: Option<f64> = None;
+    let period = 1.0 / args.rate;
+    loop {
+        // Every record up to this frame's time goes in before the frame.
+        let next = match pending.take() {
+            Some(r) => Some(r),
+            None => match reader.next(&mut record).with_context(|| args.input.display().to_string())? {
+                None => None,
+                Some(Err(rejection)) => {
+                    refused += 1;
+                    manip.reject(rejection);
+                    continue;
+                }
+                Some(Ok(())) => Some(record),
+            },
+        };
+        let now = *clock.get_or_insert_with(|| next.map_or(0.0, |r| r.time));
+        match next {
+            Some(r) if r.time <= now => {
+                if manip.push(&r, None).is_err() {
+                    refused += 1;
+                }
+                continue;
+            }
+            Some(r) => pending = Some(r),
+            None => {}
+        }
+        manip.step(now);
+        write_frame(&mut trace, now, &manip, &names)?;
+        if let Some(dir) = &args.meshes {
+            if frame % args.every == 0 {
+                let path = dir.join(format!("{frame}.ply"));
+                let mesh = manip.rendered_mut().skin(Method::Dqb);
+                let (positions, normals) = (mesh.positions().to_vec(), mesh.normals().to_vec());
+                let indices = manip.rendered().model().mesh.indices().to_vec();
+                dqhand::io::write_ply(&path, &positions, &normals, &indices)?;
+            }
+        }
+        frame += 1;
+        if pending.is_none() {
+            break;
+        }
+        clock = Some(now + period);
+    }
+    trace.flush().with_context(|| args.trace.display().to_string())?;
+    eprintln!("dqhand grasp: {frame} frames, {refused} records refused");
+    Ok(())
+}
+
+fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &[String]) -> anyhow::Result<()> {
+    let names = manip.names();
+    let contacts: Vec<Value> = manip
+        .contacts()
+        .iter()
+        .map(|c| json!({"bone": joints[c.joint], "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array()}))
+        .collect();
+    let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({"p": p.to_array(), "q": q.to_array()}))).collect();
+    let tracking = if manip.tracking() == Tracking::Tracking { "ok" } else { "lost" };
+    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": manip.held(), "contacts": contacts, "objects": objects}))?;
+    out.write_all(b"\n")?;
+    Ok(())
+}
