@@ -35,12 +35,6 @@ impl ObjectCollider {
     pub fn aabb(&self) -> &Aabb {
         &self.aabb
     }
-
-    /// The object's world pose as glam types.
-    #[must_use]
-    pub fn rotation_translation(&self) -> (Quat, Vec3) {
-        (self.pose.rotation, self.pose.translation)
-    }
 }
 
 /// Every object of a scene, in file order.

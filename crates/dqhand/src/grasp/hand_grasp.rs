@@ -93,12 +93,6 @@ impl Grasp {
         Self { params, held: None, cooldown_until: vec![f64::NEG_INFINITY; objects] }
     }
 
-    /// The thresholds.
-    #[must_use]
-    pub fn params(&self) -> &GraspParams {
-        &self.params
-    }
-
     /// The object held, if any.
     #[must_use]
     pub fn held(&self) -> Option<usize> {
