@@ -5,16 +5,21 @@
 //! the end of it only, so nothing fast or thin is passed through):
 //! 1. **Wrist.** The hand's proxies, its fingers as last rendered, move rigidly from the last
 //!    rendered wrist to the tracked one (a screw: rotation about the wrist, translation of
-//!    it); parry's nonlinear shape cast gives the first time of impact with any object, and
-//!    the wrist stops there, the palm (or a finger) on the surface. The held object moves
-//!    with the hand and does not stop it. After [`SNAP_AFTER_S`] held back, the wrist jumps to
-//!    a tracked pose whose hand is free again (the user has gone round the object, or
-//!    tracking came back elsewhere).
+//!    it); parry's nonlinear shape cast gives the first time of impact with any object or
+//!    the table, and the wrist stops just before it (a gap of [`STOP_DISTANCE`], so that the
+//!    next frame's cast starts clear of the surface: a cast that starts touching may let the
+//!    hand sink), the palm (or a finger) on the surface. After [`SNAP_AFTER_S`] held back,
+//!    the wrist jumps to a tracked pose whose hand is free again (the user has gone round the
+//!    object, or tracking came back elsewhere). While an object is held the rendered hand
+//!    keeps its grip: it moves with the object, where it was on it at the grasp, so the
+//!    tracked hand closing further (it goes into the object) does not pull the rendered one in.
 //! 2. **Fingers.** Each finger closes along its flexion, from open to the tracked angles, by
 //!    conservative advancement: the distance of its proxies to the objects over an upper bound
 //!    of how fast any of their points moves per unit of the closure gives a step that cannot
 //!    pass through anything. At the first contact the joints proximal to the touching phalanx
-//!    stop and the distal ones close on, so the finger wraps the object.
+//!    stop and the distal ones close on, so the finger wraps the object. Where the open
+//!    finger would itself be in an object (a thumb lying on the ball under the palm) the
+//!    closure starts from the finger as last rendered, which the wrist stage kept clear.
 //!
 //! The tracked pose is left as it is: the grasp logic reads it.
 
@@ -30,8 +35,9 @@ use crate::math::DualQuat;
 /// Proxies closer than this to an object touch it (m).
 pub const CONTACT_DISTANCE: f32 = 0.002;
 
-/// A finger stops closing this close to a surface (m): the proxies' margin keeps the skin off.
-const STOP_DISTANCE: f32 = 0.0004;
+/// A finger or the wrist stops this close to a surface (m): the proxies' margin keeps the
+/// skin off.
+pub const STOP_DISTANCE: f32 = 0.0004;
 
 /// Steps of conservative advancement per finger stage: enough to converge from any start; a
 /// finger that has not converged stays where it safely is.
@@ -90,7 +96,12 @@ pub struct ContactConstraint {
     tracked_world: Vec<Affine3A>,
     tracked: Pose,
     rendered: Pose,
+    /// The last frame's rendered pose: where a finger closes from when its open pose is not
+    /// clear.
+    previous: Pose,
     wrist: Option<DualQuat>,
+    /// The object held and the rendered wrist in its frame at the grasp.
+    grip: Option<(usize, DualQuat)>,
     held_back_since: Option<f64>,
     contacts: Vec<Contact>,
     closure: [Closure; 5],
@@ -170,7 +181,9 @@ impl ContactConstraint {
             tracked_world: vec![Affine3A::IDENTITY; n],
             tracked: Pose::rest(rig.dofs().len()),
             rendered: Pose::rest(rig.dofs().len()),
+            previous: Pose::rest(rig.dofs().len()),
             wrist: None,
+            grip: None,
             held_back_since: None,
             closure: [Closure::default(); 5],
             near: Vec::new(),
@@ -182,6 +195,17 @@ impl ContactConstraint {
     pub fn restart(&mut self) {
         self.wrist = None;
         self.held_back_since = None;
+        self.grip = None;
+    }
+
+    /// Object `object` has been grasped: from the next [`Self::solve`] while it is held, the
+    /// rendered wrist keeps where it is now in the object's frame (`pose`, the object's pose at
+    /// the grasp).
+    pub fn grip(&mut self, object: usize, pose: &parry3d::math::Pose) {
+        if let Some(wrist) = self.wrist {
+            let object_pose = DualQuat::from_rotation_translation(pose.rotation, pose.translation);
+            self.grip = Some((object, object_pose.conjugate() * wrist));
+        }
     }
 
     /// Takes the frame's `tracked` pose: its joint transforms ([`Self::tracked_world`]) and
@@ -206,8 +230,19 @@ impl ContactConstraint {
         }
         let tracked = &self.tracked;
         let target = tracked.wrist.unwrap_or_else(|| rig.rest_wrist());
-        let wrist = self.solve_wrist(rig, target, objects, held, now);
+        let wrist = match self.grip {
+            Some((object, offset)) if Some(object) == held => {
+                self.held_back_since = None;
+                let pose = &objects.objects()[object].pose;
+                DualQuat::from_rotation_translation(pose.rotation, pose.translation) * offset
+            }
+            _ => {
+                self.grip = None;
+                self.solve_wrist(rig, target, objects, held, now)
+            }
+        };
         self.wrist = Some(wrist);
+        self.previous.clone_from(&self.rendered);
         self.rendered.clone_from(&self.tracked);
         self.rendered.wrist = Some(wrist);
         for f in 0..FINGERS.len() {
@@ -238,13 +273,18 @@ impl ContactConstraint {
         // must not be carried into an object by the wrist either.
         let to_wrist = self.world[rig.wrist()].inverse();
         let mut toi: f32 = 1.0;
+        // The fastest any proxy point moves, m per unit of the motion: turns the stop gap
+        // into a time.
+        let mut speed: f32 = 0.0;
         for p in self.proxies.colliders() {
             let offset = to_wrist * self.world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
+            let radius = offset.translation.length() + p.extent;
+            speed = speed.max(linvel.length() + angvel.length() * radius);
             // The arc a turning point sweeps bulges out of the two end boxes by at most
             // radius · angle / 2.
-            let bulge = (offset.translation.length() + p.extent) * angvel.length().min(core::f32::consts::PI) / 2.0;
+            let bulge = radius * angvel.length().min(core::f32::consts::PI) / 2.0;
             let swept = p.shape.compute_swept_aabb(&from, &to).loosened(bulge);
             let motion = NonlinearRigidMotion::new(from, offset.inverse().transform_point3(Vec3::ZERO), linvel, angvel);
             for (_, o) in objects.near(&swept, 0.0, held) {
@@ -263,6 +303,7 @@ impl ContactConstraint {
             self.held_back_since = None;
             return target;
         }
+        let toi = (toi - STOP_DISTANCE / speed).max(0.0);
         DualQuat::from_rotation_translation(r0.slerp(r1, toi).normalize(), t0.lerp(t1, toi))
     }
 
@@ -304,6 +345,7 @@ impl ContactConstraint {
                     angles[i] = start[k] + (target[k] - start[k]) * s;
                 }
             };
+            let mut from_open = true;
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward(rig, limits);
@@ -318,7 +360,7 @@ impl ContactConstraint {
                     let pose = pose_of(&self.world[proxy.joint]);
                     let mut d = f32::INFINITY;
                     for &o in &self.near {
-                        let o = &objects.objects()[o];
+                        let o = objects.collider(o);
                         if let Ok(x) = query::distance(&pose, &*proxy.shape, &o.pose, &*o.surface) {
                             d = d.min(x.distance);
                         }
@@ -331,6 +373,14 @@ impl ContactConstraint {
                         step = step.min(d / speed);
                     }
                 }
+                if nearest.0 <= STOP_DISTANCE && std::mem::take(&mut from_open) {
+                    // The open finger is not clear: close from where it was last rendered.
+                    for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                        start[k] = self.previous.angles[i];
+                    }
+                    continue;
+                }
+                from_open = false;
                 if nearest.0 <= STOP_DISTANCE {
                     // Contact: the joints up to the touching phalanx stop here; the rest close on.
                     for k in active..chain.dofs.len() {
@@ -363,7 +413,7 @@ impl ContactConstraint {
         for p in self.proxies.colliders() {
             let pose = pose_of(&self.world[p.joint]);
             let aabb = p.shape.compute_aabb(&pose);
-            for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, None) {
+            for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, None).filter(|(i, _)| *i < objects.objects().len()) {
                 if let Ok(Some(c)) = query::contact(&pose, &*p.shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
                     let normal = (-c.normal1).normalize_or_zero();
                     self.contacts.push(Contact { joint: p.joint, part: p.part, object: i, point: c.point2, normal, distance: c.dist });

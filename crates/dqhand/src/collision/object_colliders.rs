@@ -3,6 +3,9 @@
 //! touches and penetration is measured against; it need not be closed, as the Utah teapot
 //! is not) and a solid for the physics (its convex hull), because a triangle soup has no
 //! volume to give a mass or to rest on a table with.
+//!
+//! The table is a fixed slab under the objects: the hand meets it (a finger does not close
+//! through it) and the physics rests objects on it, but it is not an object to grasp.
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -37,10 +40,31 @@ impl ObjectCollider {
     }
 }
 
-/// Every object of a scene, in file order.
+/// The table's top: a slab reaching [`TABLE_MARGIN`] past the objects' footprint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableTop {
+    /// Height of the top (y), m.
+    pub height: f32,
+    /// Centre of the top (x, z), m.
+    pub centre: [f32; 2],
+    /// Half sizes of the top (x, z), m.
+    pub half: [f32; 2],
+}
+
+/// Half the thickness of the table's slab, m.
+pub const TABLE_HALF_THICKNESS: f32 = 0.025;
+/// How far the table reaches past its objects, m.
+pub const TABLE_MARGIN: f32 = 0.3;
+/// The table's least half sizes (x, z), m.
+const TABLE_MIN_HALF: [f32; 2] = [0.6, 0.4];
+
+/// Every object of a scene, in file order, and the table.
 #[derive(Clone)]
 pub struct ObjectColliders {
-    objects: Vec<ObjectCollider>,
+    /// The objects, then the table's slab when there is one.
+    all: Vec<ObjectCollider>,
+    count: usize,
+    table: Option<TableTop>,
     warnings: Vec<String>,
 }
 
@@ -78,13 +102,33 @@ impl ObjectColliders {
             let aabb = surface.compute_aabb(&pose);
             objects.push(ObjectCollider { name: o.name.clone(), surface, solid, mesh, pose, aabb });
         }
-        Ok(Self { objects, warnings })
+        let count = objects.len();
+        let table = scene.table.map(|t| table_top(t.height, &objects));
+        if let Some(t) = table {
+            let surface = SharedShape::cuboid(t.half[0], TABLE_HALF_THICKNESS, t.half[1]);
+            let pose = Pose::from_translation(Vec3::new(t.centre[0], t.height - TABLE_HALF_THICKNESS, t.centre[1]));
+            let aabb = surface.compute_aabb(&pose);
+            objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb });
+        }
+        Ok(Self { all: objects, count, table, warnings })
     }
 
-    /// The objects, in scene order.
+    /// The objects, in scene order (not the table).
     #[must_use]
     pub fn objects(&self) -> &[ObjectCollider] {
-        &self.objects
+        &self.all[..self.count]
+    }
+
+    /// The table's top, if the scene has a table.
+    #[must_use]
+    pub fn table(&self) -> Option<TableTop> {
+        self.table
+    }
+
+    /// The table's slab as a collider (index [`Self::objects`]`.len()` in [`Self::near`]).
+    #[must_use]
+    pub fn table_collider(&self) -> Option<&ObjectCollider> {
+        self.all.get(self.count)
     }
 
     /// What was accepted with a doubt (a flat mesh, dropped triangles), one line each.
@@ -95,17 +139,45 @@ impl ObjectColliders {
 
     /// Moves object `i` (allocates nothing).
     pub fn set_pose(&mut self, i: usize, rotation: Quat, translation: Vec3) {
-        let o = &mut self.objects[i];
+        let o = &mut self.objects_mut()[i];
         o.pose = Pose::from_parts(translation, rotation);
         o.aabb = o.surface.compute_aabb(&o.pose);
     }
 
-    /// The broad phase: the objects whose bounding box meets `aabb` (grown by `margin`),
-    /// except `skip`.
+    /// Object `i`, or the table where `i` is the objects' count (an index [`Self::near`] gave).
+    #[must_use]
+    pub fn collider(&self, i: usize) -> &ObjectCollider {
+        &self.all[i]
+    }
+
+    fn objects_mut(&mut self) -> &mut [ObjectCollider] {
+        &mut self.all[..self.count]
+    }
+
+    /// The broad phase: the objects, and the table (its index one past the objects'), whose
+    /// bounding box meets `aabb` (grown by `margin`), except `skip`.
     pub fn near(&self, aabb: &Aabb, margin: f32, skip: Option<usize>) -> impl Iterator<Item = (usize, &ObjectCollider)> {
         let aabb = aabb.loosened(margin);
-        self.objects.iter().enumerate().filter(move |(i, o)| Some(*i) != skip && o.aabb.intersects(&aabb))
+        self.all.iter().enumerate().filter(move |(i, o)| Some(*i) != skip && o.aabb.intersects(&aabb))
     }
+}
+
+/// The top of a table at `height` under `objects`: their footprint grown by [`TABLE_MARGIN`],
+/// at least [`TABLE_MIN_HALF`]; centred on the origin when there is no object.
+fn table_top(height: f32, objects: &[ObjectCollider]) -> TableTop {
+    let (mut lo, mut hi) = ([0.0f32; 2], [0.0f32; 2]);
+    if !objects.is_empty() {
+        (lo, hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+        for o in objects {
+            for (k, axis) in [0, 2].into_iter().enumerate() {
+                lo[k] = lo[k].min(o.aabb.mins[axis]);
+                hi[k] = hi[k].max(o.aabb.maxs[axis]);
+            }
+        }
+    }
+    let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
+    let half = [0, 1].map(|k| ((hi[k] - lo[k]) / 2.0 + TABLE_MARGIN).max(TABLE_MIN_HALF[k]));
+    TableTop { height, centre, half }
 }
 
 /// A mesh's surface (triangles as they are: it may be open) and solid (its convex hull; a

@@ -139,8 +139,10 @@ impl ManipulationLoop {
         if event.is_none() {
             event = self.grasp.detect(now, tracking, self.constraint.contacts(), self.constraint.closure(), self.constraint.world(), self.constraint.tracked_world(), rig.wrist(), &self.poses);
         }
-        if let Some(GraspEvent::Release { object, linvel, angvel }) = event {
-            self.physics.release(object, linvel, angvel);
+        match event {
+            Some(GraspEvent::Grasp { object }) => self.constraint.grip(object, &self.objects.objects()[object].pose),
+            Some(GraspEvent::Release { object, linvel, angvel }) => self.physics.release(object, linvel, angvel),
+            None => {}
         }
         if let Some((q, t)) = self.grasp.target() {
             self.physics.hold(self.grasp.held().expect("a target is a held object's"), q, t);

@@ -11,12 +11,6 @@ use crate::scene::Scene;
 /// Gravity, m/s² along −Y.
 pub const GRAVITY: f32 = 9.81;
 
-/// Half the thickness of the table's slab, m.
-const TABLE_HALF_THICKNESS: f32 = 0.025;
-/// How far the table reaches past its objects, m, and its least half size.
-const TABLE_MARGIN: f32 = 0.3;
-const TABLE_MIN_HALF: [f32; 2] = [0.6, 0.4];
-
 /// The scene's free objects and table, simulated.
 pub struct ScenePhysics {
     world: PhysicsWorld,
@@ -45,27 +39,10 @@ impl ScenePhysics {
             bodies.push(handle);
             initial.push(pose);
         }
-        let table = scene.table.map(|t| {
-            let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
-            for c in colliders.objects() {
-                let aabb = c.aabb();
-                for (k, axis) in [0, 2].into_iter().enumerate() {
-                    lo[k] = lo[k].min(aabb.mins[axis]);
-                    hi[k] = hi[k].max(aabb.maxs[axis]);
-                }
-            }
-            if colliders.objects().is_empty() {
-                (lo, hi) = ([0.0; 2], [0.0; 2]);
-            }
-            let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
-            let half = [((hi[0] - lo[0]) / 2.0 + TABLE_MARGIN).max(TABLE_MIN_HALF[0]), ((hi[1] - lo[1]) / 2.0 + TABLE_MARGIN).max(TABLE_MIN_HALF[1])];
-            let slab = ColliderBuilder::cuboid(half[0], TABLE_HALF_THICKNESS, half[1])
-                .translation(Vec3::new(centre[0], t.height - TABLE_HALF_THICKNESS, centre[1]))
-                .friction(0.8)
-                .restitution(0.3)
-                .build();
-            world.insert_collider(slab, None);
-            (t.height, centre, half)
+        let table = colliders.table().map(|t| {
+            let slab = colliders.table_collider().expect("a table top has its slab");
+            world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(0.8).restitution(0.3).build(), None);
+            (t.height, t.centre, t.half)
         });
         Self { world, bodies, initial, held: None, table }
     }
