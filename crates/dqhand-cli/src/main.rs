@@ -10,6 +10,7 @@ mod demo;
 mod feed;
 mod gesture_bench;
 mod grasp;
+mod grasp_bench;
 mod hand;
 mod info;
 mod listen;
@@ -64,6 +65,9 @@ enum Command {
     /// Play a recording through the manipulation loop (contacts, grasps, physics) in a scene
     /// as fast as it goes; one JSON line per frame, and the rendered hand as PLY if asked.
     Grasp(grasp::Args),
+    /// Score the manipulation loop on scripted grasps of every object (success, skin penetration,
+    /// slip, release latency, tunnelling, time per frame) against the targets.
+    GraspBench(grasp_bench::Args),
 }
 
 fn main() {
@@ -77,6 +81,7 @@ fn main() {
         Command::Metrics(a) => metrics::run(&a),
         Command::Replay(a) => replay::run(&a),
         Command::Grasp(a) => grasp::run(&a),
+        Command::GraspBench(a) => grasp_bench::run(&a),
         Command::Listen(a) => listen::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Synthesize(a) => synthesize::run(&a),

@@ -289,6 +289,12 @@ impl ContactConstraint {
             let motion = NonlinearRigidMotion::new(from, offset.inverse().transform_point3(Vec3::ZERO), linvel, angvel);
             for (_, o) in objects.near(&swept, 0.0, held) {
                 let still = NonlinearRigidMotion::constant_position(o.pose);
+                // Nothing that misses the hull can hit the surface inside it (a proxy that
+                // starts inside the hull counts as a hit: the surface decides).
+                let misses_hull = o.hull().is_some_and(|h| matches!(query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &**h, 0.0, toi, true), Ok(None)));
+                if misses_hull {
+                    continue;
+                }
                 if let Ok(Some(hit)) = query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false) {
                     toi = toi.min(hit.time_of_impact);
                 }
@@ -361,9 +367,7 @@ impl ContactConstraint {
                     let mut d = f32::INFINITY;
                     for &o in &self.near {
                         let o = objects.collider(o);
-                        if let Ok(x) = query::distance(&pose, &*proxy.shape, &o.pose, &*o.surface) {
-                            d = d.min(x.distance);
-                        }
+                        d = d.min(o.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE));
                     }
                     if d < nearest.0 {
                         nearest = (d, *last);
@@ -414,6 +418,9 @@ impl ContactConstraint {
             let pose = pose_of(&self.world[p.joint]);
             let aabb = p.shape.compute_aabb(&pose);
             for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, None).filter(|(i, _)| *i < objects.objects().len()) {
+                if o.distance_at_least(&pose, &*p.shape, CONTACT_DISTANCE) > CONTACT_DISTANCE {
+                    continue;
+                }
                 if let Ok(Some(c)) = query::contact(&pose, &*p.shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
                     let normal = (-c.normal1).normalize_or_zero();
                     self.contacts.push(Contact { joint: p.joint, part: p.part, object: i, point: c.point2, normal, distance: c.dist });

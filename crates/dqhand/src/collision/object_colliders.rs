@@ -10,7 +10,8 @@
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::shape::{SharedShape, TriMeshFlags};
+use parry3d::query;
+use parry3d::shape::{Shape, SharedShape, TriMeshFlags};
 
 use crate::scene::{ObjectMesh, ObjectShape, Scene};
 use crate::{Error, Result};
@@ -37,6 +38,28 @@ impl ObjectCollider {
     #[must_use]
     pub fn aabb(&self) -> &Aabb {
         &self.aabb
+    }
+
+    /// A convex shape that holds the surface and is much cheaper to query (a mesh's hull), where
+    /// the surface is not convex itself: nothing outside it can touch the surface, so a query
+    /// that stays outside it need not look at the triangles.
+    #[must_use]
+    pub fn hull(&self) -> Option<&SharedShape> {
+        self.mesh.as_ref().map(|_| &self.solid)
+    }
+
+    /// The distance from `shape` at `pose` to the surface, or a lower bound of it above
+    /// `enough` (m): the distance to the [`Self::hull`] when that is larger.
+    #[must_use]
+    pub fn distance_at_least(&self, pose: &Pose, shape: &dyn Shape, enough: f32) -> f32 {
+        if let Some(hull) = self.hull() {
+            if let Ok(d) = query::distance(pose, shape, &self.pose, &**hull).map(|x| x.distance) {
+                if d > enough {
+                    return d;
+                }
+            }
+        }
+        query::distance(pose, shape, &self.pose, &*self.surface).map_or(f32::INFINITY, |x| x.distance)
     }
 }
 

@@ -1,0 +1,230 @@
+//! `dqhand grasp-bench`: the manipulation loop against the targets on scripted
+//! approach–grasp–lift–carry–release sequences (`dqhand::interaction::grasp_script`, made
+//! from our own kinematics, so a run repeats): every object of the built-in `objects` scene,
+//! alone on the table, approached from several directions at several speeds up to 10 m/s
+//! (the marble by a pinch; the thin plate struck flat, for tunnelling only). Each run is
+//! scored by `dqhand::interaction::benchmark::score`, which the tests use too.
+
+use std::sync::Arc;
+
+use dqhand::collision::ObjectColliders;
+use dqhand::engine::ModelSource;
+use dqhand::grasp::GraspParams;
+use dqhand::hand::{HandParams, Side};
+use dqhand::input::InputConfig;
+use dqhand::interaction::benchmark::{score, Distribution, RunScore};
+use dqhand::interaction::grasp_script::{self, GraspTask};
+use dqhand::interaction::ManipulationLoop;
+use dqhand::kinematics::JointModel;
+use dqhand::model::Model;
+use dqhand::scene::Scene;
+use glam::Vec3;
+use serde_json::{json, Value};
+
+/// Share of scripted grasps to succeed.
+const SUCCESS_TARGET: f64 = 0.98;
+/// Deepest the rendered skin may go into an object, m.
+const PENETRATION_TARGET_M: f32 = 0.001;
+/// Farthest a carried object may slip in the hand over the carry, m.
+const SLIP_TARGET_M: f32 = 0.003;
+/// Longest median time of a frame's collision, grasp and physics against the teapot, µs.
+const STEP_TARGET_US: f64 = 250.0;
+
+/// Where each object is put, alone on the table, and how far it is carried (a 0.5 m carry
+/// stays on the table).
+const PLACE_XZ: [f32; 2] = [-0.25, -0.3];
+const CARRY: Vec3 = Vec3::new(0.5, 0.0, 0.0);
+const LIFT_M: f32 = 0.12;
+
+/// A direction the hand comes from: where the palm moves (and faces) and the fingers point.
+struct Approach {
+    name: &'static str,
+    palm: Vec3,
+    fingers: Vec3,
+}
+
+const APPROACHES: [Approach; 3] = [
+    Approach { name: "above", palm: Vec3::NEG_Y, fingers: Vec3::NEG_Z },
+    Approach { name: "side", palm: Vec3::X, fingers: Vec3::NEG_Z },
+    Approach { name: "front", palm: Vec3::NEG_Z, fingers: Vec3::NEG_X },
+];
+
+/// How each object of the `objects` scene is taken.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// A whole-hand grasp from every approach.
+    Grasp,
+    /// A pinch of thumb and index from above.
+    Pinch,
+    /// Struck flat from above: tunnelling and penetration, not a grasp.
+    Strike,
+}
+
+fn kind(object: &str) -> Kind {
+    match object {
+        "marble" => Kind::Pinch,
+        "plate" => Kind::Strike,
+        _ => Kind::Grasp,
+    }
+}
+
+/// Arguments of `dqhand grasp-bench`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Only these objects of the `objects` scene (comma-separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    objects: Vec<String>,
+    /// Approach speeds, m/s (comma-separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.5, 2.0, 10.0])]
+    speeds: Vec<f32>,
+    /// Only these approaches: above, side, front (comma-separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    approaches: Vec<String>,
+}
+
+/// One run: what was done and what it measured.
+struct Run {
+    object: String,
+    kind: Kind,
+    approach: &'static str,
+    speed: f32,
+    score: RunScore,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    for &s in &args.speeds {
+        anyhow::ensure!(s.is_finite() && (0.05..=20.0).contains(&s), "--speeds {s}: an approach speed from 0.05 to 20 m/s");
+    }
+    for a in &args.approaches {
+        anyhow::ensure!(APPROACHES.iter().any(|x| x.name == a), "--approaches {a}: not one of above, side, front");
+    }
+    let all = Scene::named("objects")?;
+    for o in &args.objects {
+        anyhow::ensure!(all.object(o).is_some(), "--objects {o}: the objects scene has no such object");
+    }
+    let model = Arc::new(ModelSource::Builtin(HandParams::default()).load()?);
+    let mut runs = Vec::new();
+    for object in all.objects.iter().filter(|o| args.objects.is_empty() || args.objects.contains(&o.name)) {
+        let kind = kind(&object.name);
+        let mut scene = Scene { table: all.table, objects: vec![object.clone()], actions: Vec::new() };
+        scene.objects[0].position = Vec3::new(PLACE_XZ[0], object.position.y, PLACE_XZ[1]);
+        for approach in APPROACHES.iter().filter(|a| (kind == Kind::Grasp || a.name == "above") && (args.approaches.is_empty() || args.approaches.iter().any(|n| n == a.name))) {
+            for &speed in &args.speeds {
+                let task = GraspTask { object: object.name.clone(), approach: approach.palm, fingers: approach.fingers, speed, lift: LIFT_M, carry: CARRY, pinch: kind == Kind::Pinch };
+                let score = measure(&model, &scene, &task)?;
+                runs.push(Run { object: object.name.clone(), kind, approach: approach.name, speed, score });
+            }
+        }
+    }
+    let report = report(&runs);
+    if args.json {
+        println!("{report}");
+    } else {
+        print_tables(&report);
+    }
+    Ok(())
+}
+
+fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask) -> anyhow::Result<RunScore> {
+    let objects = ObjectColliders::new(scene)?;
+    let script = grasp_script::grasp(model.clone(), "objects", &objects, task, Side::Right)?;
+    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, InputConfig::default(), None, scene, GraspParams::default())?;
+    Ok(score(&mut manip, &script, 0, scene.objects[0].position + task.carry))
+}
+
+fn mm(m: f32) -> f64 {
+    (f64::from(m) * 1000.0 * 100.0).round() / 100.0
+}
+
+fn us(d: Option<Distribution>) -> Value {
+    d.map_or(Value::Null, |d| json!({"median": d.median * 1e6, "p95": d.p95 * 1e6, "max": d.max * 1e6, "frames": d.count}))
+}
+
+fn report(runs: &[Run]) -> Value {
+    let grasps: Vec<&Run> = runs.iter().filter(|r| r.kind != Kind::Strike).collect();
+    let successes = grasps.iter().filter(|r| r.score.success).count();
+    let rate = if grasps.is_empty() { 0.0 } else { successes as f64 / grasps.len() as f64 };
+    let max_penetration = runs.iter().map(|r| r.score.max_penetration_m).fold(0.0, f32::max);
+    let mean_penetration = runs.iter().map(|r| r.score.mean_penetration_m).sum::<f32>() / runs.len().max(1) as f32;
+    let slip = grasps.iter().map(|r| r.score.slip_m).fold(0.0, f32::max);
+    let mut latency: Vec<f64> = grasps.iter().filter_map(|r| r.score.release_frames).map(f64::from).collect();
+    let tunnelled = runs.iter().filter(|r| r.score.tunnelled).count();
+    let mut all_steps: Vec<f64> = runs.iter().flat_map(|r| r.score.step_s.iter().copied()).collect();
+    let mut teapot_steps: Vec<f64> = runs.iter().filter(|r| r.object == "teapot").flat_map(|r| r.score.step_s.iter().copied()).collect();
+    let teapot = Distribution::of(&mut teapot_steps);
+    let lines: Vec<Value> = runs
+        .iter()
+        .map(|r| {
+            let steps = Distribution::of(&mut r.score.step_s.clone());
+            json!({
+                "object": r.object, "kind": match r.kind { Kind::Grasp => "grasp", Kind::Pinch => "pinch", Kind::Strike => "strike" },
+                "approach": r.approach, "speed_m_s": r.speed, "success": r.score.success, "place_error_mm": mm(r.score.place_error_m),
+                "max_penetration_mm": mm(r.score.max_penetration_m), "mean_penetration_mm": mm(r.score.mean_penetration_m),
+                "slip_mm": mm(r.score.slip_m), "release_frames": r.score.release_frames, "tunnelled": r.score.tunnelled, "step_us": us(steps),
+            })
+        })
+        .collect();
+    json!({
+        "synthetic": "scripted approach-grasp-lift-carry-release sequences from dqhand's own kinematics (dqhand::interaction::grasp_script); not captured from a person",
+        "build": if cfg!(debug_assertions) { "debug" } else { "release" },
+        "grasps": grasps.len(), "successes": successes, "success_rate": rate, "success_pass": !grasps.is_empty() && rate >= SUCCESS_TARGET,
+        "max_penetration_mm": mm(max_penetration), "mean_penetration_mm": mm(mean_penetration), "penetration_pass": max_penetration <= PENETRATION_TARGET_M,
+        "max_slip_mm": mm(slip), "slip_pass": !grasps.is_empty() && slip <= SLIP_TARGET_M,
+        "release_frames": Distribution::of(&mut latency),
+        "tunnelled": tunnelled, "tunnelling_pass": tunnelled == 0,
+        "step_us": us(Distribution::of(&mut all_steps)), "teapot_step_us": us(teapot), "teapot_step_pass": teapot.is_some_and(|d| d.median * 1e6 <= STEP_TARGET_US),
+        "runs": lines,
+    })
+}
+
+fn pass(ok: &Value) -> &'static str {
+    if ok.as_bool() == Some(true) {
+        "pass"
+    } else {
+        "FAIL"
+    }
+}
+
+/// Prints the report as tables.
+fn print_tables(r: &Value) {
+    let f = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+    println!("{}", r["synthetic"].as_str().unwrap_or_default());
+    if r["build"] == "debug" {
+        println!("debug build: the timings below are not meaningful; build with `cargo build --release -p dqhand-cli`");
+    }
+    println!();
+    println!("{:<8} {:<7} {:<6} {:>6} {:>8} {:>10} {:>10} {:>8} {:>8} {:>9} {:>10} {:>10}", "object", "kind", "from", "m/s", "success", "place mm", "pen. mm", "mean mm", "slip mm", "release", "tunnelled", "step µs");
+    for run in r["runs"].as_array().into_iter().flatten() {
+        println!(
+            "{:<8} {:<7} {:<6} {:>6} {:>8} {:>10.1} {:>10.2} {:>8.2} {:>8.2} {:>9} {:>10} {:>10.0}",
+            run["object"].as_str().unwrap_or_default(),
+            run["kind"].as_str().unwrap_or_default(),
+            run["approach"].as_str().unwrap_or_default(),
+            f(&run["speed_m_s"]),
+            if run["kind"] == "strike" { "-" } else if run["success"] == true { "yes" } else { "NO" },
+            f(&run["place_error_mm"]),
+            f(&run["max_penetration_mm"]),
+            f(&run["mean_penetration_mm"]),
+            f(&run["slip_mm"]),
+            run["release_frames"].as_u64().map_or_else(|| "-".to_owned(), |x| x.to_string()),
+            if run["tunnelled"] == true { "YES" } else { "no" },
+            f(&run["step_us"]["median"]),
+        );
+    }
+    println!();
+    println!("target                                   measured      verdict");
+    println!("grasp success ≥ 98 %                     {:>5.1} % ({}/{})  {}", f(&r["success_rate"]) * 100.0, r["successes"], r["grasps"], pass(&r["success_pass"]));
+    println!("rendered skin penetration ≤ 1 mm         {:>6.2} mm (mean {:.2})  {}", f(&r["max_penetration_mm"]), f(&r["mean_penetration_mm"]), pass(&r["penetration_pass"]));
+    println!("slip over the 0.5 m carry ≤ 3 mm         {:>6.2} mm     {}", f(&r["max_slip_mm"]), pass(&r["slip_pass"]));
+    println!("tunnelling, up to 10 m/s: none           {:>6} runs   {}", r["tunnelled"], pass(&r["tunnelling_pass"]));
+    println!(
+        "collision + grasp + physics, teapot ≤ 250 µs (median)  {:.0} µs (p95 {:.0})  {}",
+        f(&r["teapot_step_us"]["median"]),
+        f(&r["teapot_step_us"]["p95"]),
+        pass(&r["teapot_step_pass"])
+    );
+    println!("release latency: median {} frames, max {} frames; all objects: {:.0} µs a frame (median)", r["release_frames"]["median"], r["release_frames"]["max"], f(&r["step_us"]["median"]));
+}

@@ -1,0 +1,184 @@
+//! Measures of the manipulation loop on scripted grasps ([`crate::interaction::grasp_script`]):
+//! whether the object was picked up, carried and set down, how deep the rendered skin went
+//! into it, how far a carried object slipped in the hand, how many frames the release took,
+//! whether the hand passed into or through anything, and how long a frame took.
+//!
+//! Penetration is measured on the rendered DQB skin against each object's true surface, not
+//! against the proxies the contact constraint uses: a primitive's exact shape (parry's point
+//! projection), a mesh's triangles by the generalised winding number (it is inside where the
+//! number passes ½, which holds for an open mesh like the Utah teapot too) and its distance,
+//! within [`MESH_DEPTH_RANGE_M`] of the surface.
+
+use std::time::Instant;
+
+use glam::{Affine3A, Vec3};
+use parry3d::query::Ray;
+use serde::Serialize;
+
+use crate::collision::{ObjectCollider, ObjectColliders};
+use crate::geometry::winding_number;
+use crate::grasp::GraspEvent;
+use crate::interaction::grasp_script::{Script, RATE_HZ};
+use crate::interaction::ManipulationLoop;
+use crate::kinematics::JointPositions;
+use crate::skin::Method;
+
+/// Farthest a set-down object may rest from where the script carried it, m.
+pub const PLACE_TOLERANCE_M: f32 = 0.03;
+
+/// How far inside a mesh object depth is measured, m: the winding number over every triangle
+/// is too slow for every vertex of every frame, and skin deeper than this would have crossed
+/// the surface within it on its way in (the palm-crossing check counts a hand gone further).
+pub const MESH_DEPTH_RANGE_M: f32 = 0.01;
+
+/// What one scripted run measured.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunScore {
+    /// The object was grasped before the carry, held through it, let go once the fingers
+    /// opened, and came to rest within [`PLACE_TOLERANCE_M`] of where it was carried.
+    pub success: bool,
+    /// Where the object came to rest, from where it was carried to, m.
+    pub place_error_m: f32,
+    /// The deepest any rendered skin vertex went into any object, over the run, m.
+    pub max_penetration_m: f32,
+    /// The mean over frames with a contact of each frame's deepest vertex, m.
+    pub mean_penetration_m: f32,
+    /// How far the carried object moved in the tracked wrist's frame during the carry, m.
+    pub slip_m: f32,
+    /// Frames from the fingers beginning to open to the release, if released.
+    pub release_frames: Option<u32>,
+    /// The rendered palm's centre crossed an object's surface between two frames.
+    pub tunnelled: bool,
+    /// Seconds each frame's [`ManipulationLoop::step`] took (collision, grasp, physics).
+    #[serde(skip)]
+    pub step_s: Vec<f64>,
+}
+
+/// How deep `p` (world) is inside `object`'s true surface, m; 0 outside. `mesh` is the
+/// object's triangles flattened for the winding number (a mesh object's only).
+#[must_use]
+pub fn depth(object: &ObjectCollider, mesh: Option<&(Vec<[f32; 3]>, Vec<u32>)>, p: Vec3) -> f32 {
+    if !object.aabb().contains_local_point(p) {
+        return 0.0;
+    }
+    let local = object.pose.inverse_transform_point(p);
+    match mesh {
+        Some((positions, indices)) => {
+            let distance = object.surface.project_local_point(local, false).point.distance(local);
+            if distance > MESH_DEPTH_RANGE_M || winding_number(positions, indices, local) < 0.5 {
+                return 0.0;
+            }
+            distance
+        }
+        None => {
+            let projection = object.surface.project_local_point(local, true);
+            if projection.is_inside {
+                object.surface.project_local_point(local, false).point.distance(local)
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+/// Runs `script` through `manip` (fresh, on the script's scene) and scores it: `object` is the
+/// index of the scripted object, `carried_to` where the script sets it down.
+///
+/// # Panics
+/// If the loop's skeleton lacks the WebXR joints (the built-in hand has them).
+pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carried_to: Vec3) -> RunScore {
+    let meshes: Vec<Option<(Vec<[f32; 3]>, Vec<u32>)>> = manip
+        .objects()
+        .objects()
+        .iter()
+        .map(|o| o.mesh.as_ref().map(|m| (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect())))
+        .collect();
+    let joints = JointPositions::new(manip.rendered().skeleton()).expect("a hand with WebXR joints");
+    let times = script.times;
+    let mut score = RunScore {
+        success: false,
+        place_error_m: f32::INFINITY,
+        max_penetration_m: 0.0,
+        mean_penetration_m: 0.0,
+        slip_m: 0.0,
+        release_frames: None,
+        tunnelled: false,
+        step_s: Vec::with_capacity(script.records.len()),
+    };
+    let (mut grasped_before_carry, mut held_through_carry) = (false, true);
+    let mut released = false;
+    let (mut penetration_sum, mut contact_frames) = (0.0f64, 0u32);
+    let mut in_wrist: Option<Vec3> = None;
+    let mut palm: Option<Vec3> = None;
+    let mut skin: Vec<[f32; 3]> = Vec::new();
+    for record in &script.records {
+        // The loop takes records as they come; a script's records are all good.
+        let _ = manip.push(record, None);
+        let started = Instant::now();
+        let event = manip.step(record.time);
+        score.step_s.push(started.elapsed().as_secs_f64());
+        let t = record.time;
+        let held = manip.held().is_some_and(|n| n == manip.names()[object]);
+        if t < times.carry_start && held {
+            grasped_before_carry = true;
+        }
+        if t >= times.carry_start && t <= times.carry_end {
+            held_through_carry &= held;
+        }
+        if t >= times.carry_start && t <= times.carry_end && held {
+            let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().expect("a rig").wrist()];
+            let here = wrist.inverse().transform_point3(manip.poses()[object].1);
+            let first = *in_wrist.get_or_insert(here);
+            score.slip_m = score.slip_m.max(here.distance(first));
+        }
+        if let Some(GraspEvent::Release { object: o, .. }) = event {
+            if o == object && t >= times.release && !released {
+                released = true;
+                score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
+            }
+        }
+        let held_index = manip.held().and_then(|n| manip.names().iter().position(|m| m == n));
+        // The rendered palm's centre (between the wrist and the middle finger's knuckle) must
+        // not cross a surface between frames.
+        let world = manip.rendered().world();
+        let p = joints.read(world);
+        let centre = (p[0] + p[11]) / 2.0;
+        if let Some(last) = palm.replace(centre) {
+            score.tunnelled |= crossed(manip.objects(), held_index, last, centre);
+        }
+        skin.clear();
+        skin.extend_from_slice(manip.rendered_mut().skin(Method::Dqb).positions());
+        let colliders = manip.objects().objects();
+        let mut deepest = 0.0f32;
+        for v in &skin {
+            let v = Vec3::from(*v);
+            for (o, m) in colliders.iter().zip(&meshes) {
+                deepest = deepest.max(depth(o, m.as_ref(), v));
+            }
+        }
+        score.max_penetration_m = score.max_penetration_m.max(deepest);
+        if !manip.contacts().is_empty() {
+            penetration_sum += f64::from(deepest);
+            contact_frames += 1;
+        }
+    }
+    score.mean_penetration_m = if contact_frames > 0 { (penetration_sum / f64::from(contact_frames)) as f32 } else { 0.0 };
+    score.place_error_m = manip.poses()[object].1.distance(carried_to);
+    score.success = grasped_before_carry && held_through_carry && released && manip.held().is_none() && score.place_error_m <= PLACE_TOLERANCE_M;
+    score
+}
+
+/// Whether the segment `from`–`to` crosses the surface of an object (or the table) other
+/// than `skip`.
+fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3) -> bool {
+    let length = from.distance(to);
+    if length <= f32::EPSILON {
+        return false;
+    }
+    let ray = Ray::new(from, (to - from) / length);
+    let n = objects.objects().len() + usize::from(objects.table().is_some());
+    (0..n).filter(|&i| Some(i) != skip).any(|i| {
+        let o = objects.collider(i);
+        o.surface.cast_ray(&o.pose, &ray, length, false).is_some()
+    })
+}
