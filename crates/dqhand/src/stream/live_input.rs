@@ -272,6 +272,14 @@ impl LiveInput {
         Ok(())
     }
 
+    /// Puts a scene's objects back where the scene file has them (a played recording starting
+    /// over grasps them where they were); without a scene, nothing.
+    pub fn reset_scene(&self) {
+        if let Driver::Scene(s) = &mut self.lock().driver {
+            s.manip.reset();
+        }
+    }
+
     /// Counts a record refused before it got here (unreadable, too large).
     pub fn reject(&self, rejection: Rejection) {
         match &mut self.lock().driver {
