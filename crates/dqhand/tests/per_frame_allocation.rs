@@ -15,7 +15,7 @@ use dqhand::gesture::{GestureSet, HandFeatures, Recognizer, Sequence};
 use dqhand::hand::{build, HandParams, Side};
 use dqhand::kinematics::{JointModel, JointPositions, Pose};
 use dqhand::skin::MethodSet;
-use dqhand::input::InputConfig;
+use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::synthetic::{generate, SyntheticParams};
 use dqhand::collision::ObjectColliders;
 use dqhand::grasp::GraspParams;
@@ -120,13 +120,7 @@ fn a_live_record_and_a_viewer_update_without_news_allocate_nothing() {
     let input = LiveInput::new(gesture_loop, "test", true);
     let mut session = Session::new(model, JointModel::Full).unwrap();
     let mut view = input.view();
-    let (warm_up, rest) = synthetic.records.split_at(10);
-    for r in warm_up {
-        input.push(r, |_| {}).unwrap();
-    }
-    let before = allocations();
-    let taken = rest.iter().filter(|r| input.push(r, |_| {}).is_ok()).count();
-    assert_eq!(allocations() - before, 0, "allocations during {} live records", rest.len());
+    let taken = push_live(&input, &synthetic.records);
     assert!(taken > 300, "{taken} records taken");
     assert!(input.update(&mut session, &mut view).message.is_some(), "the first update reports the state");
     let before = allocations();
@@ -146,14 +140,21 @@ fn a_live_record_through_a_scene_allocates_nothing() {
     let config = InputConfig { grace_s: 1e6, ..InputConfig::default() };
     let manip = ManipulationLoop::new(model, JointModel::Full, None, config, Some(GestureSet::builtin()), &scene, GraspParams::default()).unwrap().with_commands().unwrap();
     let input = LiveInput::with_scene(manip, "test", true).unwrap();
-    let (warm_up, rest) = script.records.split_at(10);
+    let taken = push_live(&input, &script.records);
+    assert!(taken > 100, "{taken} records taken");
+}
+
+/// Pushes `records` into `input` live, the first ten to warm up; asserts that the rest
+/// allocated nothing and returns how many of them were taken.
+fn push_live(input: &LiveInput, records: &[Record]) -> usize {
+    let (warm_up, rest) = records.split_at(10);
     for r in warm_up {
         input.push(r, |_| {}).unwrap();
     }
     let before = allocations();
     let taken = rest.iter().filter(|r| input.push(r, |_| {}).is_ok()).count();
-    assert_eq!(allocations() - before, 0, "allocations during {} live records in a scene", rest.len());
-    assert!(taken > 100, "{taken} records taken");
+    assert_eq!(allocations() - before, 0, "allocations during {} live records", rest.len());
+    taken
 }
 
 #[test]
