@@ -3,7 +3,7 @@
 
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand,
-  type Command, type Frame, type Hello, type InputMessage, type Topology,
+  type Command, type Frame, type Hello, type InputMessage, type SceneMessage, type Topology,
 } from './protocol';
 
 export interface ConnectionEvents {
@@ -12,6 +12,8 @@ export interface ConnectionEvents {
   frame(frame: Frame): void;
   /** The live input's state changed (only when the hello announces an input). */
   input(message: InputMessage): void;
+  /** The scene's objects, the object held and the contacts (only when the hello has a scene). */
+  scene(message: SceneMessage): void;
   error(message: string): void;
   status(connected: boolean): void;
 }
@@ -54,6 +56,7 @@ export class Connection {
         const message = decodeText(data);
         if (message.type === 'hello') this.events.hello(message);
         else if (message.type === 'input') this.events.input(message);
+        else if (message.type === 'scene') this.events.scene(message);
         else this.events.error(message.message);
         return;
       }

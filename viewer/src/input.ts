@@ -56,9 +56,20 @@ export class InputPanel {
     this.render();
   }
 
+  /** Shows the "holding" line when the hand manipulates a scene. */
+  setScene(on: boolean): void {
+    this.$('holding').hidden = !on;
+  }
+
+  /** The object the hand holds now (null: none). */
+  setHeld(name: string | null): void {
+    this.$('held').textContent = name ?? '—';
+  }
+
   /** Forgets the previous session's state (its counters and times restart with the new one). */
   reset(): void {
     Object.assign(this, { tracking: 'waiting', gesture: null, accepted: 0, rejected: 0 });
+    this.setHeld(null);
     this.log.clear();
     this.render();
   }

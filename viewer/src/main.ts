@@ -19,6 +19,8 @@ let hello: Hello | null = null;
 let frame: Frame | null = null;
 let dragging: HTMLInputElement | null = null;
 let pageFps = 0;
+/** Whether this connection's hello has set the scene (a server's scene is fixed; later hellos, as on a joint-model change, repeat it). */
+let sceneSet = false;
 
 const status = (text: string, kind: '' | 'ok' | 'error') => {
   const s = $('status');
@@ -36,6 +38,13 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
     select.replaceChildren(...h.joint_models.map((m) => new Option(`${m} (${m === h.joint_model ? h.dofs.length + ' DOF' : '…'})`, m, false, m === h.joint_model)));
     $<HTMLInputElement>('timeline').max = String(h.sequence.duration);
     inputPanel.setSource(h.input);
+    if (!sceneSet) {
+      sceneSet = true;
+      scene.setScene(h.scene);
+      inputPanel.setScene(h.scene !== null);
+      // One hand among the objects: side by side, two of three would not be where the objects are.
+      $<HTMLInputElement>('split').disabled = h.scene !== null;
+    }
   },
   topology(t) {
     scene.setTopology(t);
@@ -48,12 +57,17 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
   input(message) {
     inputPanel.update(message);
   },
+  scene(message) {
+    scene.showScene(message);
+    inputPanel.setHeld(message.held);
+  },
   error(message) {
     errors.push(message);
     status(`engine: ${message}`, 'error');
   },
   status(connected) {
     if (connected) inputPanel.reset();
+    sceneSet = false;
     status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
 });
@@ -249,6 +263,8 @@ window.dqhand = {
     visible: scene.visibleMethods(),
     /** The live input, null without one: tracking, the gesture now, record totals, the event log (newest first). */
     input: inputPanel.state(),
+    /** The manipulation scene, null without one: the objects drawn (placed by a scene message), the one held, contacts shown, scene messages shown. */
+    scene: scene.objects && { drawn: scene.objects.drawn(), held: scene.objects.held, contacts: scene.objects.contacts, updates: scene.objects.updates },
     geometries: scene.renderer.info.memory.geometries,
     frame: frame && {
       sequence: frame.header.sequence,

@@ -1,5 +1,5 @@
 // The stream's wire format, version 1 (crates/dqhand/src/stream/frame.rs is the reference):
-// a topology message once, then binary frames; JSON text for hello, input state, errors and commands.
+// a topology message once, then binary frames; JSON text for hello, input state, scene state, errors and commands.
 // Arrays are 4-byte aligned, so they are read as typed-array views without copying.
 
 export const VERSION = 1;
@@ -81,6 +81,57 @@ export interface Hello {
   max_message_bytes: number;
   /** The live input driving the hand, or null when the demo has none (an older server omits it: null). */
   input: HelloInput | null;
+  /** The scene the hand manipulates (`dqhand demo --scene`), or null (an older server omits it: null). */
+  scene: HelloScene | null;
+}
+
+/** Bounds of the scene messages (crates/dqhand/src/stream/frame.rs): larger ones are refused. */
+export const MAX_SCENE_OBJECTS = 256;
+export const MAX_SCENE_TRIANGLES = 50_000;
+export const MAX_SCENE_CONTACTS = 64;
+export const MAX_NAME_BYTES = 64;
+
+export type Vec3 = [number, number, number];
+
+/** The table's top: the plane y = height, a rectangle about (centre x, centre z) of the half sizes along x and z. Metres. */
+export interface SceneTable {
+  height: number;
+  centre: [number, number];
+  half: [number, number];
+}
+
+/** An object's shape in its own frame (metres; a cylinder's axis is +Y; a mesh is scaled as the physics has it). */
+export type ObjectShape =
+  | { shape: 'sphere'; radius: number }
+  | { shape: 'box'; size: Vec3 }
+  | { shape: 'cylinder'; radius: number; height: number }
+  /** `simplified`: the mesh did not fit the hello's triangle budget and is its bounding box. */
+  | { shape: 'mesh'; positions: Float32Array; indices: Uint32Array; simplified: boolean };
+
+export type SceneObject = { name: string } & ObjectShape;
+
+/** The hello's scene: the table (null: none) and the objects, in scene order. */
+export interface HelloScene {
+  table: SceneTable | null;
+  objects: SceneObject[];
+}
+
+/** A point of the rendered hand's bone touching an object, with the object's normal there (toward the hand). World, metres. */
+export interface Contact {
+  bone: string;
+  object: string;
+  p: Vec3;
+  n: Vec3;
+}
+
+/** The scene's state, sent at once on a grasp or release and at a bounded rate while it moves. */
+export interface SceneMessage {
+  type: 'scene';
+  /** The object held, or null. */
+  held: string | null;
+  /** Every object's world pose: translation and rotation xyzw. */
+  objects: Record<string, { p: Vec3; q: [number, number, number, number] }>;
+  contacts: Contact[];
 }
 
 /** The hello's description of the live input (`dqhand demo --input FILE` or `--udp PORT`). */
@@ -94,7 +145,8 @@ export interface HelloInput {
 export const TRACKING_STATES = ['waiting', 'tracking', 'lost'] as const;
 /** The input's tracking: no record yet, records arriving, or none for longer than the grace period. */
 export type Tracking = (typeof TRACKING_STATES)[number];
-export const INPUT_ACTIONS = ['next_method', 'split_view', 'toggle_heatmap'] as const;
+/** The viewer's actions, and a scene's (`reset`: every object back where the scene file puts it). */
+export const INPUT_ACTIONS = ['next_method', 'split_view', 'toggle_heatmap', 'reset'] as const;
 export type InputAction = (typeof INPUT_ACTIONS)[number];
 
 /** A recognised gesture starting or ending, at `t` seconds of the input's clock. */
@@ -127,7 +179,7 @@ export interface InputMessage {
   rejected: number;
 }
 
-export type ServerText = Hello | InputMessage | { type: 'error'; message: string };
+export type ServerText = Hello | InputMessage | SceneMessage | { type: 'error'; message: string };
 
 /** Which binary message this is, from its magic; null if neither. */
 export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
@@ -238,6 +290,7 @@ export function decodeText(text: string): ServerText {
   const type = (value as { type?: unknown } | null)?.type;
   if (type === 'hello') return checkHello(value as Record<string, unknown>);
   if (type === 'input') return checkInput(value as Record<string, unknown>);
+  if (type === 'scene') return checkSceneMessage(value as Record<string, unknown>);
   if (type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
   return value as ServerText;
 }
@@ -247,14 +300,85 @@ const isString = (v: unknown): v is string => typeof v === 'string';
 const isCount = (v: unknown): v is number => typeof v === 'number' && Number.isSafeInteger(v) && v >= 0;
 const isTime = (v: unknown): v is number => typeof v === 'number' && Number.isFinite(v);
 const oneOf = <T extends string>(values: readonly T[], v: unknown): v is T => values.includes(v as T);
+const isSize = (v: unknown): v is number => isTime(v) && v > 0;
+const isVector = (v: unknown, n: number): boolean => Array.isArray(v) && v.length === n && v.every(isTime);
+const isName = (v: unknown): v is string => isString(v) && v.length > 0 && new TextEncoder().encode(v).length <= MAX_NAME_BYTES;
+/** A value for an error message, cut short: a bad mesh may be megabytes. */
+const show = (v: unknown) => {
+  const text = JSON.stringify(v) ?? String(v);
+  return text.length > 120 ? `${text.slice(0, 120)}…` : text;
+};
 
-/** The hello with its `input` checked (the rest is trusted, as before): null or a source and gesture names. */
+/** The hello with its `input` and `scene` checked (the rest is trusted, as before). */
 function checkHello(value: Record<string, unknown>): Hello {
   const input = value.input ?? null;
   if (input !== null && !(isObject(input) && isString(input.source) && Array.isArray(input.gestures) && input.gestures.every(isString))) {
     throw new ProtocolError(`hello: input ${JSON.stringify(input)} is neither null nor {source, gestures}`);
   }
-  return { ...value, input } as unknown as Hello;
+  const scene = value.scene == null ? null : checkHelloScene(value.scene);
+  return { ...value, input, scene } as unknown as Hello;
+}
+
+/** Checks the hello's scene field by field (the error names the first bad one) and turns meshes into typed arrays. */
+function checkHelloScene(v: unknown): HelloScene {
+  const bad = (field: string, value: unknown) => new ProtocolError(`hello: scene ${field && `${field} `}${show(value)}`);
+  if (!isObject(v)) throw bad('', v);
+  const table = v.table ?? null;
+  if (table !== null && !(isObject(table) && isTime(table.height) && isVector(table.centre, 2) && isVector(table.half, 2) && (table.half as number[]).every(isSize))) {
+    throw bad('table', table);
+  }
+  if (!Array.isArray(v.objects) || v.objects.length > MAX_SCENE_OBJECTS) throw bad('objects', v.objects);
+  const names = new Set<string>();
+  let triangles = 0;
+  const objects = v.objects.map((o: unknown, i): SceneObject => {
+    const field = `objects[${i}]`;
+    if (!isObject(o) || !isName(o.name) || names.has(o.name)) throw bad(`${field}.name`, isObject(o) ? o.name : o);
+    names.add(o.name);
+    const name = o.name;
+    switch (o.shape) {
+      case 'sphere':
+        if (!isSize(o.radius)) throw bad(`${field}.radius`, o.radius);
+        return { name, shape: 'sphere', radius: o.radius };
+      case 'box':
+        if (!(isVector(o.size, 3) && (o.size as number[]).every(isSize))) throw bad(`${field}.size`, o.size);
+        return { name, shape: 'box', size: o.size as Vec3 };
+      case 'cylinder':
+        if (!isSize(o.radius)) throw bad(`${field}.radius`, o.radius);
+        if (!isSize(o.height)) throw bad(`${field}.height`, o.height);
+        return { name, shape: 'cylinder', radius: o.radius, height: o.height };
+      case 'mesh': {
+        const { positions, indices } = o;
+        if (!(Array.isArray(positions) && positions.length % 3 === 0 && positions.every(isTime))) throw bad(`${field}.positions`, positions);
+        const vertices = positions.length / 3;
+        if (!(Array.isArray(indices) && indices.length % 3 === 0 && indices.every((k) => isCount(k) && k < vertices))) throw bad(`${field}.indices`, indices);
+        triangles += indices.length / 3;
+        if (triangles > MAX_SCENE_TRIANGLES) throw bad(`${field}.indices`, `${triangles} triangles in all (at most ${MAX_SCENE_TRIANGLES})`);
+        if (typeof o.simplified !== 'boolean') throw bad(`${field}.simplified`, o.simplified);
+        return { name, shape: 'mesh', positions: Float32Array.from(positions), indices: Uint32Array.from(indices), simplified: o.simplified };
+      }
+      default:
+        throw bad(`${field}.shape`, o.shape);
+    }
+  });
+  return { table: table as SceneTable | null, objects };
+}
+
+/** Checks every field of a scene message; the message names the first bad one. */
+function checkSceneMessage(v: Record<string, unknown>): SceneMessage {
+  const bad = (field: string, value: unknown) => new ProtocolError(`scene message: ${field} ${show(value)}`);
+  if (v.held !== null && !isName(v.held)) throw bad('held', v.held);
+  if (!isObject(v.objects) || Object.keys(v.objects).length > MAX_SCENE_OBJECTS) throw bad('objects', v.objects);
+  const objects: SceneMessage['objects'] = {};
+  for (const [name, pose] of Object.entries(v.objects)) {
+    if (!isName(name) || !(isObject(pose) && isVector(pose.p, 3) && isVector(pose.q, 4))) throw bad(`objects.${name}`, pose);
+    objects[name] = { p: pose.p as Vec3, q: pose.q as [number, number, number, number] };
+  }
+  if (!Array.isArray(v.contacts) || v.contacts.length > MAX_SCENE_CONTACTS) throw bad('contacts', v.contacts);
+  const contacts = v.contacts.map((c: unknown, i): Contact => {
+    if (!(isObject(c) && isString(c.bone) && isName(c.object) && isVector(c.p, 3) && isVector(c.n, 3))) throw bad(`contacts[${i}]`, c);
+    return { bone: c.bone, object: c.object, p: c.p as Vec3, n: c.n as Vec3 };
+  });
+  return { type: 'scene', held: v.held as string | null, objects, contacts };
 }
 
 /** Checks every field of an input message; the message names the first bad one. */

@@ -1,10 +1,12 @@
 // The three.js scene: up to three hands side by side (one per skinning method), lit so that
-// creases and volume read, with optional heat map, wireframe and skeleton overlays. Geometry
-// comes from the engine; this file only draws it.
+// creases and volume read, with optional heat map, wireframe and skeleton overlays; or, with a
+// manipulation scene, one hand among the objects in their common world. Geometry comes from
+// the engine; this file only draws it.
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import type { Frame, Method, Topology } from './protocol';
+import { SceneObjects } from './objects';
+import type { Frame, HelloScene, Method, SceneMessage, Topology } from './protocol';
 
 const SKIN = new THREE.Color(0xe0a98f);
 /** Distortion that maps to the top of the heat scale (30 % mean edge-length change). */
@@ -37,7 +39,7 @@ class HandView {
   readonly jointDots: THREE.Points<THREE.BufferGeometry, THREE.PointsMaterial>;
   method: Method | null = null;
 
-  constructor(topology: Topology) {
+  constructor(topology: Topology, present: THREE.Quaternion) {
     const n = topology.vertexCount;
     const geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(topology.indices, 1));
@@ -65,7 +67,7 @@ class HandView {
       o.renderOrder = 10;
       o.frustumCulled = false;
     }
-    this.oriented.quaternion.copy(PRESENT);
+    this.oriented.quaternion.copy(present);
     this.oriented.add(this.mesh, this.bones, this.jointDots);
     this.group.add(this.oriented);
   }
@@ -136,8 +138,10 @@ export class HandScene {
   private framed = false;
   private shownCount = 0;
   private readonly heat = new THREE.Color();
-  /** Centre and size of the hand at the first frame, for camera presets. */
+  /** Centre and size of the hand at the first frame (with a scene: of the objects and the room above them), for camera presets. */
   readonly bounds = new THREE.Box3();
+  /** The manipulation scene, or null: then hands are turned for viewing (PRESENT); with one, they stay in the world the objects are in. */
+  objects: SceneObjects | null = null;
   showSkeleton = false;
   lastFrame: Frame | null = null;
 
@@ -175,25 +179,57 @@ export class HandScene {
       this.scene.remove(v.group);
       v.dispose();
     }
-    this.views = [0, 1, 2].map(() => new HandView(topology));
+    this.views = [0, 1, 2].map(() => new HandView(topology, this.objects ? new THREE.Quaternion() : PRESENT));
     for (const v of this.views) this.scene.add(v.group);
     this.parents = topology.parents;
     this.framed = false;
   }
 
-  /** Shows a frame: one hand per mesh in it, side by side. */
+  /**
+   * Sets the hello's scene (null: none): its table and objects are drawn once a scene message
+   * places them, and the hands are drawn in the world beside them (a hello comes before the
+   * topology that builds the hands).
+   */
+  setScene(scene: HelloScene | null): void {
+    if (this.objects) {
+      this.scene.remove(this.objects.group);
+      this.objects.dispose();
+    }
+    this.objects = scene && new SceneObjects(scene);
+    if (this.objects) this.scene.add(this.objects.group);
+    for (const v of this.views) v.oriented.quaternion.copy(this.objects ? new THREE.Quaternion() : PRESENT);
+    this.framed = false;
+  }
+
+  /** Shows a scene message; the first frames the camera on the objects (the floor's shadow at y = 0). */
+  showScene(message: SceneMessage): void {
+    if (!this.objects) return;
+    this.objects.update(message);
+    if (!this.framed) {
+      this.framed = true;
+      this.objects.frame(this.bounds);
+      this.ground.position.y = 0;
+      this.setView('default');
+    }
+  }
+
+  /**
+   * Shows a frame: one hand per mesh in it, side by side; with a scene one hand, in the world
+   * (DQB in a split view: three hands side by side would not be where the objects are).
+   */
   showFrame(frame: Frame): void {
     if (this.views.length === 0 || frame.header.vertexCount !== this.views[0].mesh.geometry.getAttribute('position').count) return;
     this.lastFrame = frame;
-    const count = frame.meshes.length;
+    const count = this.objects ? 1 : frame.meshes.length;
+    const first = this.objects ? Math.max(0, frame.header.methods.indexOf('dqb')) : 0;
     this.views.forEach((view, i) => {
       view.group.visible = i < count;
       if (i >= count) return;
-      view.update(frame, i, this.parents, this.heat);
+      view.update(frame, first + i, this.parents, this.heat);
       view.group.position.x = (i - (count - 1) / 2) * this.spacing;
       view.bones.visible = view.jointDots.visible = this.showSkeleton;
     });
-    if (!this.framed) {
+    if (!this.framed && !this.objects) {
       this.framed = true;
       const first = this.views[0];
       first.mesh.geometry.computeBoundingBox();
@@ -234,8 +270,9 @@ export class HandScene {
     this.key.position.copy(center).add(new THREE.Vector3(0.35, 1.0, 0.6));
     this.key.target.position.copy(center);
     const s = this.key.shadow.camera;
-    s.left = s.bottom = -0.4;
-    s.right = s.top = 0.4;
+    const reach = Math.max(0.4, 0.6 * size);
+    s.left = s.bottom = -reach;
+    s.right = s.top = reach;
     s.near = 0.1;
     s.far = 3;
     s.updateProjectionMatrix();

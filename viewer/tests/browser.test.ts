@@ -58,11 +58,17 @@ async function restartServer(whileDown = async () => {}) {
   await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
 }
 
+/** A page of the tests' size that logs its errors. */
+async function newPage(): Promise<Page> {
+  const p = await browser.newPage({ viewport: { width: 900, height: 520 } });
+  p.on('pageerror', (e) => console.error('page error:', e.message));
+  return p;
+}
+
 beforeAll(async () => {
   server = await startServer();
   browser = await launchBrowser();
-  page = await browser.newPage({ viewport: { width: 900, height: 520 } });
-  page.on('pageerror', (e) => console.error('page error:', e.message));
+  page = await newPage();
   await page.goto(server.url);
   await waitState(page, 's.connected && s.framesReceived > 3 && s.visible.length === 1');
 });
@@ -233,8 +239,7 @@ describe('the Input panel, on input messages put into the real stream', () => {
   const inputState = () => p.evaluate(() => (window as unknown as { dqhand: { state(): State } }).dqhand.state());
 
   beforeAll(async () => {
-    p = await browser.newPage({ viewport: { width: 900, height: 520 } });
-    p.on('pageerror', (e) => console.error('page error:', e.message));
+    p = await newPage();
     // The engine's messages pass through, its hello announcing an input.
     await p.routeWebSocket(/\/stream$/, (ws) => {
       const engine = ws.connectToServer();
@@ -309,8 +314,7 @@ describe('the viewer page with a recorded input', () => {
     supportsInput = /--input\b/.test(`${help.stdout}${help.stderr}`);
     if (!supportsInput) return;
     inputServer = await startServer({ args: ['--input', RECORDING] });
-    inputPage = await browser.newPage({ viewport: { width: 900, height: 520 } });
-    inputPage.on('pageerror', (e) => console.error('page error:', e.message));
+    inputPage = await newPage();
     await inputPage.goto(inputServer.url);
   });
 
@@ -347,5 +351,44 @@ describe('the viewer page with a recorded input', () => {
       15_000,
     );
     expect(s.errors).toEqual([]);
+  });
+});
+
+describe('the viewer page with a scene', () => {
+  let sceneServer: Server | null = null;
+  let p: Page;
+
+  beforeAll(async () => {
+    // No --input: the bundled grasp recording plays (make recordings writes it).
+    sceneServer = await startServer({ args: ['--scene', 'grasp'] });
+    p = await newPage();
+    await p.goto(sceneServer.url);
+  });
+
+  afterAll(async () => {
+    await p?.close();
+    await sceneServer?.stop();
+  });
+
+  test('draws the table and the objects where the engine puts them, with the hand among them', async () => {
+    // One predicate for state and page: other pages share the two cores, and this one may answer slowly.
+    await waitState(
+      p,
+      's.connected && s.framesReceived > 3 && s.scene !== null && s.scene.drawn.join() === "ball,teapot" && s.visible.length === 1' +
+        ' && document.getElementById("split").disabled && !document.getElementById("holding").hidden',
+      90_000,
+    );
+    await settle(p);
+    // The objects' blues and the table's wood, on the canvas.
+    expect(await countColour(p, { r: [0, 120], g: [40, 190], b: [150, 255] })).toBeGreaterThan(200);
+    expect(await countColour(p, { r: [120, 230], g: [80, 180], b: [40, 130] })).toBeGreaterThan(2000);
+  });
+
+  test('shows the ball held while the bundled recording grasps it', async () => {
+    // The state and the Input panel's line together (the ball is held for about 2 s of each pass).
+    await waitState(p, 's.scene.held === "ball" && document.getElementById("held").textContent === "ball" && s.input.tracking === "tracking"', 90_000);
+    expect((await p.evaluate(() => (window as unknown as { dqhand: { state(): { errors: string[] } } }).dqhand.state())).errors).toEqual([]);
+    // Released again later in the recording.
+    await waitState(p, 's.scene.held === null && document.getElementById("held").textContent === "—"', 60_000);
   });
 });

@@ -4,7 +4,10 @@
 import { readFileSync } from 'node:fs';
 import { describe, expect, test } from 'vitest';
 import { InputLog, LOG_LENGTH } from '../src/input';
-import { binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, type InputMessage, ProtocolError } from '../src/protocol';
+import {
+  binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, type Hello, type InputMessage, MAX_SCENE_CONTACTS,
+  MAX_SCENE_TRIANGLES, ProtocolError, type SceneMessage,
+} from '../src/protocol';
 
 const fixture = (name: string): ArrayBuffer => {
   const bytes = readFileSync(new URL(`./fixtures/${name}`, import.meta.url));
@@ -162,5 +165,94 @@ describe('live input', () => {
     expect(log.lines[29]).toBe('5.00  start fist');
     log.clear();
     expect(log.lines).toEqual([]);
+  });
+});
+
+describe('scene', () => {
+  const scene = {
+    table: { height: 0.75, centre: [0, -0.35], half: [0.6, 0.4] },
+    objects: [
+      { name: 'ball', shape: 'sphere', radius: 0.04 },
+      { name: 'cube', shape: 'box', size: [0.06, 0.06, 0.06] },
+      { name: 'mug', shape: 'cylinder', radius: 0.04, height: 0.1 },
+      { name: 'tri', shape: 'mesh', positions: [0, 0, 0, 1, 0, 0, 0, 1, 0], indices: [0, 1, 2], simplified: false },
+    ],
+  };
+  const hello = (s: unknown) => JSON.stringify({ type: 'hello', version: 1, input: null, scene: s });
+  const withObject = (o: object) => ({ ...scene, objects: [o] });
+
+  test('the hello\'s scene: null, absent (an older server: null), or the table and every kind of object, meshes as typed arrays', () => {
+    expect(decodeText(JSON.stringify({ type: 'hello', version: 1 }))).toMatchObject({ scene: null });
+    expect(decodeText(hello(null))).toMatchObject({ scene: null });
+    const h = decodeText(hello(scene)) as Hello;
+    expect(h.scene!.table).toEqual(scene.table);
+    expect(h.scene!.objects.slice(0, 3)).toEqual(scene.objects.slice(0, 3));
+    const mesh = h.scene!.objects[3];
+    expect(mesh.shape === 'mesh' && [mesh.positions, mesh.indices, mesh.simplified]).toEqual([new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]), new Uint32Array([0, 1, 2]), false]);
+    expect((decodeText(hello({ ...scene, table: null })) as Hello).scene!.table).toBeNull();
+  });
+
+  test('a malformed scene in the hello is refused, naming the field', () => {
+    const tri = scene.objects[3];
+    const cases: [unknown, RegExp][] = [
+      ['ball', /hello: scene "ball"/],
+      [{ ...scene, table: { height: 0.75 } }, /scene table/],
+      [{ ...scene, table: { ...scene.table, half: [0.6, -1] } }, /scene table/],
+      [{ ...scene, objects: null }, /scene objects null/],
+      [withObject({ name: 'ball', shape: 'sphere', radius: 0 }), /objects\[0\]\.radius 0/],
+      [withObject({ name: 'ball', shape: 'cone', radius: 1 }), /objects\[0\]\.shape "cone"/],
+      [withObject({ name: '', shape: 'sphere', radius: 1 }), /objects\[0\]\.name ""/],
+      [withObject({ name: 'x'.repeat(65), shape: 'sphere', radius: 1 }), /objects\[0\]\.name/],
+      [{ ...scene, objects: [scene.objects[0], scene.objects[0]] }, /objects\[1\]\.name "ball"/],
+      [withObject({ name: 'b', shape: 'box', size: [1, 1] }), /objects\[0\]\.size/],
+      [withObject({ name: 'c', shape: 'cylinder', radius: 1 }), /objects\[0\]\.height/],
+      [withObject({ ...tri, indices: [0, 1, 3] }), /objects\[0\]\.indices/],
+      [withObject({ ...tri, indices: [0, 1] }), /objects\[0\]\.indices/],
+      [withObject({ ...tri, positions: [0, 0, 0, 1, 0, 0, 0, 1] }), /objects\[0\]\.positions/],
+      [withObject({ ...tri, positions: [0, 0, 0, 1, 0, 0, 0, 1, null] }), /objects\[0\]\.positions/],
+      [withObject({ ...tri, simplified: 'no' }), /objects\[0\]\.simplified/],
+      [withObject({ ...tri, indices: Array(3 * (MAX_SCENE_TRIANGLES + 1)).fill(0) }), /triangles in all/],
+      [{ ...scene, objects: Array.from({ length: 257 }, (_, k) => ({ name: `o${k}`, shape: 'sphere', radius: 1 })) }, /scene objects/],
+    ];
+    for (const [s, message] of cases) {
+      expect(() => decodeText(hello(s))).toThrow(ProtocolError);
+      expect(() => decodeText(hello(s))).toThrow(message);
+    }
+  });
+
+  const good: SceneMessage = {
+    type: 'scene', held: 'ball',
+    objects: { ball: { p: [0.1, 0.9, -0.3], q: [0, 0, 0, 1] }, teapot: { p: [0.15, 0.75, -0.35], q: [0, 0.383, 0, 0.924] } },
+    contacts: [{ bone: 'thumb-tip', object: 'ball', p: [0.1, 0.93, -0.3], n: [0, 1, 0] }],
+  };
+  const message = (edit: Record<string, unknown> = {}) => JSON.stringify({ ...good, ...edit });
+
+  test('a scene message is parsed with every field', () => {
+    expect(decodeText(message())).toEqual(good);
+    expect(decodeText(message({ held: null, contacts: [] }))).toMatchObject({ held: null, contacts: [] });
+  });
+
+  test('a malformed scene message is refused, naming the field', () => {
+    const contact = good.contacts[0];
+    const cases: [string, RegExp][] = [
+      [message({ held: 3 }), /held 3/],
+      [message({ held: undefined }), /held undefined/],
+      [message({ objects: [] }), /objects \[\]/],
+      [message({ objects: { ball: { p: [0, 1], q: [0, 0, 0, 1] } } }), /objects\.ball/],
+      [message({ objects: { ball: { p: [0, 1, 0], q: [0, 0, 0, 'w'] } } }), /objects\.ball/],
+      [message({ contacts: null }), /contacts null/],
+      [message({ contacts: [{ ...contact, n: [0, 1] }] }), /contacts\[0\]/],
+      [message({ contacts: [{ ...contact, bone: 7 }] }), /contacts\[0\]/],
+      [message({ contacts: Array(MAX_SCENE_CONTACTS + 1).fill(contact) }), /contacts \[/],
+    ];
+    for (const [t, m] of cases) {
+      expect(() => decodeText(t)).toThrow(ProtocolError);
+      expect(() => decodeText(t)).toThrow(m);
+    }
+  });
+
+  test('the scene\'s reset is an action of the input log', () => {
+    const input = JSON.stringify({ type: 'input', tracking: 'tracking', gesture: 'open_palm', events: [], actions: [{ t: 3, gesture: 'open_palm', action: 'reset' }], accepted: 1, rejected: 0 });
+    expect((decodeText(input) as InputMessage).actions).toEqual([{ t: 3, gesture: 'open_palm', action: 'reset' }]);
   });
 });

@@ -10,9 +10,11 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::GESTURES;
+use dqhand::grasp::GraspParams;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
-use dqhand::interaction::GestureLoop;
+use dqhand::interaction::{GestureLoop, ManipulationLoop};
+use dqhand::scene::Scene;
 use dqhand::skin::Method;
 use dqhand::stream::LiveInput;
 
@@ -69,6 +71,15 @@ pub struct Args {
     /// Gesture definitions to recognise instead of the built-in ones.
     #[arg(long)]
     gestures_file: Option<PathBuf>,
+    /// Manipulate a scene: a built-in one (`grasp`, `objects`) or a scene JSON file. Without
+    /// --input or --udp the bundled grasp recording plays.
+    #[arg(long)]
+    scene: Option<String>,
+}
+
+/// The recording `demo --scene` plays when no input is given (`make recordings` writes it).
+fn grasp_recording() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../dqhand/data/recordings/grasp-joints.jsonl")
 }
 
 pub(crate) fn parse_fps(s: &str) -> Result<f64, String> {
@@ -117,8 +128,17 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
         config.actions.retain(|a| gestures.gestures().iter().any(|g| g.name() == a.gesture));
     }
     let mapper = Some(args.common.mapper(args.joint_model)?);
-    let gesture_loop = GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?.with_commands()?;
-    if let (Some(input), Some(record)) = (&args.input, &args.record) {
+    let scene = args.scene.as_deref().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
+    let played = match (&args.input, &scene, args.udp) {
+        (Some(path), _, _) => Some(path.clone()),
+        (None, Some(_), None) => {
+            let path = grasp_recording();
+            anyhow::ensure!(path.is_file(), "{}: the bundled grasp recording is missing: run `make recordings`", path.display());
+            Some(path.canonicalize()?)
+        }
+        (None, _, _) => None,
+    };
+    if let (Some(input), Some(record)) = (&played, &args.record) {
         if input.canonicalize().ok() == record.canonicalize().ok() {
             anyhow::bail!("{}: --record would replace the recording being played", record.display());
         }
@@ -131,16 +151,27 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
         }
         None => None,
     };
-    let source = match (&args.input, &udp) {
+    let source = match (&played, &udp) {
         (Some(path), _) => path.display().to_string(),
         (None, Some(socket)) => format!("udp {}", socket.local_addr()?),
         (None, None) => "WebSocket /input".to_owned(),
     };
-    let announce = args.input.is_some() || udp.is_some();
-    let feed = Arc::new(Feed { input: LiveInput::new(gesture_loop, source.clone(), announce), records, clients: AtomicUsize::new(0) });
+    let announce = played.is_some() || udp.is_some();
+    let input = match scene {
+        None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?.with_commands()?, source.clone(), announce),
+        Some((name, scene)) => {
+            let manip = ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default())
+                .and_then(ManipulationLoop::with_commands)
+                .with_context(|| name.to_owned())?;
+            crate::warn_all(&manip.objects().warnings().iter().map(|w| format!("{name}: {w}")).collect::<Vec<_>>());
+            println!("scene: {name}, {} objects ({})", manip.names().len(), manip.names().join(", "));
+            LiveInput::with_scene(manip, source.clone(), announce).with_context(|| name.to_owned())?
+        }
+    };
+    let feed = Arc::new(Feed { input, records, clients: AtomicUsize::new(0) });
     let reporter = Arc::clone(&feed);
     std::thread::spawn(move || reporter.report());
-    if let Some(path) = &args.input {
+    if let Some(path) = &played {
         RecordingReader::open(path, args.format, &args.common)?; // fail now, not in the thread
         let (feed, path, format, common) = (Arc::clone(&feed), path.clone(), args.format, args.common.clone());
         std::thread::spawn(move || {

@@ -61,13 +61,17 @@ impl Feed {
 
     /// Plays a recording in real time, from its first record's time, over and over: each
     /// pass follows the previous one by its last interval between records, so the input's
-    /// clock runs on and the hand does not drop out between passes. Pauses longer than
-    /// [`MAX_PAUSE_S`] are shortened to it; unreadable records are counted on the first pass.
+    /// clock runs on and the hand does not drop out between passes; a scene starts over with
+    /// each pass. Pauses longer than [`MAX_PAUSE_S`] are shortened to it; unreadable records
+    /// are counted on the first pass.
     pub fn play(&self, path: &Path, format: Option<Format>, args: &InputArgs) -> anyhow::Result<()> {
         let start = Instant::now();
         let mut record = self.records.blank();
         let (mut shift, mut pass) = (0.0, 0);
         loop {
+            if pass > 0 {
+                self.input.reset_scene();
+            }
             let mut reader = RecordingReader::open(path, format, args)?;
             let (mut first, mut last, mut interval, mut played) = (None::<f64>, None::<f64>, FIRST_INTERVAL, 0.0);
             while let Some(read) = reader.next(&mut record)? {

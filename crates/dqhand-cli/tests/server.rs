@@ -194,6 +194,7 @@ fn streams_hello_topology_and_frames_and_applies_edits() {
     let hello = text(&mut ws);
     assert_eq!(hello["type"], "hello");
     assert_eq!(hello["joint_model"], "full");
+    assert!(hello["scene"].is_null(), "no scene without --scene: {}", hello["scene"]);
     let vertices = hello["vertices"].as_u64().unwrap() as u32;
     let Message::Binary(topology) = ws.read().unwrap() else { panic!("topology expected") };
     let topology = Topology::parse(&topology).unwrap();
@@ -498,4 +499,78 @@ fn the_input_socket_refuses_other_origins() {
     drop(senders);
     let mut viewer = connect(&server);
     assert_eq!(text(&mut viewer)["type"], "hello");
+}
+
+/// `--scene grasp` without an input plays the bundled grasp recording (`make recordings`):
+/// the hello carries the table and the objects' shapes, and scene messages follow the objects
+/// and the contacts until the hand holds the ball.
+#[test]
+fn a_scene_is_in_the_hello_and_streamed_until_the_ball_is_held() {
+    let server = start("scene", &["--scene", "grasp"]);
+    assert!(server.banner.contains("scene: grasp, 2 objects (ball, teapot)"), "{}", server.banner);
+    let mut ws = connect(&server);
+    let hello = text(&mut ws);
+    assert!(hello["input"]["source"].as_str().unwrap().ends_with("grasp-joints.jsonl"), "{}", hello["input"]);
+    let scene = &hello["scene"];
+    assert_eq!(scene["table"]["height"], 0.75);
+    assert!(scene["table"]["half"][0].as_f64().unwrap() >= 0.6, "{}", scene["table"]);
+    let objects = scene["objects"].as_array().unwrap();
+    assert_eq!(objects[0]["name"], "ball");
+    assert_eq!(objects[0]["shape"], "sphere");
+    assert!((objects[0]["radius"].as_f64().unwrap() - 0.04).abs() < 1e-6);
+    assert_eq!((&objects[1]["name"], &objects[1]["shape"], &objects[1]["simplified"]), (&"teapot".into(), &"mesh".into(), &false.into()));
+    let (positions, indices) = (objects[1]["positions"].as_array().unwrap(), objects[1]["indices"].as_array().unwrap());
+    assert!(indices.len() > 300 && indices.len() % 3 == 0 && positions.len() % 3 == 0, "{} indices, {} coordinates", indices.len(), positions.len());
+    assert!(indices.iter().all(|i| (i.as_u64().unwrap() as usize) < positions.len() / 3));
+    // The teapot is scaled 0.6 in the scene file: about 0.6 × 0.3 m wide.
+    let xs: Vec<f64> = positions.iter().step_by(3).map(|x| x.as_f64().unwrap()).collect();
+    let width = xs.iter().copied().fold(f64::MIN, f64::max) - xs.iter().copied().fold(f64::MAX, f64::min);
+    assert!((0.1..0.3).contains(&width), "teapot {width} m wide");
+    let (mut scenes, mut contacts, mut ball_moved) = (0, 0, false);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        assert!(Instant::now() < deadline, "the ball was never held: {scenes} scene messages, {contacts} with contacts");
+        let m = next_text(&mut ws);
+        if m["type"] != "scene" {
+            assert_eq!(m["type"], "input", "{m}");
+            continue;
+        }
+        scenes += 1;
+        assert!(m["objects"]["teapot"]["q"].as_array().unwrap().len() == 4, "{m}");
+        let ball = m["objects"]["ball"]["p"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect::<Vec<_>>();
+        ball_moved |= (ball[1] - 0.79).abs() > 0.01;
+        let c = m["contacts"].as_array().unwrap();
+        assert!(c.len() <= 64);
+        if let Some(c) = c.first() {
+            contacts += 1;
+            assert!(c["bone"].as_str().is_some() && c["p"].as_array().unwrap().len() == 3 && c["n"].as_array().unwrap().len() == 3, "{c}");
+        }
+        if m["held"] == "ball" {
+            break;
+        }
+        assert!(m["held"].is_null(), "{m}");
+    }
+    assert!(contacts > 0, "the hand touched the ball before holding it");
+    assert!(!ball_moved, "the ball rested on the table until it was held");
+    // Held, it is lifted with the hand.
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let m = next_text(&mut ws);
+        if m["type"] == "scene" && m["objects"]["ball"]["p"][1].as_f64().unwrap() > 0.85 {
+            assert_eq!(m["held"], "ball");
+            break;
+        }
+        assert!(Instant::now() < deadline, "the held ball was never lifted");
+    }
+}
+
+#[test]
+fn a_bad_scene_file_is_refused_naming_it() {
+    let dir = site("bad-scene");
+    let path = dir.join("scene.json");
+    std::fs::write(&path, r#"{"objects": [{"name": "ball", "shape": "sphere", "radius": -1, "position": [0, 1, 0], "mass": 1}]}"#).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["demo", "--no-open", "--port", "0", "--viewer"]).arg(dir.join("site")).arg("--scene").arg(&path).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&path.display().to_string()) && err.contains("radius"), "{err}");
 }

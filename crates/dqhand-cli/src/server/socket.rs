@@ -98,7 +98,7 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
             if update.hello {
                 ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, Some(input)))).map_err(io)?;
             }
-            if let Some(message) = update.message {
+            for message in [update.message, update.scene].into_iter().flatten() {
                 ws.send(Message::text(message)).map_err(io)?;
             }
         }

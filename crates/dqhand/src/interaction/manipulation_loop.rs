@@ -17,7 +17,7 @@ use glam::{Quat, Vec3};
 use super::{CommandTable, GestureLoop};
 use crate::collision::{fit_proxies, Contact, ContactConstraint, HandProxies, ObjectColliders, PROXY_MARGIN};
 use crate::engine::Engine;
-use crate::gesture::GestureSet;
+use crate::gesture::{Events, GestureSet};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
 use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
 use crate::kinematics::JointModel;
@@ -33,6 +33,8 @@ const MAX_STEP_S: f64 = 1.0 / 30.0;
 pub struct ManipulationLoop {
     input: GestureLoop,
     scene_commands: Option<CommandTable<SceneAction>>,
+    /// The scene command the last record triggered.
+    command: Option<SceneCommand>,
     objects: ObjectColliders,
     names: Vec<String>,
     constraint: ContactConstraint,
@@ -69,6 +71,7 @@ impl ManipulationLoop {
         Ok(Self {
             input,
             scene_commands,
+            command: None,
             names: scene.objects.iter().map(|o| o.name.clone()).collect(),
             objects,
             constraint,
@@ -82,19 +85,36 @@ impl ManipulationLoop {
         })
     }
 
-    /// Takes one record (`arrival` as in [`GestureLoop::push`]); a scene action its gesture
-    /// completes is carried out at the next [`Self::step`]. Allocates nothing.
+    /// The loop with the input configuration's viewer commands too ([`GestureLoop::with_commands`]),
+    /// where gestures also drive a viewer.
+    ///
+    /// # Errors
+    /// As [`GestureLoop::with_commands`].
+    pub fn with_commands(mut self) -> Result<Self> {
+        self.input = self.input.with_commands()?;
+        Ok(self)
+    }
+
+    /// Takes one record (`arrival` as in [`GestureLoop::push`]) and returns the gesture events
+    /// it caused; a scene action its gesture completes ([`Self::command`]) is carried out at
+    /// the next [`Self::step`]. Allocates nothing.
     ///
     /// # Errors
     /// The record's refusal; the hand keeps its pose.
-    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> std::result::Result<(), Rejection> {
+    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> std::result::Result<Events<'_>, Rejection> {
+        self.command = None;
         let events = self.input.push(record, arrival)?;
         if let Some(table) = &mut self.scene_commands {
-            if table.update(record.time, events) == Some(SceneCommand::Reset) {
-                self.reset_due = true;
-            }
+            self.command = table.update(record.time, events.clone());
+            self.reset_due |= self.command == Some(SceneCommand::Reset);
         }
-        Ok(())
+        Ok(events)
+    }
+
+    /// The scene command (a row of the scene's `actions`) that the last record triggered.
+    #[must_use]
+    pub fn command(&self) -> Option<SceneCommand> {
+        self.command
     }
 
     /// Counts a record refused before it reached the loop.

@@ -26,7 +26,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result, SceneProblem};
 
@@ -113,7 +113,7 @@ pub struct SceneAction {
 }
 
 /// What a scene gesture does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SceneCommand {
     /// Every object back where the file puts it, at rest.

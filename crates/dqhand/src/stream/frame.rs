@@ -21,7 +21,34 @@
 //!    then per mesh: f32 positions[3 · vertex count], f32 normals[3 · vertex count],
 //!                   (flag 0) f32 distortion[vertex count]
 //! ```
+//!
+//! With a scene (`dqhand demo --scene`) two JSON texts join them. The hello's `scene` (null
+//! without one; [`scene_hello`]): the table's top and each object's shape in its own frame,
+//! metres, +Y up; a mesh's triangles scaled as the physics has them, at most
+//! [`MAX_SCENE_TRIANGLES`] in all (a mesh past that is sent as its bounding box, 12 triangles,
+//! with `"simplified": true`, so a huge mesh cannot make the hello huge):
+//! ```json
+//! {"table": {"height": 0.75, "centre": [0.0, -0.35], "half": [0.6, 0.4]},
+//!  "objects": [{"name": "ball", "shape": "sphere", "radius": 0.04},
+//!              {"name": "cube", "shape": "box", "size": [0.06, 0.06, 0.06]},
+//!              {"name": "mug", "shape": "cylinder", "radius": 0.04, "height": 0.1},
+//!              {"name": "teapot", "shape": "mesh", "positions": [0.1, 0.0, 0.02, …],
+//!               "indices": [0, 1, 2, …], "simplified": false}]}
+//! ```
+//! Then, as the objects move ([`scene_message`]): the object held, every object's pose
+//! (rotation `[x, y, z, w]`) and the rendered hand's contacts, at most [`MAX_SCENE_CONTACTS`]
+//! (the bone touching, the point on the object, the object's normal there toward the hand):
+//! ```json
+//! {"type": "scene", "held": "ball", "objects": {"ball": {"p": [x, y, z], "q": [x, y, z, w]}, …},
+//!  "contacts": [{"bone": "thumb-tip", "object": "ball", "p": [x, y, z], "n": [x, y, z]}]}
+//! ```
+//! Both stay bounded: a scene has at most [`MAX_SCENE_OBJECTS`] objects, named in at most
+//! [`MAX_NAME_BYTES`] bytes ([`check_scene`]).
 
+use glam::Vec3;
+use serde_json::{json, Map, Value};
+
+use crate::interaction::ManipulationLoop;
 use crate::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
@@ -318,4 +345,86 @@ impl Topology {
         r.end()?;
         Ok(Self { vertex_count, indices, parents })
     }
+}
+
+/// Triangles of mesh objects a hello carries at most, in all.
+pub const MAX_SCENE_TRIANGLES: usize = 50_000;
+/// Contacts a scene message carries at most.
+pub const MAX_SCENE_CONTACTS: usize = 64;
+/// Objects a streamed scene may have.
+pub const MAX_SCENE_OBJECTS: usize = 256;
+/// Bytes of an object's name in a streamed scene, at most.
+pub const MAX_NAME_BYTES: usize = 64;
+
+/// Whether the scene of `manip` fits the bounds of the scene messages.
+///
+/// # Errors
+/// [`Error::Frame`] naming the bound the scene exceeds.
+pub fn check_scene(manip: &ManipulationLoop) -> Result<()> {
+    let names = manip.names();
+    if names.len() > MAX_SCENE_OBJECTS {
+        return Err(Error::Frame(format!("a scene of {} objects (the viewer takes at most {MAX_SCENE_OBJECTS})", names.len())));
+    }
+    match names.iter().find(|n| n.len() > MAX_NAME_BYTES) {
+        Some(n) => Err(Error::Frame(format!("object name {n:?} is longer than {MAX_NAME_BYTES} bytes"))),
+        None => Ok(()),
+    }
+}
+
+/// The hello's `scene`: the table and the objects' shapes (see the module documentation).
+#[must_use]
+pub fn scene_hello(manip: &ManipulationLoop) -> Value {
+    let table = manip.physics().table().map(|(height, centre, half)| json!({ "height": height, "centre": centre, "half": half }));
+    let mut budget = MAX_SCENE_TRIANGLES;
+    let objects: Vec<Value> = manip
+        .objects()
+        .objects()
+        .iter()
+        .map(|o| {
+            let (name, s) = (&o.name, &o.surface);
+            if let Some(mesh) = &o.mesh {
+                let simplified = mesh.triangles.len() > budget;
+                let (positions, indices): (Vec<f32>, Vec<u32>) = if simplified {
+                    let (lo, hi) = mesh.vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+                    let corners = (0..8).flat_map(|k| [if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z }]);
+                    (corners.collect(), BOX_TRIANGLES.to_vec())
+                } else {
+                    budget -= mesh.triangles.len();
+                    (mesh.vertices.iter().flat_map(|v| v.to_array()).collect(), mesh.triangles.as_flattened().to_vec())
+                };
+                json!({ "name": name, "shape": "mesh", "positions": positions, "indices": indices, "simplified": simplified })
+            } else if let Some(ball) = s.as_ball() {
+                json!({ "name": name, "shape": "sphere", "radius": ball.radius })
+            } else if let Some(cuboid) = s.as_cuboid() {
+                json!({ "name": name, "shape": "box", "size": (2.0 * cuboid.half_extents).to_array() })
+            } else {
+                let cylinder = s.as_cylinder().expect("an object is a mesh, ball, cuboid or cylinder (ObjectColliders::new)");
+                json!({ "name": name, "shape": "cylinder", "radius": cylinder.radius, "height": 2.0 * cylinder.half_height })
+            }
+        })
+        .collect();
+    json!({ "table": table, "objects": objects })
+}
+
+/// The 12 outward triangles of a box whose corner `k` has bit 0, 1, 2 set for the high x, y, z.
+const BOX_TRIANGLES: [u32; 36] = [
+    0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, // −z, +z
+    0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, // −y, +y
+    0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5, // −x, +x
+];
+
+/// A `scene` message: the object held, the objects' poses and the contacts after the loop's
+/// last step (see the module documentation).
+#[must_use]
+pub fn scene_message(manip: &ManipulationLoop) -> String {
+    let names = manip.names();
+    let joints = manip.rendered().skeleton().joints();
+    let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({ "p": p.to_array(), "q": q.to_array() }))).collect();
+    let contacts: Vec<Value> = manip
+        .contacts()
+        .iter()
+        .take(MAX_SCENE_CONTACTS)
+        .map(|c| json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() }))
+        .collect();
+    json!({ "type": "scene", "held": manip.held(), "objects": objects, "contacts": contacts }).to_string()
 }

@@ -1,7 +1,9 @@
 //! Live input for the viewers: one user's hand (a recording played in real time, a UDP
 //! stream, the server's `/input` WebSocket) drives every connected viewer through one shared
-//! [`GestureLoop`]. Each viewer follows its pose, applies its gesture commands to its own view
-//! and is told the tracking state, the current gesture and the events in `input` messages:
+//! [`GestureLoop`], or with a scene one shared [`ManipulationLoop`] (which wraps one). Each
+//! viewer follows its pose (with a scene the rendered, contact-constrained one), applies its
+//! gesture commands to its own view and is told the tracking state, the current gesture and
+//! the events in `input` messages (`reset`: a scene's action):
 //!
 //! ```json
 //! {"type": "input", "tracking": "tracking", "gesture": "fist",
@@ -10,26 +12,40 @@
 //!  "accepted": 120, "rejected": 0}
 //! ```
 //!
+//! With a scene, viewers are also sent `scene` messages ([`super::frame::scene_message`]):
+//! at once when the object held changes, otherwise at most every [`SCENE_PERIOD`] while the
+//! scene moves.
+//!
 //! Sources push records from their own threads; viewers read at their frame rate. The lock
-//! is held for one record or one frame's update, never across I/O.
+//! is held for one record or one frame's update, never across I/O. A scene's loop steps with
+//! each record and, between records, in whichever viewer's update finds a step due
+//! ([`STEP_PERIOD`]): objects fall and the hand's tracking is judged without a thread of its own.
 
 use std::collections::VecDeque;
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
+use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 
+use super::frame::{check_scene, scene_hello, scene_message};
 use super::Session;
-use crate::gesture::{Event, EventKind};
+use crate::gesture::{Event, EventKind, Events};
 use crate::input::{Action, Record, Rejection, Tracking};
-use crate::interaction::GestureLoop;
-use crate::kinematics::JointModel;
+use crate::interaction::{GestureLoop, ManipulationLoop};
+use crate::kinematics::{JointModel, Pose};
+use crate::scene::SceneCommand;
+use crate::Result;
 
 /// Log entries kept for viewers that have not read them yet; a viewer further behind misses
 /// the oldest (its pose and state are still current).
 const LOG_CAPACITY: usize = 256;
 /// A change of the record counters alone is reported at most this often.
 const COUNTER_PERIOD: Duration = Duration::from_millis(250);
+/// A scene's loop steps at least this often (s) while viewers watch, records or not.
+pub const STEP_PERIOD: f64 = 1.0 / 60.0;
+/// A moving scene is reported at most this often (s); a grasp or release at once.
+pub const SCENE_PERIOD: f64 = 1.0 / 30.0;
 
 /// One user's hand shared by the viewers of a server.
 pub struct LiveInput {
@@ -37,21 +53,87 @@ pub struct LiveInput {
     announce: bool,
     gestures: Vec<String>,
     joint_model: JointModel,
+    /// The hello's `scene` (built once: a mesh's triangles are many).
+    scene: Option<Value>,
     start: Instant,
     state: Mutex<State>,
 }
 
 struct State {
-    gesture_loop: GestureLoop,
+    driver: Driver,
+    /// Poses taken or stepped: a viewer whose last one is older follows the new one.
+    posed: u64,
     log: VecDeque<Entry>,
     /// Entries ever logged: the sequence number of the next one.
     logged: u64,
+}
+
+/// What the records drive.
+enum Driver {
+    Gestures(Box<GestureLoop>),
+    Scene(Box<SceneState>),
+}
+
+/// A scene's loop and what its viewers have been told.
+struct SceneState {
+    manip: ManipulationLoop,
+    /// The input's clock at the last step.
+    stepped: f64,
+    /// Steps that changed what a scene message says.
+    version: u64,
+    /// The objects' poses, the contact count and the object held as of `version`.
+    poses: Vec<(Quat, Vec3)>,
+    contacts: usize,
+    held: Option<usize>,
+    /// The scene message of `message.0`, built once for every viewer.
+    message: (u64, String),
+}
+
+impl SceneState {
+    /// One step of the loop at `now`, noting whether the scene message changed. Allocates nothing.
+    fn step(&mut self, now: f64) {
+        self.manip.step(now);
+        self.stepped = now;
+        let (poses, contacts) = (self.manip.poses(), self.manip.contacts().len());
+        let held = self.manip.held().and_then(|h| self.manip.names().iter().position(|n| n == h));
+        if poses != self.poses.as_slice() || contacts + self.contacts > 0 || held != self.held {
+            self.poses.copy_from_slice(poses);
+            (self.contacts, self.held) = (contacts, held);
+            self.version += 1;
+        }
+    }
+}
+
+impl Driver {
+    /// The gesture loop (a scene's: the one under its manipulation loop).
+    fn gestures(&self) -> &GestureLoop {
+        match self {
+            Driver::Gestures(g) => g,
+            Driver::Scene(s) => s.manip.input(),
+        }
+    }
+
+    fn push(&mut self, record: &Record, arrival: f64) -> std::result::Result<Events<'_>, Rejection> {
+        match self {
+            Driver::Gestures(g) => g.push(record, Some(arrival)),
+            Driver::Scene(s) => s.manip.push(record, Some(arrival)),
+        }
+    }
+
+    /// The pose viewers show: the tracked one, or with a scene the rendered one.
+    fn pose(&self) -> &Pose {
+        match self {
+            Driver::Gestures(g) => g.pipeline().pose(),
+            Driver::Scene(s) => s.manip.constraint().rendered(),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
 enum Entry {
     Event { t: f64, event: EventKind, gesture: usize },
     Action { t: f64, gesture: usize, action: Action },
+    Scene { t: f64, gesture: usize, command: SceneCommand },
 }
 
 /// What one viewer has taken from the input so far.
@@ -63,6 +145,8 @@ pub struct InputView {
     /// The next log entry to read.
     next: u64,
     sent: Option<Sent>,
+    /// The scene version last sent, the object held then, and when (the input's clock).
+    scene: Option<(u64, Option<usize>, f64)>,
 }
 
 /// The state a viewer was last told, and when (the input's clock).
@@ -82,6 +166,8 @@ pub struct InputUpdate {
     pub hello: bool,
     /// An `input` message to send.
     pub message: Option<String>,
+    /// A `scene` message to send.
+    pub scene: Option<String>,
 }
 
 impl LiveInput {
@@ -90,10 +176,27 @@ impl LiveInput {
     /// record (the demo's `/input` WebSocket, open whether or not anyone uses it).
     #[must_use]
     pub fn new(gesture_loop: GestureLoop, source: impl Into<String>, announce: bool) -> Self {
+        Self::driving(Driver::Gestures(Box::new(gesture_loop)), None, source.into(), announce)
+    }
+
+    /// The input of `manip`'s scene, as [`Self::new`]: viewers follow its rendered hand and
+    /// are sent the scene.
+    ///
+    /// # Errors
+    /// As [`check_scene`]: a scene too large to stream.
+    pub fn with_scene(manip: ManipulationLoop, source: impl Into<String>, announce: bool) -> Result<Self> {
+        check_scene(&manip)?;
+        let scene = Some(scene_hello(&manip));
+        let state = SceneState { poses: manip.poses().to_vec(), contacts: 0, held: None, stepped: 0.0, version: 0, message: (u64::MAX, String::new()), manip };
+        Ok(Self::driving(Driver::Scene(Box::new(state)), scene, source.into(), announce))
+    }
+
+    fn driving(driver: Driver, scene: Option<Value>, source: String, announce: bool) -> Self {
+        let gesture_loop = driver.gestures();
         let gestures = gesture_loop.gestures().map_or_else(Vec::new, |set| set.gestures().iter().map(|g| g.name().to_owned()).collect());
         let joint_model = gesture_loop.pipeline().retargeter().rig().model();
-        let state = State { gesture_loop, log: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
-        Self { source: source.into(), announce, gestures, joint_model, start: Instant::now(), state: Mutex::new(state) }
+        let state = State { driver, posed: 0, log: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
+        Self { source, announce, gestures, joint_model, scene, start: Instant::now(), state: Mutex::new(state) }
     }
 
     /// The index of the gesture called `name` in the recognised set.
@@ -119,24 +222,30 @@ impl LiveInput {
         self.active().then(|| json!({ "source": self.source, "gestures": self.gestures }))
     }
 
+    /// The hello's `scene`: the table and the objects' shapes; `None` without a scene.
+    #[must_use]
+    pub fn scene(&self) -> Option<&Value> {
+        self.scene.as_ref()
+    }
+
     fn active(&self) -> bool {
         self.announce || {
             let state = self.lock();
-            let pipeline = state.gesture_loop.pipeline();
+            let pipeline = state.driver.gestures().pipeline();
             pipeline.accepted() + pipeline.rejections().total() > 0
         }
     }
 
-    /// Takes one record arriving now; `taken` sees it once the loop has taken it, in the order
-    /// records are taken (under the input's lock: recording it there keeps a recording in
-    /// that order when several sources send at once).
+    /// Takes one record arriving now (and steps a scene's loop); `taken` sees it once the loop
+    /// has taken it, in the order records are taken (under the input's lock: recording it
+    /// there keeps a recording in that order when several sources send at once).
     ///
     /// # Errors
     /// The record's refusal (counted, and reported to the viewers in the totals).
     pub fn push(&self, record: &Record, taken: impl FnOnce(&Record)) -> Result<(), Rejection> {
         let arrival = self.clock();
         let mut guard = self.lock();
-        let State { gesture_loop, log, logged } = &mut *guard;
+        let State { driver, posed, log, logged } = &mut *guard;
         let mut add = |entry| {
             if log.len() == LOG_CAPACITY {
                 log.pop_front();
@@ -145,43 +254,71 @@ impl LiveInput {
             *logged += 1;
         };
         let index = |name: &str| self.index(name).expect("events name gestures of the set");
-        for e in gesture_loop.push(record, Some(arrival))? {
+        for e in driver.push(record, arrival)? {
             add(Entry::Event { t: e.t, event: e.event, gesture: index(e.gesture) });
         }
         taken(record);
+        *posed += 1;
+        let gesture_loop = driver.gestures();
         if let (Some(action), Some(gesture)) = (gesture_loop.action(), gesture_loop.gesture()) {
             add(Entry::Action { t: record.time, gesture: index(gesture), action });
+        }
+        if let Driver::Scene(s) = driver {
+            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.input().gesture()) {
+                add(Entry::Scene { t: record.time, gesture: index(gesture), command });
+            }
+            s.step(arrival);
         }
         Ok(())
     }
 
+    /// Puts a scene's objects back where the scene file has them (a played recording starting
+    /// over grasps them where they were); without a scene, nothing.
+    pub fn reset_scene(&self) {
+        if let Driver::Scene(s) = &mut self.lock().driver {
+            s.manip.reset();
+        }
+    }
+
     /// Counts a record refused before it got here (unreadable, too large).
     pub fn reject(&self, rejection: Rejection) {
-        self.lock().gesture_loop.reject(rejection);
+        match &mut self.lock().driver {
+            Driver::Gestures(g) => g.reject(rejection),
+            Driver::Scene(s) => s.manip.reject(rejection),
+        }
     }
 
     /// The records taken so far, and the refusals, one line per kind (for a log).
     #[must_use]
     pub fn summary(&self) -> (u64, u64, Vec<String>) {
         let state = self.lock();
-        let pipeline = state.gesture_loop.pipeline();
+        let pipeline = state.driver.gestures().pipeline();
         (pipeline.accepted(), pipeline.rejections().total(), pipeline.rejections().summary().collect())
     }
 
     /// A viewer's view of the input, from now on (earlier events are not replayed to it).
     #[must_use]
     pub fn view(&self) -> InputView {
-        InputView { announced: self.active(), version: 0, next: self.lock().logged, sent: None }
+        InputView { announced: self.active(), version: 0, next: self.lock().logged, sent: None, scene: None }
     }
 
     /// Brings one viewer up to date, once per frame: marks the hand lost after the grace
-    /// time, gives `session` the newest pose and the gesture commands since its last update,
-    /// and says what to send.
+    /// time (steps a scene's loop when a step is due), gives `session` the newest pose and the
+    /// gesture commands since its last update, and says what to send.
     pub fn update(&self, session: &mut Session, view: &mut InputView) -> InputUpdate {
         let arrival = self.clock();
-        let mut state = self.lock();
-        state.gesture_loop.advance(arrival);
-        let pipeline = state.gesture_loop.pipeline();
+        let mut guard = self.lock();
+        let state = &mut *guard;
+        match &mut state.driver {
+            Driver::Gestures(g) => g.advance(arrival),
+            Driver::Scene(s) if arrival - s.stepped >= STEP_PERIOD => {
+                s.step(arrival);
+                state.posed += 1;
+            }
+            Driver::Scene(_) => {}
+        }
+        let gesture_loop = state.driver.gestures();
+        let pipeline = gesture_loop.pipeline();
         let (accepted, rejected) = (pipeline.accepted(), pipeline.rejections().total());
         let mut update = InputUpdate::default();
         if !view.announced {
@@ -191,9 +328,9 @@ impl LiveInput {
             view.announced = true;
             update.hello = true;
         }
-        if accepted != view.version {
-            session.follow(pipeline.pose(), self.joint_model);
-            view.version = accepted;
+        if state.posed != view.version {
+            session.follow(state.driver.pose(), self.joint_model);
+            view.version = state.posed;
         }
         let first = state.logged - state.log.len() as u64;
         let new = state.log.iter().skip(view.next.saturating_sub(first) as usize);
@@ -205,10 +342,11 @@ impl LiveInput {
                     session.act(action);
                     actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action }));
                 }
+                Entry::Scene { t, gesture, command } => actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": command })),
             }
         }
         view.next = state.logged;
-        let gesture = state.gesture_loop.gesture().and_then(|g| self.index(g));
+        let gesture = gesture_loop.gesture().and_then(|g| self.index(g));
         let sent = Sent { tracking: pipeline.tracking(), gesture, accepted, rejected, at: arrival };
         let due = match view.sent {
             None => true,
@@ -232,6 +370,19 @@ impl LiveInput {
                 .to_string(),
             );
             view.sent = Some(sent);
+        }
+        if let Driver::Scene(s) = &mut state.driver {
+            let due = match view.scene {
+                None => true,
+                Some((version, held, at)) => version != s.version && (held != s.held || arrival - at >= SCENE_PERIOD),
+            };
+            if due {
+                if s.message.0 != s.version {
+                    s.message = (s.version, scene_message(&s.manip));
+                }
+                update.scene = Some(s.message.1.clone());
+                view.scene = Some((s.version, s.held, arrival));
+            }
         }
         update
     }

@@ -11,5 +11,5 @@ mod session;
 
 pub use command::Command;
 pub use frame::{FrameHeader, FrameView, FrameWriter, Topology};
-pub use live_input::{InputUpdate, InputView, LiveInput};
+pub use live_input::{InputUpdate, InputView, LiveInput, SCENE_PERIOD, STEP_PERIOD};
 pub use session::{Applied, Session, GESTURE_SECONDS};

@@ -82,7 +82,7 @@ impl Session {
     }
 
     /// The JSON greeting: the model, the DOFs with their ranges, the gestures, sequences and
-    /// methods the page can ask for, and the live input driving the hand, if any.
+    /// methods the page can ask for, the live input driving the hand and its scene, if any.
     #[must_use]
     pub fn hello(&self, max_message_bytes: usize, input: Option<&LiveInput>) -> String {
         let model = self.joint_model();
@@ -107,6 +107,7 @@ impl Session {
             "gesture_seconds": GESTURE_SECONDS,
             "max_message_bytes": max_message_bytes,
             "input": input.and_then(LiveInput::describe),
+            "scene": input.and_then(LiveInput::scene),
         })
         .to_string()
     }
