@@ -379,9 +379,10 @@ describe('the viewer page with a scene', () => {
       90_000,
     );
     await settle(p);
-    // The objects' blues and the table's wood, on the canvas.
-    expect(await countColour(p, { r: [0, 120], g: [40, 190], b: [150, 255] })).toBeGreaterThan(200);
-    expect(await countColour(p, { r: [120, 230], g: [80, 180], b: [40, 130] })).toBeGreaterThan(2000);
+    // The objects' blues and the table's wood, on the canvas (polled: a loaded machine may
+    // read the canvas between the state and the next drawn frame).
+    await expect.poll(() => countColour(p, { r: [0, 120], g: [40, 190], b: [150, 255] }), { timeout: 30_000, interval: 500 }).toBeGreaterThan(200);
+    await expect.poll(() => countColour(p, { r: [120, 230], g: [80, 180], b: [40, 130] }), { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
   });
 
   test('shows the ball held while the bundled recording grasps it', async () => {
