@@ -8,6 +8,7 @@ use std::sync::{Arc, OnceLock};
 
 use dqhand::collision::ObjectColliders;
 use dqhand::grasp::{GraspEvent, GraspParams};
+use dqhand::interaction::benchmark;
 use dqhand::hand::{HandParams, Side};
 use dqhand::input::InputConfig;
 use dqhand::interaction::grasp_script::{self, GraspTask, Script};
@@ -166,4 +167,44 @@ fn a_dropped_ball_bounces_and_rests_on_the_table_a_thrown_one_flies() {
     physics.step(1.0 / 60.0);
     let (p, v) = (physics.pose(0).1, physics.velocity(0).0);
     assert!((v.x - 2.0).abs() < 0.05 && p.x > 0.02, "keeps the hand's velocity: {v} at {p}");
+}
+
+#[test]
+fn skin_depth_is_measured_against_the_true_surface_of_primitives_and_meshes() {
+    // A closed cube mesh, 10 cm, and a 4 cm ball, against plain geometry (mesh depths within
+    // MESH_DEPTH_RANGE_M of the surface, as measured).
+    let dir = std::env::temp_dir().join(format!("dqhand-depth-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let h = 0.05;
+    let mut obj = String::new();
+    for i in 0..8 {
+        let c = |bit: i32| if i & bit == 0 { -h } else { h };
+        obj += &format!("v {} {} {}\n", c(1), c(2), c(4));
+    }
+    // Outward counter-clockwise faces of the cube (1-based OBJ indices).
+    for f in ["1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6"] {
+        let v: Vec<&str> = f.split(' ').collect();
+        obj += &format!("f {} {} {}\nf {} {} {}\n", v[0], v[1], v[2], v[0], v[2], v[3]);
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("scene.json"),
+        r#"{"objects": [{"name": "cube", "shape": "mesh", "file": "cube.obj", "position": [1, 0, 0], "mass": 1},
+                        {"name": "ball", "shape": "sphere", "radius": 0.04, "position": [0, 1, 0], "mass": 1}]}"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&dir.join("scene.json")).unwrap();
+    let objects = ObjectColliders::new(&scene).unwrap();
+    let (cube, ball) = (&objects.objects()[0], &objects.objects()[1]);
+    let m = cube.mesh.as_ref().unwrap();
+    let flat = (m.vertices.iter().map(|v| v.to_array()).collect::<Vec<_>>(), m.triangles.iter().flatten().copied().collect::<Vec<_>>());
+    for (p, want) in [(Vec3::new(1.0, 0.042, 0.0), 0.008), (Vec3::new(1.045, 0.0, 0.01), 0.005), (Vec3::new(1.0, 0.06, 0.0), 0.0), (Vec3::new(0.9, 0.0, 0.0), 0.0)] {
+        let got = benchmark::depth(cube, Some(&flat), p);
+        assert!((got - want).abs() < 1e-5, "cube mesh: depth of {p} is {got}, not {want}");
+    }
+    for (p, want) in [(Vec3::new(0.0, 1.01, 0.0), 0.03), (Vec3::new(0.0, 1.0, 0.039), 0.001), (Vec3::new(0.03, 1.03, 0.0), 0.0)] {
+        let got = benchmark::depth(ball, None, p);
+        assert!((got - want).abs() < 1e-5, "ball: depth of {p} is {got}, not {want}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

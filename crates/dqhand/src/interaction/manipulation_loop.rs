@@ -128,7 +128,8 @@ impl ManipulationLoop {
     }
 
     /// One frame at `now` (s; the records' clock): see the module documentation. Returns
-    /// the grasp or release it caused. Allocates nothing.
+    /// the grasp or release it caused. Its own work allocates nothing; rapier's step inside
+    /// it allocates a few times a frame.
     pub fn step(&mut self, now: f64) -> Option<GraspEvent> {
         self.input.advance(now);
         let dt = self.last.map_or(1.0 / 60.0, |last| (now - last).clamp(0.0, MAX_STEP_S));
