@@ -330,7 +330,8 @@ fn report(args: &Args, sources: &[SourceRun], retarget: &RetargetRun) -> Value {
     })
 }
 
-fn pass(ok: bool) -> &'static str {
+/// A target's verdict, as every bench prints it.
+pub(crate) fn pass(ok: bool) -> &'static str {
     if ok {
         "pass"
     } else {

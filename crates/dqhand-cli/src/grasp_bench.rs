@@ -181,11 +181,7 @@ fn report(runs: &[Run]) -> Value {
 }
 
 fn pass(ok: &Value) -> &'static str {
-    if ok.as_bool() == Some(true) {
-        "pass"
-    } else {
-        "FAIL"
-    }
+    crate::gesture_bench::pass(ok.as_bool() == Some(true))
 }
 
 /// Prints the report as tables.

@@ -458,16 +458,4 @@ impl ContactConstraint {
     pub fn closure(&self) -> &[Closure; 5] {
         &self.closure
     }
-
-    /// Whether the rendered wrist is held back from the tracked one by an object.
-    #[must_use]
-    pub fn wrist_held_back(&self) -> bool {
-        self.held_back_since.is_some()
-    }
-
-    /// The proxies.
-    #[must_use]
-    pub fn proxies(&self) -> &HandProxies {
-        &self.proxies
-    }
 }

@@ -13,5 +13,5 @@ mod proxy;
 
 pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S};
 pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
-pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop, TABLE_HALF_THICKNESS, TABLE_MARGIN};
+pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};

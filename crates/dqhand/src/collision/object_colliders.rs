@@ -63,7 +63,8 @@ impl ObjectCollider {
     }
 }
 
-/// The table's top: a slab reaching [`TABLE_MARGIN`] past the objects' footprint.
+/// The table's top: a slab 5 cm thick reaching 30 cm past the objects' footprint, at least
+/// 1.2 × 0.8 m.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TableTop {
     /// Height of the top (y), m.
@@ -75,9 +76,9 @@ pub struct TableTop {
 }
 
 /// Half the thickness of the table's slab, m.
-pub const TABLE_HALF_THICKNESS: f32 = 0.025;
+const TABLE_HALF_THICKNESS: f32 = 0.025;
 /// How far the table reaches past its objects, m.
-pub const TABLE_MARGIN: f32 = 0.3;
+const TABLE_MARGIN: f32 = 0.3;
 /// The table's least half sizes (x, z), m.
 const TABLE_MIN_HALF: [f32; 2] = [0.6, 0.4];
 

@@ -218,12 +218,6 @@ impl ManipulationLoop {
         &self.objects
     }
 
-    /// The physics (the table, velocities).
-    #[must_use]
-    pub fn physics(&self) -> &ScenePhysics {
-        &self.physics
-    }
-
     /// The contact constraint (the tracked and rendered poses, finger closures).
     #[must_use]
     pub fn constraint(&self) -> &ContactConstraint {

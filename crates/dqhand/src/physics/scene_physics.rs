@@ -18,7 +18,6 @@ pub struct ScenePhysics {
     /// Where the file puts each object.
     initial: Vec<Pose>,
     held: Option<usize>,
-    table: Option<(f32, [f32; 2], [f32; 2])>,
 }
 
 impl ScenePhysics {
@@ -39,18 +38,10 @@ impl ScenePhysics {
             bodies.push(handle);
             initial.push(pose);
         }
-        let table = colliders.table().map(|t| {
-            let slab = colliders.table_collider().expect("a table top has its slab");
+        if let Some(slab) = colliders.table_collider() {
             world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(0.8).restitution(0.3).build(), None);
-            (t.height, t.centre, t.half)
-        });
-        Self { world, bodies, initial, held: None, table }
-    }
-
-    /// The table's top: its height, centre (x, z) and half sizes (x, z), if there is one.
-    #[must_use]
-    pub fn table(&self) -> Option<(f32, [f32; 2], [f32; 2])> {
-        self.table
+        }
+        Self { world, bodies, initial, held: None }
     }
 
     /// Object `i`'s pose: rotation and translation.

@@ -374,7 +374,7 @@ pub fn check_scene(manip: &ManipulationLoop) -> Result<()> {
 /// The hello's `scene`: the table and the objects' shapes (see the module documentation).
 #[must_use]
 pub fn scene_hello(manip: &ManipulationLoop) -> Value {
-    let table = manip.physics().table().map(|(height, centre, half)| json!({ "height": height, "centre": centre, "half": half }));
+    let table = manip.objects().table().map(|t| json!({ "height": t.height, "centre": t.centre, "half": t.half }));
     let mut budget = MAX_SCENE_TRIANGLES;
     let objects: Vec<Value> = manip
         .objects()

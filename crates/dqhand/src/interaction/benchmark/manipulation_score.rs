@@ -12,6 +12,7 @@
 use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
+use parry3d::bounding_volume::Aabb;
 use parry3d::query::Ray;
 use serde::Serialize;
 
@@ -30,6 +31,9 @@ pub const PLACE_TOLERANCE_M: f32 = 0.03;
 /// is too slow for every vertex of every frame, and skin deeper than this would have crossed
 /// the surface within it on its way in (the palm-crossing check counts a hand gone further).
 pub const MESH_DEPTH_RANGE_M: f32 = 0.01;
+
+/// A mesh's vertex positions and flat triangle indices, as the winding number reads them.
+pub type FlatMesh = (Vec<[f32; 3]>, Vec<u32>);
 
 /// What one scripted run measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -57,27 +61,23 @@ pub struct RunScore {
 /// How deep `p` (world) is inside `object`'s true surface, m; 0 outside. `mesh` is the
 /// object's triangles flattened for the winding number (a mesh object's only).
 #[must_use]
-pub fn depth(object: &ObjectCollider, mesh: Option<&(Vec<[f32; 3]>, Vec<u32>)>, p: Vec3) -> f32 {
+pub fn depth(object: &ObjectCollider, mesh: Option<&FlatMesh>, p: Vec3) -> f32 {
     if !object.aabb().contains_local_point(p) {
         return 0.0;
     }
     let local = object.pose.inverse_transform_point(p);
-    match mesh {
-        Some((positions, indices)) => {
-            let distance = object.surface.project_local_point(local, false).point.distance(local);
-            if distance > MESH_DEPTH_RANGE_M || winding_number(positions, indices, local) < 0.5 {
-                return 0.0;
-            }
-            distance
-        }
-        None => {
-            let projection = object.surface.project_local_point(local, true);
-            if projection.is_inside {
-                object.surface.project_local_point(local, false).point.distance(local)
-            } else {
-                0.0
-            }
-        }
+    // Projected onto the boundary (not solid): the nearest surface point, and whether `p` is
+    // inside, which a primitive knows exactly and a mesh's winding number decides.
+    let projection = object.surface.project_local_point(local, false);
+    let distance = projection.point.distance(local);
+    let inside = match mesh {
+        Some((positions, indices)) => distance <= MESH_DEPTH_RANGE_M && winding_number(positions, indices, local) >= 0.5,
+        None => projection.is_inside,
+    };
+    if inside {
+        distance
+    } else {
+        0.0
     }
 }
 
@@ -87,7 +87,7 @@ pub fn depth(object: &ObjectCollider, mesh: Option<&(Vec<[f32; 3]>, Vec<u32>)>, 
 /// # Panics
 /// If the loop's skeleton lacks the WebXR joints (the built-in hand has them).
 pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carried_to: Vec3) -> RunScore {
-    let meshes: Vec<Option<(Vec<[f32; 3]>, Vec<u32>)>> = manip
+    let meshes: Vec<Option<FlatMesh>> = manip
         .objects()
         .objects()
         .iter()
@@ -124,12 +124,12 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         }
         if t >= times.carry_start && t <= times.carry_end {
             held_through_carry &= held;
-        }
-        if t >= times.carry_start && t <= times.carry_end && held {
-            let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().expect("a rig").wrist()];
-            let here = wrist.inverse().transform_point3(manip.poses()[object].1);
-            let first = *in_wrist.get_or_insert(here);
-            score.slip_m = score.slip_m.max(here.distance(first));
+            if held {
+                let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().expect("a rig").wrist()];
+                let here = wrist.inverse().transform_point3(manip.poses()[object].1);
+                let first = *in_wrist.get_or_insert(here);
+                score.slip_m = score.slip_m.max(here.distance(first));
+            }
         }
         if let Some(GraspEvent::Release { object: o, .. }) = event {
             if o == object && t >= times.release && !released {
@@ -176,9 +176,5 @@ fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3)
         return false;
     }
     let ray = Ray::new(from, (to - from) / length);
-    let n = objects.objects().len() + usize::from(objects.table().is_some());
-    (0..n).filter(|&i| Some(i) != skip).any(|i| {
-        let o = objects.collider(i);
-        o.surface.cast_ray(&o.pose, &ray, length, false).is_some()
-    })
+    objects.near(&Aabb::from_points([from, to]), 0.0, skip).any(|(_, o)| o.surface.cast_ray(&o.pose, &ray, length, false).is_some())
 }
