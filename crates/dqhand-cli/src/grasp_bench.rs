@@ -36,17 +36,20 @@ const PLACE_XZ: [f32; 2] = [-0.25, -0.3];
 const CARRY: Vec3 = Vec3::new(0.5, 0.0, 0.0);
 const LIFT_M: f32 = 0.12;
 
-/// A direction the hand comes from: where the palm moves (and faces) and the fingers point.
+/// A direction the (right) hand comes from: where the palm moves (and faces) and the fingers
+/// point.
 struct Approach {
     name: &'static str,
     palm: Vec3,
     fingers: Vec3,
 }
 
+/// From the side and the front the thumb is up, as a right hand takes a thing on a table: with
+/// the thumb down it would be caught between the object and the table.
 const APPROACHES: [Approach; 3] = [
     Approach { name: "above", palm: Vec3::NEG_Y, fingers: Vec3::NEG_Z },
-    Approach { name: "side", palm: Vec3::X, fingers: Vec3::NEG_Z },
-    Approach { name: "front", palm: Vec3::NEG_Z, fingers: Vec3::NEG_X },
+    Approach { name: "side", palm: Vec3::NEG_X, fingers: Vec3::NEG_Z },
+    Approach { name: "front", palm: Vec3::NEG_Z, fingers: Vec3::X },
 ];
 
 /// How each object of the `objects` scene is taken.

@@ -351,7 +351,11 @@ impl ContactConstraint {
                     angles[i] = start[k] + (target[k] - start[k]) * s;
                 }
             };
-            let mut from_open = true;
+            // Where the closure starts: open, else as last rendered, else the tracked angles
+            // (clear after a snap of the wrist); the first whose proxies are clear. When
+            // none is (an object has moved into the finger), the finger stays as last
+            // rendered, the least change, and the physics pushes the object off it.
+            let mut tries = 0;
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward(rig, limits);
@@ -377,14 +381,20 @@ impl ContactConstraint {
                         step = step.min(d / speed);
                     }
                 }
-                if nearest.0 <= STOP_DISTANCE && std::mem::take(&mut from_open) {
-                    // The open finger is not clear: close from where it was last rendered.
-                    for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                        start[k] = self.previous.angles[i];
+                if tries < 3 && s == 0.0 && active == 0 {
+                    tries += 1;
+                    if nearest.0 <= STOP_DISTANCE {
+                        let from = if tries == 2 { &self.tracked } else { &self.previous };
+                        for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                            start[k] = from.angles[i];
+                        }
+                        if tries == 3 {
+                            break;
+                        }
+                        continue;
                     }
-                    continue;
+                    tries = 3;
                 }
-                from_open = false;
                 if nearest.0 <= STOP_DISTANCE {
                     // Contact: the joints up to the touching phalanx stop here; the rest close on.
                     for k in active..chain.dofs.len() {

@@ -168,6 +168,27 @@ impl ObjectColliders {
         o.aabb = o.surface.compute_aabb(&o.pose);
     }
 
+    /// Where object `i` may go when the hand puts it at `rotation`, `translation`: no lower
+    /// than resting on the table where it is over the table. A held object moves kinematically,
+    /// so the physics would let it pass into the table, and released there it would fall
+    /// through.
+    #[must_use]
+    pub fn above_table(&self, i: usize, rotation: Quat, translation: Vec3) -> Vec3 {
+        let Some(table) = self.table else { return translation };
+        let pose = Pose::from_parts(translation, rotation);
+        let solid = &self.objects()[i].solid;
+        let over = (0..2).all(|k| (translation[2 * k] - table.centre[k]).abs() <= table.half[k]);
+        let lowest = match solid.as_support_map() {
+            Some(convex) => convex.support_point(&pose, Vec3::NEG_Y).y,
+            None => solid.compute_aabb(&pose).mins.y,
+        };
+        if over && lowest < table.height {
+            translation + Vec3::Y * (table.height - lowest)
+        } else {
+            translation
+        }
+    }
+
     /// Object `i`, or the table where `i` is the objects' count (an index [`Self::near`] gave).
     #[must_use]
     pub fn collider(&self, i: usize) -> &ObjectCollider {

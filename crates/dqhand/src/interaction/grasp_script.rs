@@ -15,6 +15,7 @@ use parry3d::query::Ray;
 use super::synthetic::joint_set;
 use crate::collision::ObjectColliders;
 use crate::engine::Engine;
+use crate::gesture::gesture;
 use crate::hand::Side;
 use crate::input::{HandData, Record};
 use crate::kinematics::{JointModel, JointPositions, Motion, Pose};
@@ -85,9 +86,14 @@ struct HandFrame {
     palm: Vec3,
     palmar: Vec3,
     fingers: Vec3,
+    /// Between the thumb's tip and the opposing finger's half-way through a grasp's closure
+    /// (the middle's), or at the end of a pinch's (the index's, where the tips meet): where
+    /// the object goes, across the approach, so that thumb and fingers close on opposite
+    /// sides of it.
+    grip: Vec3,
 }
 
-fn hand_frame(engine: &mut Engine, joints: &JointPositions) -> HandFrame {
+fn hand_frame(engine: &mut Engine, joints: &JointPositions, pinch: bool) -> HandFrame {
     let rig = engine.rig().expect("a joint-model engine").clone();
     engine.pose(&Pose::rest(rig.dofs().len()));
     let world = engine.world();
@@ -98,26 +104,48 @@ fn hand_frame(engine: &mut Engine, joints: &JointPositions) -> HandFrame {
     let palmar = (-Vec3::Y - fingers * fingers.dot(-Vec3::Y)).normalize();
     // The palm's surface: its thickness is about a third of a metacarpal's length.
     let palm = p[11] * 0.55 + palmar * (p[11].length() * 0.3);
-    HandFrame { palm, palmar, fingers }
+    engine.pose(&shape(if pinch { 1.0 / PINCH_OVERSHOOT } else { 0.5 }, pinch));
+    let world = engine.world();
+    let to_wrist = world[rig.wrist()].inverse();
+    let half = joints.read(world).map(|p| to_wrist.transform_point3(p));
+    // WebXR order: 4 thumb tip, 9 index tip, 14 middle tip.
+    let grip = (half[4] + half[if pinch { 9 } else { 14 }]) / 2.0;
+    HandFrame { palm, palmar, fingers, grip }
 }
 
-/// The closing shape (1) and the open one (0) of a grasp, angles of the `full` model.
+/// How far past the library's `pinch` the scripted pinch closes: the tracked tips press on
+/// past a small object's surface, as a user's do.
+const PINCH_OVERSHOOT: f32 = 1.25;
+const GRIP_ALONG: f32 = 1.0;
+
+/// The closing shape (1) and the open one (0) of a grasp, angles of the `full` model. A
+/// pinch closes toward the gesture library's `pinch` (the thumb's pad on the index's),
+/// [`PINCH_OVERSHOOT`] times over.
 fn shape(closed: f32, pinch: bool) -> Pose {
     let mut pose = Pose::rest(JointModel::Full.dof_count());
-    for (d, a) in JointModel::Full.dofs().zip(&mut pose.angles) {
+    let pinched = gesture("pinch").expect("the library has a pinch").pose(JointModel::Full);
+    for ((d, a), p) in JointModel::Full.dofs().zip(&mut pose.angles).zip(&pinched.angles) {
         let thumb = d.bone.starts_with("thumb");
-        let index = d.bone.starts_with("index");
         let (open, shut) = match (d.bone, d.motion) {
-            ("thumb-metacarpal", Motion::Abd) => (15.0, 50.0),
-            ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
+            ("thumb-metacarpal", Motion::Abd) => (if pinch { 15.0 } else { 0.0 }, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
+            _ if pinch => (if thumb || d.bone.starts_with("index") || d.motion == Motion::Abd { 0.0 } else { 20.0 }, p.to_degrees() * PINCH_OVERSHOOT),
+            ("thumb-metacarpal", Motion::Flex) => (-15.0, 30.0),
             (_, Motion::Flex) if thumb => (0.0, 45.0),
-            (_, Motion::Flex) if pinch && !index => (20.0, 60.0),
-            (b, Motion::Flex) if b.ends_with("proximal") => (0.0, if pinch { 50.0 } else { 80.0 }),
-            (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, if pinch { 50.0 } else { 95.0 }),
-            (_, Motion::Flex) => (0.0, if pinch { 30.0 } else { 60.0 }),
+            (b, Motion::Flex) if b.ends_with("proximal") => (0.0, 80.0),
+            (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, 95.0),
+            (_, Motion::Flex) => (0.0, 60.0),
             (_, Motion::Abd) => (0.0, 0.0),
         };
-        *a = (open + (shut - open) * closed as f64).to_radians() as f32;
+        // A power grasp is led by the knuckles: the proximal phalanges wrap the object first,
+        // then the distal ones (the pinch and the thumb close evenly).
+        let lead = if pinch || thumb {
+            closed
+        } else if d.bone.ends_with("proximal") {
+            (closed / 0.6).min(1.0)
+        } else {
+            ((closed - 0.3) / 0.7).max(0.0)
+        };
+        *a = (open + (shut - open) * lead).to_radians();
     }
     pose
 }
@@ -144,13 +172,27 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         .ok_or_else(|| Error::Scene { file: file.to_owned(), problem: SceneProblem::NoObject(task.object.clone()) })?;
     let d = task.approach.normalize();
     let f = (task.fingers - d * task.fingers.dot(d)).normalize();
-    // Where the palm meets the object: the surface point seen along the approach through
-    // the middle of its bounding box.
-    let centre = object.aabb().center();
-    let ray = Ray::new(centre - d, d);
-    let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
-    let contact = centre - d + d * toi;
-    let grasp_at = contact + d * PRESS_M;
+    let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
+    let joints = JointPositions::new(engine.skeleton())?;
+    let frame = hand_frame(&mut engine, &joints, task.pinch);
+    let rotation = {
+        let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
+        let world = Mat3::from_cols(d, f, d.cross(f));
+        Quat::from_mat3(&(world * hand.transpose())).normalize()
+    };
+    // Where the palm goes. A grasp: it presses into the surface point seen along the
+    // approach through the middle of the object's bounding box, shifted across the approach
+    // so that the hand's grip point is over the middle. A pinch: the tips meet in the middle.
+    let grip = rotation * (frame.grip - frame.palm);
+    let grasp_at = if task.pinch {
+        object.aabb().center() - grip
+    } else {
+        let side = d.cross(f);
+        let centre = object.aabb().center() - side * grip.dot(side) - f * (grip.dot(f) * GRIP_ALONG);
+        let ray = Ray::new(centre - d, d);
+        let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
+        centre - d + d * (toi + PRESS_M)
+    };
     let start = grasp_at - d * STANDOFF_M;
     let lifted = grasp_at + Vec3::Y * task.lift;
     let carried = lifted + task.carry;
@@ -180,14 +222,6 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     // The approach is at constant speed (its speed is the point); the rest eased.
     let eased = |k: usize| k != 2;
     let frames = (end * RATE_HZ).floor() as usize + 1;
-    let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
-    let joints = JointPositions::new(engine.skeleton())?;
-    let frame = hand_frame(&mut engine, &joints);
-    let rotation = {
-        let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
-        let world = Mat3::from_cols(d, f, d.cross(f));
-        Quat::from_mat3(&(world * hand.transpose())).normalize()
-    };
     let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times };
     for i in 0..frames {
         let t = i as f64 / RATE_HZ;

@@ -63,9 +63,10 @@ impl ManipulationLoop {
         let rendered = Engine::with_joint_model(model.clone(), joint_model)?;
         let rig = rendered.rig().expect("an engine with a joint model has a rig");
         let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rig.skeleton());
-        let constraint = ContactConstraint::new(proxies, rig);
+        let constraint = ContactConstraint::new(proxies.clone(), rig);
         let objects = ObjectColliders::new(scene)?;
-        let physics = ScenePhysics::new(scene, &objects);
+        let mut physics = ScenePhysics::new(scene, &objects);
+        physics.add_hand(&proxies);
         let n = scene.objects.len();
         let poses = (0..n).map(|i| physics.pose(i)).collect();
         Ok(Self {
@@ -153,6 +154,7 @@ impl ManipulationLoop {
         let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world());
         if let Some((q, t)) = self.grasp.target() {
             let held = self.grasp.held().expect("a target is a held object's");
+            let t = self.objects.above_table(held, q, t);
             self.objects.set_pose(held, q, t);
             self.poses[held] = (q, t);
         }
@@ -165,9 +167,11 @@ impl ManipulationLoop {
             Some(GraspEvent::Release { object, linvel, angvel }) => self.physics.release(object, linvel, angvel),
             None => {}
         }
-        if let Some((q, t)) = self.grasp.target() {
-            self.physics.hold(self.grasp.held().expect("a target is a held object's"), q, t);
+        if let Some(held) = self.grasp.held() {
+            let (q, t) = self.poses[held];
+            self.physics.hold(held, q, t);
         }
+        self.physics.move_hand(self.constraint.world());
         self.physics.step(dt as f32);
         self.read_poses();
         self.rendered.pose(self.constraint.rendered());

@@ -1,11 +1,11 @@
 //! The scene's rigid bodies in a rapier world.
 
-use glam::{Quat, Vec3};
+use glam::{Affine3A, Quat, Vec3};
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle, RigidBodyType};
 use rapier3d::pipeline::PhysicsWorld;
 use parry3d::math::Pose;
 
-use crate::collision::ObjectColliders;
+use crate::collision::{pose_of, HandProxies, ObjectColliders};
 use crate::scene::Scene;
 
 /// Gravity, m/s² along −Y.
@@ -18,6 +18,10 @@ pub struct ScenePhysics {
     /// Where the file puts each object.
     initial: Vec<Pose>,
     held: Option<usize>,
+    /// The rendered hand's proxies as kinematic bodies, with their joints: a free object
+    /// meets the hand (a released ball rests on the fingers, a rolling one stops at them)
+    /// instead of passing into it.
+    hand: Vec<(RigidBodyHandle, usize)>,
 }
 
 impl ScenePhysics {
@@ -41,7 +45,29 @@ impl ScenePhysics {
         if let Some(slab) = colliders.table_collider() {
             world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(0.8).restitution(0.3).build(), None);
         }
-        Self { world, bodies, initial, held: None }
+        Self { world, bodies, initial, held: None, hand: Vec::new() }
+    }
+
+    /// Adds the hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves.
+    pub fn add_hand(&mut self, proxies: &HandProxies) {
+        for p in proxies.colliders() {
+            let body = RigidBodyBuilder::kinematic_position_based().build();
+            let (handle, _) = self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build());
+            self.hand.push((handle, p.joint));
+        }
+    }
+
+    /// Puts the hand's joints at `world`. Placed, not swept: the solver would give the bodies
+    /// the velocity of the move, and a hand that stops at an object within the frame (the
+    /// contact constraint stops it a fraction of a millimetre short) would strike it at full
+    /// speed. So the hand holds free objects off and stops them, and does not bat them.
+    pub fn move_hand(&mut self, world: &[Affine3A]) {
+        for &(h, joint) in &self.hand {
+            let pose = pose_of(&world[joint]);
+            let body = &mut self.world.bodies[h];
+            body.set_position(pose, true);
+            body.set_next_kinematic_position(pose);
+        }
     }
 
     /// Object `i`'s pose: rotation and translation.
