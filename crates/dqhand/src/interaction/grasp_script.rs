@@ -116,7 +116,6 @@ fn hand_frame(engine: &mut Engine, joints: &JointPositions, pinch: bool) -> Hand
 /// How far past the library's `pinch` the scripted pinch closes: the tracked tips press on
 /// past a small object's surface, as a user's do.
 const PINCH_OVERSHOOT: f32 = 1.25;
-const GRIP_ALONG: f32 = 1.0;
 
 /// The closing shape (1) and the open one (0) of a grasp, angles of the `full` model. A
 /// pinch closes toward the gesture library's `pinch` (the thumb's pad on the index's),
@@ -187,8 +186,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     let grasp_at = if task.pinch {
         object.aabb().center() - grip
     } else {
-        let side = d.cross(f);
-        let centre = object.aabb().center() - side * grip.dot(side) - f * (grip.dot(f) * GRIP_ALONG);
+        let centre = object.aabb().center() - (grip - d * grip.dot(d));
         let ray = Ray::new(centre - d, d);
         let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
         centre - d + d * (toi + PRESS_M)
