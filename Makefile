@@ -65,7 +65,8 @@ test: assets viewer chromium recordings
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
 
-# docs/figures/*.png: the paper's Figures 5-7 on our hand, rendered by the real page.
+# docs/figures/*.png: the paper's Figures 5-7 and 9 on our hand, rendered by the real page
+# (Figure 9 makes its own scripted grasp recording with the release binary).
 figures: build viewer chromium
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/release/dqhand CHROMIUM=$(CHROMIUM) node scripts/figures.mjs
 

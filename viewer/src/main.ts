@@ -1,6 +1,7 @@
 // The viewer page: connects to the engine, draws its frames and turns controls into commands.
 
 import './style.css';
+import { Vector3 } from 'three';
 import { Connection } from './connection';
 import { InputPanel } from './input';
 import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS } from './protocol';
@@ -281,9 +282,13 @@ window.dqhand = {
   }),
   send: (command: Command) => connection.send(command),
   setting: (command: Command) => connection.setting(command),
-  /** Camera: 'default', 'side' or a direction, optionally close on a joint (by name) at a distance (m). */
-  view: (preset: 'default' | 'side' | [number, number, number], joint?: string, distance?: number) => {
-    const index = joint && hello ? hello.joints.indexOf(joint) : -1;
+  /**
+   * Camera: 'default', 'side' or a direction, optionally close on a joint (by name) or on a
+   * world point (m; with a scene, the engine's world the objects are in) at a distance (m).
+   */
+  view: (preset: 'default' | 'side' | [number, number, number], focus?: string | [number, number, number], distance?: number) => {
+    if (Array.isArray(focus)) return scene.setView(preset, new Vector3(...focus), distance);
+    const index = focus && hello ? hello.joints.indexOf(focus) : -1;
     scene.setView(preset, index >= 0 ? scene.jointPosition(index) ?? undefined : undefined, distance);
   },
 };

@@ -392,4 +392,21 @@ describe('the viewer page with a scene', () => {
     // Released again later in the recording.
     await waitState(p, 's.scene.held === null && document.getElementById("held").textContent === "—"', 60_000);
   });
+
+  test('frames the camera on a world point (make figures, Fig. 9)', async () => {
+    type View = (preset: string | number[], focus?: string | number[], distance?: number) => void;
+    const view = (focus?: number[], distance?: number) => p.evaluate(([f, d]) => (window as unknown as { dqhand: { view: View } }).dqhand.view('default', f, d), [focus, distance] as const);
+    const drawn = async () => (await canvasStats(p)).strips[0];
+    try {
+      // Close on a point 4 m above the table: nothing there, only the background.
+      await view([0, 5, 0], 0.1);
+      await settle(p, 3);
+      await expect.poll(drawn, { timeout: 30_000, interval: 500 }).toBeLessThan(50);
+    } finally {
+      await view();
+    }
+    // Back on the scene: the table and the objects again.
+    await settle(p, 3);
+    await expect.poll(drawn, { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
+  });
 });
