@@ -236,3 +236,29 @@ fn mesh_shapes(mesh: &ObjectMesh) -> std::result::Result<(SharedShape, SharedSha
     });
     Ok((surface, solid))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_held_object_is_kept_on_the_table_top_only_over_the_table() {
+        let scene = Scene::named("objects").unwrap();
+        let colliders = ObjectColliders::new(&scene).unwrap();
+        let table = colliders.table().unwrap();
+        let ball = scene.objects.iter().position(|o| o.name == "ball").unwrap();
+        let cube = scene.objects.iter().position(|o| o.name == "cube").unwrap();
+        let over = Vec3::new(table.centre[0], table.height - 0.05, table.centre[1]);
+        // A sphere of 4 cm rests with its centre 4 cm above the top, whatever its rotation.
+        let raised = colliders.above_table(ball, Quat::from_rotation_x(1.0), over);
+        assert!((raised.y - (table.height + 0.04)).abs() < 1e-5, "{raised}");
+        // A 6 cm cube turned 45° about Z rests on an edge: √2 · 3 cm below its centre.
+        let turned = colliders.above_table(cube, Quat::from_rotation_z(core::f32::consts::FRAC_PI_4), over);
+        assert!((turned.y - (table.height + 0.03 * 2f32.sqrt())).abs() < 1e-4, "{turned}");
+        // Above the top, or beside the table, it goes where the hand puts it.
+        let high = over + Vec3::Y * 0.2;
+        assert_eq!(colliders.above_table(ball, Quat::IDENTITY, high), high);
+        let beside = Vec3::new(table.centre[0] + table.half[0] + 0.1, table.height - 0.05, table.centre[1]);
+        assert_eq!(colliders.above_table(ball, Quat::IDENTITY, beside), beside);
+    }
+}

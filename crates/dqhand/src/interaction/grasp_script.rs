@@ -126,9 +126,9 @@ fn shape(closed: f32, pinch: bool) -> Pose {
     for ((d, a), p) in JointModel::Full.dofs().zip(&mut pose.angles).zip(&pinched.angles) {
         let thumb = d.bone.starts_with("thumb");
         let (open, shut) = match (d.bone, d.motion) {
-            ("thumb-metacarpal", Motion::Abd) => (if pinch { 15.0 } else { 0.0 }, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
+            ("thumb-metacarpal", Motion::Abd) => (15.0, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
             _ if pinch => (if thumb || d.bone.starts_with("index") || d.motion == Motion::Abd { 0.0 } else { 20.0 }, p.to_degrees() * PINCH_OVERSHOOT),
-            ("thumb-metacarpal", Motion::Flex) => (-15.0, 30.0),
+            ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
             (_, Motion::Flex) if thumb => (0.0, 45.0),
             (b, Motion::Flex) if b.ends_with("proximal") => (0.0, 80.0),
             (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, 95.0),

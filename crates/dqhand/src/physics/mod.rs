@@ -1,6 +1,7 @@
 //! Physics of the free objects (rapier3d): gravity, the table, friction and restitution. A
 //! held object is moved by the hand (kinematically, so it pushes what it meets) and handed
-//! back to the simulation with the hand's velocity when released.
+//! back to the simulation with the hand's velocity when released; the rendered hand's proxies
+//! are kinematic bodies too, so what falls or rolls onto the hand rests against it.
 
 mod scene_physics;
 
