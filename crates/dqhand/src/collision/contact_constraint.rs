@@ -355,7 +355,9 @@ impl ContactConstraint {
             // (clear after a snap of the wrist); the first whose proxies are clear. When
             // none is (an object has moved into the finger), the finger stays as last
             // rendered, the least change, and the physics pushes the object off it.
-            let mut tries = 0;
+            // `checking` is the start being tried (0 open, 1 last rendered, 2 tracked) until
+            // one is clear.
+            let mut checking = Some(0);
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward(rig, limits);
@@ -381,19 +383,18 @@ impl ContactConstraint {
                         step = step.min(d / speed);
                     }
                 }
-                if tries < 3 && s == 0.0 && active == 0 {
-                    tries += 1;
+                if let Some(tried) = checking.take() {
                     if nearest.0 <= STOP_DISTANCE {
-                        let from = if tries == 2 { &self.tracked } else { &self.previous };
+                        let from = if tried == 1 { &self.tracked } else { &self.previous };
                         for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                             start[k] = from.angles[i];
                         }
-                        if tries == 3 {
+                        if tried == 2 {
                             break;
                         }
+                        checking = Some(tried + 1);
                         continue;
                     }
-                    tries = 3;
                 }
                 if nearest.0 <= STOP_DISTANCE {
                     // Contact: the joints up to the touching phalanx stop here; the rest close on.

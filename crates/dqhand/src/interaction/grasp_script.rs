@@ -93,21 +93,25 @@ struct HandFrame {
     grip: Vec3,
 }
 
-fn hand_frame(engine: &mut Engine, joints: &JointPositions, pinch: bool) -> HandFrame {
-    let rig = engine.rig().expect("a joint-model engine").clone();
-    engine.pose(&Pose::rest(rig.dofs().len()));
+/// The WebXR joints of `engine`'s hand in `pose`, in its wrist's frame.
+fn in_wrist(engine: &mut Engine, joints: &JointPositions, pose: &Pose) -> [Vec3; 25] {
+    engine.pose(pose);
     let world = engine.world();
-    let to_wrist = world[rig.wrist()].inverse();
-    let p = joints.read(world).map(|p| to_wrist.transform_point3(p));
+    let wrist = engine.rig().expect("a joint-model engine").wrist();
+    let to_wrist = world[wrist].inverse();
+    joints.read(world).map(|p| to_wrist.transform_point3(p))
+}
+
+fn hand_frame(engine: &mut Engine, joints: &JointPositions, closing: &Closing) -> HandFrame {
+    let dofs = engine.rig().expect("a joint-model engine").dofs().len();
+    let p = in_wrist(engine, joints, &Pose::rest(dofs));
     // WebXR order: 0 wrist, 11 middle proximal; palmar is the wrist's −Y.
     let fingers = p[11].normalize();
     let palmar = (-Vec3::Y - fingers * fingers.dot(-Vec3::Y)).normalize();
     // The palm's surface: its thickness is about a third of a metacarpal's length.
     let palm = p[11] * 0.55 + palmar * (p[11].length() * 0.3);
-    engine.pose(&shape(if pinch { 1.0 / PINCH_OVERSHOOT } else { 0.5 }, pinch));
-    let world = engine.world();
-    let to_wrist = world[rig.wrist()].inverse();
-    let half = joints.read(world).map(|p| to_wrist.transform_point3(p));
+    let pinch = closing.pinch;
+    let half = in_wrist(engine, joints, &closing.pose(if pinch { 1.0 / PINCH_OVERSHOOT } else { 0.5 }));
     // WebXR order: 4 thumb tip, 9 index tip, 14 middle tip.
     let grip = (half[4] + half[if pinch { 9 } else { 14 }]) / 2.0;
     HandFrame { palm, palmar, fingers, grip }
@@ -117,36 +121,70 @@ fn hand_frame(engine: &mut Engine, joints: &JointPositions, pinch: bool) -> Hand
 /// past a small object's surface, as a user's do.
 const PINCH_OVERSHOOT: f32 = 1.25;
 
-/// The closing shape (1) and the open one (0) of a grasp, angles of the `full` model. A
-/// pinch closes toward the gesture library's `pinch` (the thumb's pad on the index's),
-/// [`PINCH_OVERSHOOT`] times over.
-fn shape(closed: f32, pinch: bool) -> Pose {
-    let mut pose = Pose::rest(JointModel::Full.dof_count());
-    let pinched = gesture("pinch").expect("the library has a pinch").pose(JointModel::Full);
-    for ((d, a), p) in JointModel::Full.dofs().zip(&mut pose.angles).zip(&pinched.angles) {
-        let thumb = d.bone.starts_with("thumb");
-        let (open, shut) = match (d.bone, d.motion) {
-            ("thumb-metacarpal", Motion::Abd) => (15.0, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
-            _ if pinch => (if thumb || d.bone.starts_with("index") || d.motion == Motion::Abd { 0.0 } else { 20.0 }, p.to_degrees() * PINCH_OVERSHOOT),
-            ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
-            (_, Motion::Flex) if thumb => (0.0, 45.0),
-            (b, Motion::Flex) if b.ends_with("proximal") => (0.0, 80.0),
-            (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, 95.0),
-            (_, Motion::Flex) => (0.0, 60.0),
-            (_, Motion::Abd) => (0.0, 0.0),
-        };
-        // A power grasp is led by the knuckles: the proximal phalanges wrap the object first,
-        // then the distal ones (the pinch and the thumb close evenly).
-        let lead = if pinch || thumb {
-            closed
-        } else if d.bone.ends_with("proximal") {
-            (closed / 0.6).min(1.0)
-        } else {
-            ((closed - 0.3) / 0.7).max(0.0)
-        };
-        *a = (open + (shut - open) * lead).to_radians();
+/// How a DOF's closure follows the grasp's.
+#[derive(Clone, Copy)]
+enum Lead {
+    /// With it (the pinch, the thumb).
+    Even,
+    /// Ahead of it: the knuckles, which lead a power grasp, so the proximal phalanges wrap
+    /// the object first.
+    Knuckle,
+    /// Behind it: the distal joints of a power grasp.
+    Distal,
+}
+
+/// A grasp's closing motion over the `full` model's DOFs: each one's open and shut angles
+/// (degrees) and how it follows the closure. A pinch closes toward the gesture library's
+/// `pinch` (the thumb's pad on the index's), [`PINCH_OVERSHOOT`] times over.
+struct Closing {
+    pinch: bool,
+    dofs: Vec<(f32, f32, Lead)>,
+}
+
+impl Closing {
+    fn new(pinch: bool) -> Self {
+        let pinched = gesture("pinch").expect("the library has a pinch").pose(JointModel::Full);
+        let dofs = JointModel::Full
+            .dofs()
+            .zip(&pinched.angles)
+            .map(|(d, p)| {
+                let thumb = d.bone.starts_with("thumb");
+                let (open, shut) = match (d.bone, d.motion) {
+                    ("thumb-metacarpal", Motion::Abd) => (15.0, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
+                    _ if pinch => (if thumb || d.bone.starts_with("index") || d.motion == Motion::Abd { 0.0 } else { 20.0 }, p.to_degrees() * PINCH_OVERSHOOT),
+                    ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
+                    (_, Motion::Flex) if thumb => (0.0, 45.0),
+                    (b, Motion::Flex) if b.ends_with("proximal") => (0.0, 80.0),
+                    (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, 95.0),
+                    (_, Motion::Flex) => (0.0, 60.0),
+                    (_, Motion::Abd) => (0.0, 0.0),
+                };
+                let lead = if pinch || thumb {
+                    Lead::Even
+                } else if d.bone.ends_with("proximal") {
+                    Lead::Knuckle
+                } else {
+                    Lead::Distal
+                };
+                (open, shut, lead)
+            })
+            .collect();
+        Self { pinch, dofs }
     }
-    pose
+
+    /// The hand closed by `closed` (0 open, 1 shut).
+    fn pose(&self, closed: f32) -> Pose {
+        let mut pose = Pose::rest(self.dofs.len());
+        for (a, &(open, shut, lead)) in pose.angles.iter_mut().zip(&self.dofs) {
+            let s = match lead {
+                Lead::Even => closed,
+                Lead::Knuckle => (closed / 0.6).min(1.0),
+                Lead::Distal => ((closed - 0.3) / 0.7).max(0.0),
+            };
+            *a = (open + (shut - open) * s).to_radians();
+        }
+        pose
+    }
 }
 
 fn smooth(s: f64) -> f32 {
@@ -173,7 +211,8 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     let f = (task.fingers - d * task.fingers.dot(d)).normalize();
     let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
     let joints = JointPositions::new(engine.skeleton())?;
-    let frame = hand_frame(&mut engine, &joints, task.pinch);
+    let closing = Closing::new(task.pinch);
+    let frame = hand_frame(&mut engine, &joints, &closing);
     let rotation = {
         let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
         let world = Mat3::from_cols(d, f, d.cross(f));
@@ -228,7 +267,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
         let s = if eased(k + 1) { smooth(s) } else { s.clamp(0.0, 1.0) as f32 };
         let palm = p0.lerp(p1, s);
-        let mut pose = shape(c0 + (c1 - c0) * s, task.pinch);
+        let mut pose = closing.pose(c0 + (c1 - c0) * s);
         pose.wrist = Some(DualQuat::from_rotation_translation(rotation, palm - rotation * frame.palm));
         engine.pose(&pose);
         let world: &[Affine3A] = engine.world();
