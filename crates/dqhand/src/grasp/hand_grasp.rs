@@ -66,7 +66,8 @@ struct Held {
     current: [Vec3; MAX_ANCHORS + 4],
     /// The object's pose at the grasp.
     start: (Quat, Vec3),
-    /// The grasping fingers (thumb first) and the sum of their rendered closures then.
+    /// The grasping fingers (thumb first) and the most their rendered closures (summed) have
+    /// wrapped the object since the grasp: the tracked ones must open past it to release.
     fingers: [bool; 5],
     closure: f32,
     lost_since: Option<f64>,
@@ -113,8 +114,9 @@ impl Grasp {
 
     /// The first half of a frame at `now` (s), before the rendered hand is solved: the held
     /// object follows the tracked joints `tracked_world` ([`Self::target`]), or is let go
-    /// because the fingers opened (`closure`, tracked) or tracking has been lost (`tracking`
-    /// false) for longer than the grace time. Allocates nothing.
+    /// because the fingers opened (`closure`: tracked, and rendered as last solved) or
+    /// tracking has been lost (`tracking` false) for longer than the grace time. Allocates
+    /// nothing.
     pub fn follow(&mut self, now: f64, tracking: bool, closure: &[Closure; 5], tracked_world: &[Affine3A]) -> Option<GraspEvent> {
         let held = self.held.as_mut()?;
         if !tracking {
@@ -122,9 +124,10 @@ impl Grasp {
             return (now - since > self.params.loss_grace_s).then(|| self.release(now, false));
         }
         held.lost_since = None;
-        let closed: f32 = closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| c.tracked).sum();
+        let sum = |side: fn(&Closure) -> f32| -> f32 { closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| side(c)).sum() };
+        held.closure = held.closure.max(sum(|c| c.rendered));
         let count = held.fingers.iter().filter(|g| **g).count() as f32;
-        if closed < held.closure - self.params.release_deg.to_radians() * count {
+        if sum(|c| c.tracked) < held.closure - self.params.release_deg.to_radians() * count {
             return Some(self.release(now, true));
         }
         let n = held.count;
@@ -315,6 +318,22 @@ mod tests {
         assert!((linvel - Vec3::new(0.6, 0.0, 0.0)).length() < 1e-3, "the hand moved 1 cm per frame: {linvel}");
         assert_eq!(grasped(&mut g, t + 0.1), None, "cooling down");
         assert!(grasped(&mut g, t + 0.31).is_some(), "cooled down");
+    }
+
+    #[test]
+    fn a_grasp_made_with_open_fingers_is_released_past_their_tightest_wrap() {
+        // Thumb and index resting on the object open (stopped at 0°, tracked 5°): grasped.
+        let open = |tracked: f32, rendered: f32| {
+            let c = Closure { tracked: tracked.to_radians(), rendered: rendered.to_radians() };
+            [c, c, Closure::default(), Closure::default(), Closure::default()]
+        };
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        assert!(g.detect(0.0, true, &pinch(), &open(5.0, 0.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL).is_some());
+        // They close on, wrapping the object to 30° each, and open again: fully open is no
+        // more than 8° past the closure at the grasp, but it is 30° past the tightest wrap.
+        assert_eq!(g.follow(0.1, true, &open(40.0, 30.0), &world(Vec3::ZERO)), None);
+        assert_eq!(g.follow(0.2, true, &open(25.0, 25.0), &world(Vec3::ZERO)), None, "within the margin of the wrap");
+        assert!(matches!(g.follow(0.3, true, &open(0.0, 0.0), &world(Vec3::ZERO)), Some(GraspEvent::Release { .. })));
     }
 
     #[test]

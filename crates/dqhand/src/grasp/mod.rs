@@ -11,9 +11,11 @@
 //! * **Hold.** The touching points are fixed in their bones (the tracked ones, which the
 //!   user moves), with four points of the wrist's frame; each frame the object takes the
 //!   best-fit rigid motion ([`crate::math::rigid_fit`]) of those points since the grasp.
-//! * **Release.** The grasping fingers open past their closure at the grasp by
-//!   [`GraspParams::release_deg`] each (hysteresis: between the two thresholds nothing
-//!   changes); the object is then not grasped again for [`GraspParams::cooldown_s`]. It
+//! * **Release.** The grasping fingers open past the tightest their rendered copies have
+//!   wrapped the object since the grasp by [`GraspParams::release_deg`] each (hysteresis:
+//!   between the two thresholds nothing changes). Not past their closure at the grasp: a
+//!   grasp can begin with fingers resting on the object open, and they cannot open further.
+//!   The object is then not grasped again for [`GraspParams::cooldown_s`]. It
 //!   leaves with the hand's velocity over the last frames, so a throw flies.
 //! * **Tracking loss.** A held object stays where it is while tracking is lost, and drops
 //!   after [`GraspParams::loss_grace_s`].

@@ -135,7 +135,9 @@ enum Lead {
 
 /// A grasp's closing motion over the `full` model's DOFs: each one's open and shut angles
 /// (degrees) and how it follows the closure. A pinch closes toward the gesture library's
-/// `pinch` (the thumb's pad on the index's), [`PINCH_OVERSHOOT`] times over.
+/// `pinch` (the thumb's pad on the index's), [`PINCH_OVERSHOOT`] times over. The open hand of
+/// a power grasp has its thumb beside the index (CMC extended 15°, not abducted): in front of
+/// the palm it meets a mug or a teapot first and holds the palm 4 cm off.
 struct Closing {
     pinch: bool,
     dofs: Vec<(f32, f32, Lead)>,
@@ -150,9 +152,9 @@ impl Closing {
             .map(|(d, p)| {
                 let thumb = d.bone.starts_with("thumb");
                 let (open, shut) = match (d.bone, d.motion) {
-                    ("thumb-metacarpal", Motion::Abd) => (15.0, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
+                    ("thumb-metacarpal", Motion::Abd) => (if pinch { 15.0 } else { 0.0 }, if pinch { p.to_degrees() * PINCH_OVERSHOOT } else { 50.0 }),
                     _ if pinch => (if thumb || d.bone.starts_with("index") || d.motion == Motion::Abd { 0.0 } else { 20.0 }, p.to_degrees() * PINCH_OVERSHOOT),
-                    ("thumb-metacarpal", Motion::Flex) => (0.0, 30.0),
+                    ("thumb-metacarpal", Motion::Flex) => (-15.0, 30.0),
                     (_, Motion::Flex) if thumb => (0.0, 45.0),
                     (b, Motion::Flex) if b.ends_with("proximal") => (0.0, 80.0),
                     (b, Motion::Flex) if b.ends_with("intermediate") => (0.0, 95.0),
