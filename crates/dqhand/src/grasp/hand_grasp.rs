@@ -58,10 +58,10 @@ const HISTORY: usize = 4;
 struct Held {
     object: usize,
     wrist: usize,
-    /// (joint, point in the joint's frame): contacts and the wrist frame's points.
+    /// (joint, point in the rendered joint's frame): contacts and the wrist frame's points.
     anchors: [(usize, Vec3); MAX_ANCHORS + 4],
     count: usize,
-    /// The anchors in world space at the grasp (tracked pose).
+    /// The anchors at the grasp ([`Held::place`]).
     reference: [Vec3; MAX_ANCHORS + 4],
     current: [Vec3; MAX_ANCHORS + 4],
     /// The object's pose at the grasp.
@@ -113,11 +113,11 @@ impl Grasp {
     }
 
     /// The first half of a frame at `now` (s), before the rendered hand is solved: the held
-    /// object follows the tracked joints `tracked_world` ([`Self::target`]), or is let go
-    /// because the fingers opened (`closure`: tracked, and rendered as last solved) or
-    /// tracking has been lost (`tracking` false) for longer than the grace time. Allocates
-    /// nothing.
-    pub fn follow(&mut self, now: f64, tracking: bool, closure: &[Closure; 5], tracked_world: &[Affine3A]) -> Option<GraspEvent> {
+    /// object follows the hand ([`Self::target`]; `tracked_world` this frame's tracked joints,
+    /// `rendered_world` the last rendered ones), or is let go because the fingers opened
+    /// (`closure`: tracked, and rendered as last solved) or tracking has been lost
+    /// (`tracking` false) for longer than the grace time. Allocates nothing.
+    pub fn follow(&mut self, now: f64, tracking: bool, closure: &[Closure; 5], tracked_world: &[Affine3A], rendered_world: &[Affine3A]) -> Option<GraspEvent> {
         let held = self.held.as_mut()?;
         if !tracking {
             let since = *held.lost_since.get_or_insert(now);
@@ -131,9 +131,7 @@ impl Grasp {
             return Some(self.release(now, true));
         }
         let n = held.count;
-        for (c, &(j, local)) in held.current[..n].iter_mut().zip(&held.anchors[..n]) {
-            *c = tracked_world[j].transform_point3(local);
-        }
+        place(&held.anchors[..n], held.wrist, tracked_world, rendered_world, &mut held.current);
         let (r, t) = rigid_fit(&held.reference[..n], &held.current[..n]);
         held.target = ((r * held.start.0).normalize(), r * held.start.1 + t);
         held.remember(now, &tracked_world[held.wrist]);
@@ -186,10 +184,7 @@ impl Grasp {
             held.anchors[held.count] = (wrist, p);
             held.count += 1;
         }
-        for i in 0..held.count {
-            let (j, local) = held.anchors[i];
-            held.reference[i] = tracked_world[j].transform_point3(local);
-        }
+        place(&held.anchors[..held.count], wrist, tracked_world, rendered_world, &mut held.reference);
         held.closure = closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| c.rendered).sum();
         held.remember(now, &tracked_world[wrist]);
         self.held = Some(held);
@@ -230,6 +225,17 @@ impl Grasp {
             (Vec3::ZERO, Vec3::ZERO)
         };
         GraspEvent::Release { object: held.object, linvel, angvel }
+    }
+}
+
+/// Where `anchors` are now (into `out`): on the rendered bones, carried by the tracked
+/// `wrist`. Not on the tracked bones: the tracked fingers close on into the object after the
+/// grasp, which would drag it across the palm; the rendered ones stop on its surface and move
+/// only where the user's fingers move outside it.
+fn place(anchors: &[(usize, Vec3)], wrist: usize, tracked_world: &[Affine3A], rendered_world: &[Affine3A], out: &mut [Vec3]) {
+    let carry = tracked_world[wrist] * rendered_world[wrist].inverse();
+    for (o, &(j, local)) in out.iter_mut().zip(anchors) {
+        *o = (carry * rendered_world[j]).transform_point3(local);
     }
 }
 
@@ -298,9 +304,22 @@ mod tests {
         let mut g = Grasp::new(GraspParams::default(), 1);
         grasped(&mut g, 0.0);
         let shift = Vec3::new(0.1, 0.2, -0.3);
-        assert_eq!(g.follow(1.0 / 60.0, true, &closure(40.0), &world(shift)), None);
+        assert_eq!(g.follow(1.0 / 60.0, true, &closure(40.0), &world(shift), &world(Vec3::ZERO)), None);
         let (q, t) = g.target().unwrap();
         assert!((t - shift).length() < 1e-5 && q.angle_between(Quat::IDENTITY) < 1e-4, "{t} {q}");
+    }
+
+    #[test]
+    fn tracked_fingers_closing_into_the_object_do_not_drag_it() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        grasped(&mut g, 0.0);
+        // The tracked thumb and index 1 cm further in, the wrist and the rendered hand still.
+        let mut tracked = world(Vec3::ZERO);
+        tracked[1] = Affine3A::from_translation(Vec3::new(-0.01, 0.0, 0.0));
+        tracked[2] = Affine3A::from_translation(Vec3::new(0.01, 0.0, 0.0));
+        assert_eq!(g.follow(1.0 / 60.0, true, &closure(50.0), &tracked, &world(Vec3::ZERO)), None);
+        let (q, t) = g.target().unwrap();
+        assert!(t.length() < 1e-6 && q.angle_between(Quat::IDENTITY) < 1e-5, "{t} {q}");
     }
 
     #[test]
@@ -311,10 +330,10 @@ mod tests {
         let mut t = 0.0;
         for k in 1..=3 {
             t = f64::from(k) / 60.0;
-            assert_eq!(g.follow(t, true, &closure(25.0), &world(Vec3::new(0.01 * k as f32, 0.0, 0.0))), None);
+            assert_eq!(g.follow(t, true, &closure(25.0), &world(Vec3::new(0.01 * k as f32, 0.0, 0.0)), &world(Vec3::ZERO)), None);
         }
         t += 1.0 / 60.0;
-        let Some(GraspEvent::Release { object: 0, linvel, .. }) = g.follow(t, true, &closure(21.0), &world(Vec3::new(0.04, 0.0, 0.0))) else { panic!("opened past the margin") };
+        let Some(GraspEvent::Release { object: 0, linvel, .. }) = g.follow(t, true, &closure(21.0), &world(Vec3::new(0.04, 0.0, 0.0)), &world(Vec3::ZERO)) else { panic!("opened past the margin") };
         assert!((linvel - Vec3::new(0.6, 0.0, 0.0)).length() < 1e-3, "the hand moved 1 cm per frame: {linvel}");
         assert_eq!(grasped(&mut g, t + 0.1), None, "cooling down");
         assert!(grasped(&mut g, t + 0.31).is_some(), "cooled down");
@@ -331,20 +350,20 @@ mod tests {
         assert!(g.detect(0.0, true, &pinch(), &open(5.0, 0.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST, &BALL).is_some());
         // They close on, wrapping the object to 30° each, and open again: fully open is no
         // more than 8° past the closure at the grasp, but it is 30° past the tightest wrap.
-        assert_eq!(g.follow(0.1, true, &open(40.0, 30.0), &world(Vec3::ZERO)), None);
-        assert_eq!(g.follow(0.2, true, &open(25.0, 25.0), &world(Vec3::ZERO)), None, "within the margin of the wrap");
-        assert!(matches!(g.follow(0.3, true, &open(0.0, 0.0), &world(Vec3::ZERO)), Some(GraspEvent::Release { .. })));
+        assert_eq!(g.follow(0.1, true, &open(40.0, 30.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None);
+        assert_eq!(g.follow(0.2, true, &open(25.0, 25.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None, "within the margin of the wrap");
+        assert!(matches!(g.follow(0.3, true, &open(0.0, 0.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), Some(GraspEvent::Release { .. })));
     }
 
     #[test]
     fn a_short_tracking_loss_keeps_the_object() {
         let mut g = Grasp::new(GraspParams::default(), 1);
         grasped(&mut g, 0.0);
-        assert_eq!(g.follow(0.1, false, &closure(0.0), &world(Vec3::ONE)), None);
-        assert_eq!(g.follow(0.55, false, &closure(0.0), &world(Vec3::ONE)), None, "0.45 s lost: within the grace time");
+        assert_eq!(g.follow(0.1, false, &closure(0.0), &world(Vec3::ONE), &world(Vec3::ZERO)), None);
+        assert_eq!(g.follow(0.55, false, &closure(0.0), &world(Vec3::ONE), &world(Vec3::ZERO)), None, "0.45 s lost: within the grace time");
         assert_eq!(g.target().unwrap().1, Vec3::ZERO, "stays where it was while lost");
-        assert_eq!(g.follow(0.6, true, &closure(40.0), &world(Vec3::ZERO)), None, "tracking back");
-        assert_eq!(g.follow(0.7, false, &closure(40.0), &world(Vec3::ZERO)), None);
-        assert!(matches!(g.follow(1.21, false, &closure(40.0), &world(Vec3::ZERO)), Some(GraspEvent::Release { linvel: Vec3::ZERO, .. })), "0.51 s lost: dropped");
+        assert_eq!(g.follow(0.6, true, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None, "tracking back");
+        assert_eq!(g.follow(0.7, false, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None);
+        assert!(matches!(g.follow(1.21, false, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), Some(GraspEvent::Release { linvel: Vec3::ZERO, .. })), "0.51 s lost: dropped");
     }
 }

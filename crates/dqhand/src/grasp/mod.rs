@@ -8,9 +8,11 @@
 //!   fingers is tracked closed past where its rendered copy stopped on the surface by
 //!   [`GraspParams::press_deg`]. A pinch (thumb and index tips) is the same rule on a
 //!   small object.
-//! * **Hold.** The touching points are fixed in their bones (the tracked ones, which the
-//!   user moves), with four points of the wrist's frame; each frame the object takes the
+//! * **Hold.** The touching points are fixed in their rendered bones, with four points of
+//!   the wrist's frame, and carried by the tracked wrist; each frame the object takes the
 //!   best-fit rigid motion ([`crate::math::rigid_fit`]) of those points since the grasp.
+//!   Rendered, not tracked, fingers: the tracked ones close on into the object after the
+//!   grasp and would drag it 1–3 cm across the palm; the rendered ones stop on its surface.
 //! * **Release.** The grasping fingers open past the tightest their rendered copies have
 //!   wrapped the object since the grasp by [`GraspParams::release_deg`] each (hysteresis:
 //!   between the two thresholds nothing changes). Not past their closure at the grasp: a

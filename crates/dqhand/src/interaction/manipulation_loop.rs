@@ -151,7 +151,7 @@ impl ManipulationLoop {
         let rig = engine.rig().expect("a gesture loop's engine has a rig");
         let limits = engine.limits();
         self.constraint.track(rig, limits, self.input.pipeline().pose());
-        let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world());
+        let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world(), self.constraint.world());
         if let Some((q, t)) = self.grasp.target() {
             let held = self.grasp.held().expect("a target is a held object's");
             let t = self.objects.above_table(held, q, t);
