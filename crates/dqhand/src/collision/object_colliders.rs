@@ -48,18 +48,21 @@ impl ObjectCollider {
         self.mesh.as_ref().map(|_| &self.solid)
     }
 
+    /// The distance from `shape` at `pose` to the [`Self::hull`], if there is one: a lower
+    /// bound of the distance to the surface.
+    #[must_use]
+    pub fn hull_distance(&self, pose: &Pose, shape: &dyn Shape) -> Option<f32> {
+        self.hull().and_then(|hull| query::distance(pose, shape, &self.pose, &**hull).ok()).map(|x| x.distance)
+    }
+
     /// The distance from `shape` at `pose` to the surface, or a lower bound of it above
     /// `enough` (m): the distance to the [`Self::hull`] when that is larger.
     #[must_use]
     pub fn distance_at_least(&self, pose: &Pose, shape: &dyn Shape, enough: f32) -> f32 {
-        if let Some(hull) = self.hull() {
-            if let Ok(d) = query::distance(pose, shape, &self.pose, &**hull).map(|x| x.distance) {
-                if d > enough {
-                    return d;
-                }
-            }
+        match self.hull_distance(pose, shape) {
+            Some(d) if d > enough => d,
+            _ => query::distance(pose, shape, &self.pose, &*self.surface).map_or(f32::INFINITY, |x| x.distance),
         }
-        query::distance(pose, shape, &self.pose, &*self.surface).map_or(f32::INFINITY, |x| x.distance)
     }
 }
 

@@ -124,10 +124,9 @@ impl Grasp {
             return (now - since > self.params.loss_grace_s).then(|| self.release(now, false));
         }
         held.lost_since = None;
-        let sum = |side: fn(&Closure) -> f32| -> f32 { closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| side(c)).sum() };
-        held.closure = held.closure.max(sum(|c| c.rendered));
+        held.closure = held.closure.max(grasping(closure, held.fingers, |c| c.rendered));
         let count = held.fingers.iter().filter(|g| **g).count() as f32;
-        if sum(|c| c.tracked) < held.closure - self.params.release_deg.to_radians() * count {
+        if grasping(closure, held.fingers, |c| c.tracked) < held.closure - self.params.release_deg.to_radians() * count {
             return Some(self.release(now, true));
         }
         let n = held.count;
@@ -185,7 +184,7 @@ impl Grasp {
             held.count += 1;
         }
         place(&held.anchors[..held.count], wrist, tracked_world, rendered_world, &mut held.reference);
-        held.closure = closure.iter().zip(held.fingers).filter(|(_, g)| *g).map(|(c, _)| c.rendered).sum();
+        held.closure = grasping(closure, held.fingers, |c| c.rendered);
         held.remember(now, &tracked_world[wrist]);
         self.held = Some(held);
         Some(GraspEvent::Grasp { object })
@@ -226,6 +225,11 @@ impl Grasp {
         };
         GraspEvent::Release { object: held.object, linvel, angvel }
     }
+}
+
+/// The grasping `fingers`' closures summed, `side` (tracked or rendered) of each.
+fn grasping(closure: &[Closure; 5], fingers: [bool; 5], side: fn(&Closure) -> f32) -> f32 {
+    closure.iter().zip(fingers).filter(|(_, g)| *g).map(|(c, _)| side(c)).sum()
 }
 
 /// Where `anchors` are now (into `out`): on the rendered bones, carried by the tracked
