@@ -107,6 +107,53 @@ fn rendered_skin_stays_out_of_the_ball_the_tracked_hand_does_not() {
 }
 
 #[test]
+fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
+    // Alone on the table, where the benchmark puts it: taken from above, its handle under the
+    // ring and little fingers, which arch the palm (CMC flexion) as they close.
+    let mut scene = scene("objects");
+    scene.objects.retain(|o| o.name == "teapot");
+    scene.objects[0].position = Vec3::new(-0.25, scene.objects[0].position.y, -0.3);
+    let s = script(&scene, &GraspTask::from_above("teapot"));
+    let objects = ObjectColliders::new(&scene).unwrap();
+    let m = objects.objects()[0].mesh.as_ref().unwrap();
+    let flat: benchmark::FlatMesh = (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect());
+    let (mut deepest, mut turned, mut held_frames, mut slid) = (0.0f32, 0.0f32, 0, 0.0f32);
+    let mut in_wrist: Option<glam::Quat> = None;
+    // Where each joint touching the held teapot was last frame, in the teapot's frame.
+    let mut touching: Vec<(usize, Vec3)> = Vec::new();
+    run(&scene, &s, |m, t, _| {
+        let skin = m.rendered_mut().skin(Method::Dqb).positions().to_vec();
+        let teapot = &m.objects().objects()[0];
+        for p in skin {
+            deepest = deepest.max(benchmark::depth(teapot, Some(&flat), Vec3::from(p)));
+        }
+        if m.held() == Some("teapot") {
+            held_frames += 1;
+            // The teapot's orientation in the tracked wrist's frame: the grip must not turn it.
+            let wrist = m.constraint().tracked_world()[0];
+            let (_, r, _) = wrist.to_scale_rotation_translation();
+            let here = r.inverse() * m.poses()[0].0;
+            let first = *in_wrist.get_or_insert(here);
+            turned = turned.max(first.angle_between(here));
+            // Until the fingers open to let go, the joints touching stay where they are on it.
+            let (q, p) = m.poses()[0];
+            let on_teapot = |j: usize| q.inverse() * (Vec3::from(m.constraint().world()[j].translation) - p);
+            for &(j, was) in touching.iter().filter(|_| t < s.times.release) {
+                slid = slid.max(on_teapot(j).distance(was));
+            }
+            touching = m.contacts().iter().filter(|c| c.object == 0).map(|c| (c.joint, on_teapot(c.joint))).collect();
+        } else {
+            in_wrist = None;
+            touching.clear();
+        }
+    });
+    assert!(held_frames > 60, "held for {held_frames} frames");
+    assert!(deepest <= 0.001, "the rendered skin went {deepest} m into the teapot");
+    assert!(turned.to_degrees() < 2.0, "the teapot turned {}° in the hand", turned.to_degrees());
+    assert!(slid < 0.0005, "a joint touching the teapot slid {slid} m over it");
+}
+
+#[test]
 fn a_strike_at_10_m_s_does_not_pass_through_a_thin_plate() {
     let scene = scene("objects");
     let plate = scene.object("plate").unwrap();

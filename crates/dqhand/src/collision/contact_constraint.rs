@@ -19,7 +19,9 @@
 //!    pass through anything. At the first contact the joints proximal to the touching phalanx
 //!    stop and the distal ones close on, so the finger wraps the object. Where the open
 //!    finger would itself be in an object (a thumb lying on the ball under the palm) the
-//!    closure starts from the finger as last rendered, which the wrist stage kept clear.
+//!    closure starts from the finger as last rendered, which the wrist stage kept clear; a
+//!    finger touching the held object starts there too, and keeps its grip. The ring and
+//!    little fingers' chains begin at their CMC joints, which arch the palm as they close.
 //!
 //! The tracked pose is left as it is: the grasp logic reads it.
 
@@ -78,6 +80,9 @@ struct FingerChain {
     /// The DOFs that close it (flexion; the thumb's CMC abduction too), proximal first:
     /// (index in the pose, joint it turns).
     dofs: Vec<(usize, usize)>,
+    /// The rest of its DOFs (abduction, twist), indices in the pose: a gripping finger keeps
+    /// them too.
+    others: Vec<usize>,
     /// Its proxies: (index in [`HandProxies::colliders`], the last DOF (position in `dofs`)
     /// that moves it, and per DOF an upper bound of the distance of its points from that
     /// DOF's joint, 0 where the DOF does not move it).
@@ -137,16 +142,20 @@ impl ContactConstraint {
             length
         };
         let fingers = core::array::from_fn(|f| {
-            // Flexion, and the thumb's opposition (CMC abduction), which also closes it.
+            // Flexion (the ring and little fingers' from their CMC joints, which arch the palm),
+            // and the thumb's opposition (CMC abduction), which also closes it.
             let closes = |d: &crate::kinematics::Dof| d.motion == Motion::Flex || d.bone == "thumb-metacarpal";
-            let mut dofs: Vec<(usize, usize)> = rig
-                .model()
-                .dofs()
-                .zip(rig.dofs())
-                .enumerate()
-                .filter(|(_, (d, r))| closes(d) && HandPart::of(&joints[r.joint].name) == HandPart::Finger(f))
-                .map(|(i, (_, r))| (i, r.joint))
-                .collect();
+            let (mut dofs, mut others) = (Vec::new(), Vec::new());
+            for (i, (d, r)) in rig.model().dofs().zip(rig.dofs()).enumerate() {
+                if !joints[r.joint].name.starts_with(FINGERS[f]) {
+                    continue;
+                }
+                if closes(d) {
+                    dofs.push((i, r.joint));
+                } else {
+                    others.push(i);
+                }
+            }
             let depth = |mut j: usize| {
                 let mut d = 0;
                 while let Some(p) = joints[j].parent {
@@ -157,11 +166,11 @@ impl ContactConstraint {
             dofs.sort_by_key(|&(_, j)| depth(j));
             assert!(dofs.len() <= 4, "at most four closing DOFs per finger");
             let mut reach: f32 = 0.0;
+            // Every proxy the chain moves: its phalanges', and a metacarpal's that turns.
             let proxies = proxies
                 .colliders()
                 .iter()
                 .enumerate()
-                .filter(|(_, p)| p.part == HandPart::Finger(f))
                 .filter_map(|(i, p)| {
                     let levers: Vec<f32> = dofs.iter().map(|&(_, j)| if is_ancestor(j, p.joint) { chain_length(j, p.joint) + p.extent } else { 0.0 }).collect();
                     let last = levers.iter().rposition(|&l| l > 0.0)?;
@@ -169,7 +178,7 @@ impl ContactConstraint {
                     Some((i, last, levers))
                 })
                 .collect();
-            FingerChain { dofs, proxies, reach }
+            FingerChain { dofs, others, proxies, reach }
         });
         let n = skeleton.len();
         Self {
@@ -222,8 +231,8 @@ impl ContactConstraint {
 
     /// Solves the rendered pose for the tracked pose of [`Self::track`] at time `now` (s)
     /// against `objects`; `held`, the object in the hand, moves with the hand, so it does not
-    /// stop the wrist (the fingers still close on it). Allocates nothing once `near` has grown
-    /// to the scene.
+    /// stop the wrist, and the fingers that touched it keep their grip (see
+    /// [`Self::close_finger`]). Allocates nothing once `near` has grown to the scene.
     pub fn solve(&mut self, rig: &HandRig, limits: Limits, objects: &ObjectColliders, held: Option<usize>, now: f64) {
         if self.near.capacity() < objects.objects().len() {
             self.near.reserve(objects.objects().len());
@@ -246,7 +255,7 @@ impl ContactConstraint {
         self.rendered.clone_from(&self.tracked);
         self.rendered.wrist = Some(wrist);
         for f in 0..FINGERS.len() {
-            self.close_finger(rig, limits, f, objects);
+            self.close_finger(rig, limits, f, objects, held);
         }
         self.forward(rig, limits);
         self.find_contacts(objects);
@@ -325,18 +334,33 @@ impl ContactConstraint {
     }
 
     /// Stage 2 for finger `f`: conservative advancement of its closure.
-    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders) {
+    ///
+    /// A finger that touched the `held` object last frame keeps its grip until the tracked
+    /// finger opens past it: the closure starts from the finger as last rendered, the joints up
+    /// to a phalanx touching there stay, and the distal ones close on (it wraps the object
+    /// further). Closing it from open again would ask the object the same questions every
+    /// frame, and a slightly different path may end on a different contact (the tracked
+    /// finger has gone into the object), turning the object in the hand. Its abduction stays
+    /// too: it would slide the touching phalanx sideways, unchecked.
+    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders, held: Option<usize>) {
         let chain = std::mem::take(&mut self.fingers[f]);
         if chain.dofs.is_empty() {
             self.fingers[f] = chain;
             return;
         }
+        let opening = self.closure[f].tracked < self.closure[f].rendered;
+        let gripping = held.is_some_and(|h| !opening && self.contacts.iter().any(|c| c.object == h && c.part == HandPart::Finger(f)));
         // The closure runs from `start` to the tracked angles (`self.rendered` holds those).
         let mut target = [0.0f32; 4];
         let mut start = [0.0f32; 4];
         for (k, &(i, _)) in chain.dofs.iter().enumerate() {
             target[k] = self.rendered.angles[i];
             self.rendered.angles[i] = 0.0;
+        }
+        if gripping {
+            for &i in &chain.others {
+                self.rendered.angles[i] = self.previous.angles[i];
+            }
         }
         self.forward(rig, limits);
         let root = Vec3::from(self.world[chain.dofs[0].1].translation);
@@ -356,8 +380,14 @@ impl ContactConstraint {
             // none is (an object has moved into the finger), the finger stays as last
             // rendered, the least change, and the physics pushes the object off it.
             // `checking` is the start being tried (0 open, 1 last rendered, 2 tracked) until
-            // one is clear.
+            // one is clear. A gripping finger starts as last rendered, touching.
             let mut checking = Some(0);
+            if gripping {
+                for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                    start[k] = self.previous.angles[i];
+                }
+                checking = None;
+            }
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward(rig, limits);

@@ -15,7 +15,8 @@ pub const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "pinky"];
 /// The part of the hand a proxy belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HandPart {
-    /// The wrist and the four finger metacarpals: they move with the wrist.
+    /// The wrist and the four finger metacarpals: they move with the wrist (the ring and little
+    /// ones also turn a little at their CMC joints as those fingers close).
     Palm,
     /// A finger's phalanges (index into [`FINGERS`]); the thumb's include its metacarpal,
     /// which moves at the CMC joint.
