@@ -117,7 +117,7 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     let objects = ObjectColliders::new(&scene).unwrap();
     let m = objects.objects()[0].mesh.as_ref().unwrap();
     let flat: benchmark::FlatMesh = (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect());
-    let (mut deepest, mut turned, mut held_frames, mut slid) = (0.0f32, 0.0f32, 0, 0.0f32);
+    let (mut deepest, mut turned, mut held_frames, mut slid, mut off_surface) = (0.0f32, 0.0f32, 0, 0.0f32, 0.0f32);
     let mut in_wrist: Option<glam::Quat> = None;
     // Where each joint touching the held teapot was last frame, in the teapot's frame.
     let mut touching: Vec<(usize, Vec3)> = Vec::new();
@@ -142,6 +142,12 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
                 slid = slid.max(on_teapot(j).distance(was));
             }
             touching = m.contacts().iter().filter(|c| c.object == 0).map(|c| (c.joint, on_teapot(c.joint))).collect();
+            // Its contacts (kept from frame to frame while the grip holds still) lie on it.
+            let teapot = &m.objects().objects()[0];
+            for c in m.contacts() {
+                let on = teapot.surface.project_point(&teapot.pose, c.point, false).point;
+                off_surface = off_surface.max(on.distance(c.point));
+            }
         } else {
             in_wrist = None;
             touching.clear();
@@ -151,6 +157,7 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     assert!(deepest <= 0.001, "the rendered skin went {deepest} m into the teapot");
     assert!(turned.to_degrees() < 2.0, "the teapot turned {}° in the hand", turned.to_degrees());
     assert!(slid < 0.0005, "a joint touching the teapot slid {slid} m over it");
+    assert!(off_surface < 1e-4, "a contact point lay {off_surface} m off the held teapot's surface");
 }
 
 #[test]

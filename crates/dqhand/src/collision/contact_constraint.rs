@@ -41,6 +41,11 @@ pub const CONTACT_DISTANCE: f32 = 0.002;
 /// skin off.
 pub const STOP_DISTANCE: f32 = 0.0004;
 
+/// A wrist motion that moves no proxy point farther than this (m) is not cast: nothing is
+/// passed through in a micrometre, and a still hand would ask every query of the last frame
+/// again (a hand closing on an object holds its wrist still).
+const STILL_M: f32 = 1e-6;
+
 /// Steps of conservative advancement per finger stage: enough to converge from any start; a
 /// finger that has not converged stays where it safely is.
 const MAX_ADVANCES: usize = 40;
@@ -108,7 +113,19 @@ pub struct ContactConstraint {
     /// The object held and the rendered wrist in its frame at the grasp.
     grip: Option<(usize, DualQuat)>,
     held_back_since: Option<f64>,
+    /// The object that carried the rendered hand (its grip) in the last solve, and its pose
+    /// there: the contacts with it were found at that pose.
+    carried: Option<(usize, parry3d::math::Pose)>,
+    /// Per finger: its last closure ended with every joint stopped on a contact.
+    settled: [bool; 5],
+    /// Per finger: its rendered angles are the last frame's.
+    kept: [bool; 5],
+    /// Per joint: the finger whose closure moves it (none for the palm, which only the wrist
+    /// moves).
+    moved_by: Vec<Option<usize>>,
     contacts: Vec<Contact>,
+    /// The last frame's contacts (a second buffer, swapped with `contacts`).
+    last_contacts: Vec<Contact>,
     closure: [Closure; 5],
     near: Vec<usize>,
 }
@@ -181,8 +198,14 @@ impl ContactConstraint {
             FingerChain { dofs, others, proxies, reach }
         });
         let n = skeleton.len();
+        let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
         Self {
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
+            last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
+            carried: None,
+            settled: [false; 5],
+            kept: [false; 5],
+            moved_by,
             proxies,
             fingers,
             locals: skeleton.rest_locals(),
@@ -205,6 +228,7 @@ impl ContactConstraint {
         self.wrist = None;
         self.held_back_since = None;
         self.grip = None;
+        self.carried = None;
     }
 
     /// Object `object` has been grasped: from the next [`Self::solve`] while it is held, the
@@ -239,26 +263,33 @@ impl ContactConstraint {
         }
         let tracked = &self.tracked;
         let target = tracked.wrist.unwrap_or_else(|| rig.rest_wrist());
-        let wrist = match self.grip {
+        let (wrist, carrier) = match self.grip {
             Some((object, offset)) if Some(object) == held => {
                 self.held_back_since = None;
                 let pose = &objects.objects()[object].pose;
-                DualQuat::from_rotation_translation(pose.rotation, pose.translation) * offset
+                (DualQuat::from_rotation_translation(pose.rotation, pose.translation) * offset, Some(object))
             }
             _ => {
                 self.grip = None;
-                self.solve_wrist(rig, target, objects, held, now)
+                (self.solve_wrist(rig, target, objects, held, now), None)
             }
         };
+        // Carried by the same object last frame and this one, the hand has not moved on it:
+        // what the fingers keep of their pose need not be asked of it again.
+        let still_on = self.carried.filter(|&(o, _)| Some(o) == carrier);
         self.wrist = Some(wrist);
         self.previous.clone_from(&self.rendered);
         self.rendered.clone_from(&self.tracked);
         self.rendered.wrist = Some(wrist);
         for f in 0..FINGERS.len() {
-            self.close_finger(rig, limits, f, objects, held);
+            self.close_finger(rig, limits, f, objects, held, still_on.is_some());
+            let chain = &self.fingers[f];
+            let same = |i: usize| self.rendered.angles[i].to_bits() == self.previous.angles[i].to_bits();
+            self.kept[f] = chain.dofs.iter().all(|&(i, _)| same(i)) && chain.others.iter().all(|&i| same(i));
         }
         self.forward(rig, limits);
-        self.find_contacts(objects);
+        self.find_contacts(objects, still_on);
+        self.carried = carrier.map(|o| (o, objects.collider(o).pose));
         for (f, chain) in self.fingers.iter().enumerate() {
             self.closure[f].rendered = chain.dofs.iter().map(|&(i, _)| self.rendered.angles[i]).sum();
         }
@@ -281,6 +312,11 @@ impl ContactConstraint {
         // The whole hand moves rigidly, its fingers as last rendered: a finger or the thenar
         // must not be carried into an object by the wrist either.
         let to_wrist = self.world[rig.wrist()].inverse();
+        let reach = self.proxies.colliders().iter().map(|p| (to_wrist * self.world[p.joint]).translation.length() + p.extent).fold(0.0, f32::max);
+        if linvel.length() + angvel.length() * reach < STILL_M {
+            self.held_back_since = None;
+            return target;
+        }
         let mut toi: f32 = 1.0;
         // The fastest any proxy point moves, m per unit of the motion: turns the stop gap
         // into a time.
@@ -342,7 +378,11 @@ impl ContactConstraint {
     /// frame, and a slightly different path may end on a different contact (the tracked
     /// finger has gone into the object), turning the object in the hand. Its abduction stays
     /// too: it would slide the touching phalanx sideways, unchecked.
-    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders, held: Option<usize>) {
+    ///
+    /// A gripping finger that was `still` on the held object (see [`Self::solve`]) and had
+    /// settled on it (every joint stopped on a contact) stays as it was without a query: a
+    /// closure from there stops at once.
+    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
         let chain = std::mem::take(&mut self.fingers[f]);
         if chain.dofs.is_empty() {
             self.fingers[f] = chain;
@@ -350,6 +390,13 @@ impl ContactConstraint {
         }
         let opening = self.closure[f].tracked < self.closure[f].rendered;
         let gripping = held.is_some_and(|h| !opening && self.contacts.iter().any(|c| c.object == h && c.part == HandPart::Finger(f)));
+        if gripping && still && self.settled[f] {
+            for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
+                self.rendered.angles[i] = self.previous.angles[i];
+            }
+            self.fingers[f] = chain;
+            return;
+        }
         // The closure runs from `start` to the tracked angles (`self.rendered` holds those).
         let mut target = [0.0f32; 4];
         let mut start = [0.0f32; 4];
@@ -450,15 +497,32 @@ impl ContactConstraint {
                 self.rendered.angles[i] = target[k];
             }
         }
+        self.settled[f] = active >= chain.dofs.len();
         self.fingers[f] = chain;
     }
 
-    fn find_contacts(&mut self, objects: &ObjectColliders) {
+    /// The contacts of the rendered pose. Where the hand was `still_on` an object (carried by
+    /// it last frame and this one, at the pose given), the contacts with it of every joint the
+    /// fingers kept still are last frame's, moved with the object: rigidly attached, they are
+    /// the same.
+    fn find_contacts(&mut self, objects: &ObjectColliders, still_on: Option<(usize, parry3d::math::Pose)>) {
+        std::mem::swap(&mut self.contacts, &mut self.last_contacts);
         self.contacts.clear();
+        let (moved_by, kept) = (&self.moved_by, &self.kept);
+        let unmoved = |j: usize| still_on.is_some() && moved_by[j].is_none_or(|f| kept[f]);
+        if let Some((object, then)) = still_on {
+            let now = objects.collider(object).pose;
+            let turn = now.rotation * then.rotation.inverse();
+            for c in self.last_contacts.iter().filter(|c| c.object == object && unmoved(c.joint)) {
+                let point = turn * (c.point - then.translation) + now.translation;
+                self.contacts.push(Contact { point, normal: turn * c.normal, ..*c });
+            }
+        }
         for p in self.proxies.colliders() {
             let pose = pose_of(&self.world[p.joint]);
             let aabb = p.shape.compute_aabb(&pose);
-            for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, None).filter(|(i, _)| *i < objects.objects().len()) {
+            let skip = still_on.map(|(o, _)| o).filter(|_| unmoved(p.joint));
+            for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, skip).filter(|(i, _)| *i < objects.objects().len()) {
                 if o.distance_at_least(&pose, &*p.shape, CONTACT_DISTANCE) > CONTACT_DISTANCE {
                     continue;
                 }
