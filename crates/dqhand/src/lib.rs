@@ -8,6 +8,7 @@
 //! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
 //! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
 //! * [`model`] — a skeleton and the mesh bound to it;
+//! * [`gltf_file`] — a glTF 2.0 file opened safely, for the importer and scene meshes;
 //! * [`scene`] — the objects and table of the manipulation loop, from scene files;
 //! * [`collision`] — collision proxies per bone (paper 4.2), the scene's shapes, and the
 //!   contact constraint: continuous collision detection that keeps the rendered hand out of
@@ -34,6 +35,7 @@ pub mod collision;
 pub mod engine;
 pub mod geometry;
 pub mod gesture;
+pub mod gltf_file;
 pub mod grasp;
 pub mod hand;
 pub mod input;

@@ -141,7 +141,103 @@ fn degenerate_meshes_are_repaired_or_refused_with_a_reason() {
     let e = ObjectMesh::load(&bad_index).unwrap_err().to_string();
     assert!(e.starts_with(&bad_index.display().to_string()), "{e}");
     let e = ObjectMesh::load(Path::new("teapot.stl")).unwrap_err().to_string();
-    assert!(e.starts_with("teapot.stl: not an OBJ file"), "{e}");
+    assert!(e.starts_with("teapot.stl: not a mesh file (.obj, .glb or .gltf)"), "{e}");
     let e = ObjectMesh::load(Path::new("/no/such/teapot.obj")).unwrap_err().to_string();
     assert!(e.starts_with("/no/such/teapot.obj"), "{e}");
+}
+
+/// A `.gltf` with one triangle (in a base64 `data:` buffer) under a node scaled by 2 and moved
+/// by (1, 0, 0), under a parent turned 90° about +Y, and a second node that is a line (skipped).
+fn gltf_json(scene: &str) -> String {
+    // Three vertices (0,0,0), (1,0,0), (0,1,0), then indices 0 1 2 and two bytes of padding.
+    let mut bin = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 0] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    use base64::Engine as _;
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let turn = [0.0, std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2];
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, {scene}
+            "nodes": [{{"rotation": {turn:?}, "children": [1, 2]}}, {{"mesh": 0, "translation": [1, 0, 0], "scale": [2, 2, 2]}}, {{"mesh": 1}}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}, {{"primitives": [{{"attributes": {{"POSITION": 0}}, "mode": 1}}]}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+                          {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}}],
+            "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 6}}],
+            "buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{data}"}}]}}"#,
+        bin.len()
+    )
+}
+
+/// glTF meshes are placed by their nodes' world transforms (checked by hand: a turn of 90°
+/// about +Y takes x to −z); primitives that are not triangles are skipped with a warning.
+#[test]
+fn a_gltf_mesh_reads_in_its_scene_frame() {
+    let dir = std::env::temp_dir().join(format!("dqhand-gltf-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("triangle.gltf");
+    std::fs::write(&path, gltf_json(r#""scene": 0, "scenes": [{"nodes": [0]}],"#)).unwrap();
+    let mesh = ObjectMesh::load(&path).unwrap();
+    // Local (x, y, z) → scaled and moved (2x + 1, 2y, 2z) → turned (2z, 2y, −(2x + 1)).
+    let expected = [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.0, 0.0, -3.0), Vec3::new(0.0, 2.0, -1.0)];
+    assert_eq!(mesh.triangles, [[0, 1, 2]]);
+    for (v, e) in mesh.vertices.iter().zip(expected) {
+        assert!(v.distance(e) < 1e-5, "{v} for {e}");
+    }
+    assert!(mesh.warnings.iter().any(|w| w.contains("1 primitives that are not triangles skipped")), "{:?}", mesh.warnings);
+    // Without a scene, every node without a parent is a root; the same triangle.
+    std::fs::write(&path, gltf_json("")).unwrap();
+    assert_eq!(ObjectMesh::load(&path).unwrap().vertices.len(), 3);
+}
+
+/// The committed teapot written as `.glb` (by the project's writer) reads as the same mesh as
+/// its OBJ (through tobj), and a scene can use it.
+#[test]
+fn the_teapot_reads_the_same_from_glb() {
+    let obj = ObjectMesh::load(&teapot_path()).unwrap();
+    let dir = std::env::temp_dir().join(format!("dqhand-teapot-glb-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let glb = dir.join("teapot.glb");
+    let positions: Vec<[f32; 3]> = obj.vertices.iter().map(|v| v.to_array()).collect();
+    let indices: Vec<u32> = obj.triangles.iter().flatten().copied().collect();
+    dqhand::io::write_posed(&glb, &positions, &vec![[0.0, 1.0, 0.0]; positions.len()], &[], &indices).unwrap();
+    let read = ObjectMesh::load(&glb).unwrap();
+    assert_eq!(read.vertices, obj.vertices);
+    assert_eq!(read.triangles, obj.triangles);
+    std::fs::write(dir.join("scene.json"), r#"{"objects": [{"name": "teapot", "shape": "mesh", "file": "teapot.glb", "position": [0, 1, 0], "mass": 0.5}]}"#).unwrap();
+    let scene = Scene::load(&dir.join("scene.json")).unwrap();
+    dqhand::collision::ObjectColliders::new(&scene).unwrap();
+}
+
+/// Malformed glTF meshes are refused naming the file and the problem, never a panic: a
+/// primitive naming an accessor that does not exist (it panicked inside the `gltf` crate), an
+/// index out of range, a node hierarchy that loops (read once, no hang).
+#[test]
+fn malformed_gltf_meshes_are_refused_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("dqhand-bad-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let refused = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let e = ObjectMesh::load(&path).unwrap_err().to_string();
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        e
+    };
+    let e = refused("dangling.gltf", r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#);
+    assert!(e.contains("POSITION uses accessor 0, but there are 0"), "{e}");
+    // The indices read from the first vertex's bytes: 1.0f32 makes index 16256.
+    let e = refused("index.gltf", &gltf_json("").replace(r#"{"bufferView": 1, "componentType": 5123"#, r#"{"bufferView": 0, "byteOffset": 12, "componentType": 5123"#));
+    assert!(e.contains("index 16256 is out of range for 3 vertices"), "{e}");
+    let looping = gltf_json("").replace(r#"{"mesh": 1}"#, r#"{"mesh": 1, "children": [0]}"#);
+    let path = dir.join("loop.gltf");
+    std::fs::write(&path, looping).unwrap();
+    match ObjectMesh::load(&path) {
+        Ok(mesh) => assert_eq!(mesh.vertices.len(), 3),
+        Err(e) => assert!(e.to_string().starts_with(&path.display().to_string()), "{e}"),
+    }
+    let e = refused("junk.glb", "glTF not really");
+    assert!(e.contains("glTF") || e.contains("GLB"), "{e}");
 }

@@ -255,8 +255,8 @@ impl ContactConstraint {
 
     /// Solves the rendered pose for the tracked pose of [`Self::track`] at time `now` (s)
     /// against `objects`; `held`, the object in the hand, moves with the hand, so it does not
-    /// stop the wrist, and the fingers that touched it keep their grip (see
-    /// [`Self::close_finger`]). Allocates nothing once `near` has grown to the scene.
+    /// stop the wrist, and the fingers that touched it keep their grip (the module
+    /// documentation, stage 2). Allocates nothing once `near` has grown to the scene.
     pub fn solve(&mut self, rig: &HandRig, limits: Limits, objects: &ObjectColliders, held: Option<usize>, now: f64) {
         if self.near.capacity() < objects.objects().len() {
             self.near.reserve(objects.objects().len());

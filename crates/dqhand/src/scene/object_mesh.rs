@@ -1,13 +1,16 @@
 //! The triangle mesh of a scene object (`"shape": "mesh"`), from OBJ (tobj: every object of
-//! the file, faces fanned into triangles), cleaned for collision: triangles without area
-//! dropped (a warning says how many).
+//! the file, faces fanned into triangles) or glTF 2.0 (`.glb`, `.gltf`: every triangle
+//! primitive of the meshes of the default scene, placed by its nodes' transforms), cleaned for
+//! collision: triangles without area dropped (a warning says how many).
 //! A mesh need not be closed (the Utah teapot is not) or have a volume (a plate modelled as
 //! one sheet): it then collides as a surface, and a warning says so.
 
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
+use gltf::accessor::{DataType, Dimensions};
 
+use crate::gltf_file;
 use crate::{Error, Result};
 
 /// Triangles with less area than this (square metres) are degenerate: a 0.1 mm sliver.
@@ -27,19 +30,29 @@ pub struct ObjectMesh {
 }
 
 impl ObjectMesh {
-    /// Reads `path`, an `.obj` file.
+    /// Reads `path`, an `.obj`, `.glb` or `.gltf` file.
     ///
     /// # Errors
-    /// [`Error::File`] wrapping [`Error::ObjectMesh`] (another extension, a file the reader
-    /// refuses, coordinates that are not finite, indices out of range, no triangle with an
-    /// area), or [`Error::Io`].
+    /// [`Error::File`] wrapping [`Error::ObjectMesh`] or [`Error::Gltf`] (another extension, a
+    /// file the reader refuses, coordinates that are not finite, indices out of range, no
+    /// triangle with an area), or [`Error::Io`].
     pub fn load(path: &Path) -> Result<Self> {
-        let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-        if !is_obj {
-            return Err(Error::ObjectMesh("not an OBJ file (.obj)".into()).in_file(path));
-        }
-        let (vertices, indices) = read_obj(path)?;
-        Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))
+        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let (vertices, indices, mut warnings) = match extension.as_deref() {
+            Some("obj") => {
+                let (vertices, indices) = read_obj(path)?;
+                (vertices, indices, Vec::new())
+            }
+            Some("glb" | "gltf") => {
+                let bytes = std::fs::read(path).map_err(Error::io(path))?;
+                read_gltf(&bytes, path).map_err(|e| e.in_file(path))?
+            }
+            _ => return Err(Error::ObjectMesh("not a mesh file (.obj, .glb or .gltf)".into()).in_file(path)),
+        };
+        let mut mesh = Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))?;
+        warnings.append(&mut mesh.warnings);
+        mesh.warnings = warnings;
+        Ok(mesh)
     }
 
     /// A mesh from `vertices` and a flat triangle index list, checked and cleaned.
@@ -97,4 +110,56 @@ fn read_obj(path: &Path) -> Result<(Vec<Vec3>, Vec<u32>)> {
         indices.extend(model.mesh.indices.iter().map(|i| base + i));
     }
     Ok((vertices, indices))
+}
+
+/// A glTF's triangles, in the frame of its default scene (else its first; else every node
+/// that has no parent): each mesh node's primitives placed by the node's world transform.
+/// Primitives that are not triangles are skipped (a warning says how many).
+fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<String>)> {
+    let (gltf, buffers) = gltf_file::open(bytes, path)?;
+    let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
+    let mut roots: Vec<(gltf::Node<'_>, Mat4)> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(scene) => scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
+        None => {
+            let children: std::collections::HashSet<usize> = gltf.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            gltf.nodes().filter(|n| !children.contains(&n.index())).map(|n| (n, Mat4::IDENTITY)).collect()
+        }
+    };
+    let (mut vertices, mut indices, mut skipped) = (Vec::new(), Vec::new(), 0);
+    // Each node once, whatever its place in the hierarchy (a file may make a cycle of it).
+    let mut seen = vec![false; gltf.nodes().len()];
+    while let Some((node, parent)) = roots.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue;
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        roots.extend(node.children().map(|c| (c, world)));
+        let Some(mesh) = node.mesh() else { continue };
+        for prim in mesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                skipped += 1;
+                continue;
+            }
+            let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            gltf_file::check_accessor(prim.get(&gltf::Semantic::Positions), &format!("{what} POSITION"), (Dimensions::Vec3, &[DataType::F32]), &buffers)?;
+            gltf_file::check_accessor(prim.indices(), &format!("{what} index"), (Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32]), &buffers)?;
+            let reader = prim.reader(get);
+            let positions = reader.read_positions().ok_or_else(|| Error::Gltf(format!("{what} has no POSITION accessor")))?;
+            let base = vertices.len() as u32;
+            vertices.extend(positions.map(|p| world.transform_point3(Vec3::from(p))));
+            let n = vertices.len() as u32 - base;
+            match reader.read_indices() {
+                Some(i) => {
+                    let i: Vec<u32> = i.into_u32().collect();
+                    if let Some(&bad) = i.iter().find(|&&i| i >= n) {
+                        return Err(Error::Gltf(format!("{what}: index {bad} is out of range for {n} vertices")));
+                    }
+                    indices.extend(i.iter().map(|i| base + i));
+                }
+                None => indices.extend(base..base + n),
+            }
+        }
+    }
+    let warnings = if skipped > 0 { vec![format!("{skipped} primitives that are not triangles skipped")] } else { Vec::new() };
+    Ok((vertices, indices, warnings))
 }

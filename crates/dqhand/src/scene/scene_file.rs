@@ -92,7 +92,7 @@ pub enum ObjectShape {
         /// Metres, along +Y.
         height: f32,
     },
-    /// A triangle mesh (an `.obj` file; read with [`super::ObjectMesh::load`]).
+    /// A triangle mesh (an `.obj`, `.glb` or `.gltf` file; read with [`super::ObjectMesh::load`]).
     Mesh {
         /// The file, resolved against the scene file's folder.
         file: PathBuf,
