@@ -20,7 +20,7 @@ use dqhand::scene::Scene;
 use dqhand::skin::Method;
 use serde_json::{json, Map, Value};
 
-use crate::recording::{Format, GestureArgs, InputArgs, RecordingReader};
+use crate::recording::RecordingArgs;
 
 /// Arguments of `dqhand grasp`.
 #[derive(clap::Args)]
@@ -28,16 +28,8 @@ pub struct Args {
     /// The scene: a built-in one (`grasp`, `objects`) or a scene JSON file.
     #[arg(long)]
     scene: String,
-    /// The recording (glove CSV, or joints/landmarks JSON lines).
-    #[arg(long)]
-    input: PathBuf,
-    /// Its format (default: `.csv` is glove, anything else JSON lines).
-    #[arg(long)]
-    format: Option<Format>,
     #[command(flatten)]
-    common: InputArgs,
-    #[command(flatten)]
-    recognition: GestureArgs,
+    recording: RecordingArgs,
     /// Write one JSON line per frame here.
     #[arg(long)]
     trace: PathBuf,
@@ -60,9 +52,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let scene = Scene::named(&args.scene)?;
     let model = Arc::new(args.model.load()?);
     let joint_model = JointModel::Full;
-    let mapper = Some(args.common.mapper(joint_model)?);
-    let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
-    let mut manip = ManipulationLoop::new(model, joint_model, mapper, args.common.config()?, args.recognition.set()?, &scene, GraspParams::default())?;
+    let mapper = Some(args.recording.common.mapper(joint_model)?);
+    let mut reader = args.recording.reader()?;
+    let mut manip = ManipulationLoop::new(model, joint_model, mapper, args.recording.common.config()?, args.recording.recognition.set()?, &scene, GraspParams::default())?;
     for w in manip.objects().warnings() {
         eprintln!("dqhand: warning: {}: {w}", args.scene);
     }
@@ -71,7 +63,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
     let names: Vec<String> = manip.rendered().skeleton().names().map(str::to_owned).collect();
-    let mut record = Record { time: 0.0, side: args.common.hand, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None };
     let mut pending: Option<Record> = None;
     let (mut frame, mut refused) = (0u64, 0u64);
     let mut clock: Option<f64> = None;
@@ -80,7 +72,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // Every record up to this frame's time goes in before the frame.
         let next = match pending.take() {
             Some(r) => Some(r),
-            None => match reader.next(&mut record).with_context(|| args.input.display().to_string())? {
+            None => match reader.next(&mut record).with_context(|| args.recording.input.display().to_string())? {
                 None => None,
                 Some(Err(rejection)) => {
                     refused += 1;

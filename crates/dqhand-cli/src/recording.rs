@@ -109,6 +109,28 @@ pub enum RecordingReader {
     Glove(GloveCsvReader<BufReader<File>>),
 }
 
+/// A recording to play and what to do with it: the options `replay` and `grasp` share.
+#[derive(clap::Args)]
+pub struct RecordingArgs {
+    /// The recording (glove CSV, or joints/landmarks JSON lines).
+    #[arg(long)]
+    pub input: PathBuf,
+    /// Its format (default: `.csv` is glove, anything else JSON lines).
+    #[arg(long)]
+    pub format: Option<Format>,
+    #[command(flatten)]
+    pub common: InputArgs,
+    #[command(flatten)]
+    pub recognition: GestureArgs,
+}
+
+impl RecordingArgs {
+    /// The recording, opened.
+    pub fn reader(&self) -> anyhow::Result<RecordingReader> {
+        RecordingReader::open(&self.input, self.format, &self.common)
+    }
+}
+
 impl RecordingReader {
     /// Opens `path` as `format`, or by its extension (`.csv` glove, else JSON lines).
     pub fn open(path: &Path, format: Option<Format>, args: &InputArgs) -> anyhow::Result<Self> {

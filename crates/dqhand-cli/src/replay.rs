@@ -16,21 +16,13 @@ use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
 use dqhand::math::quantile;
 
-use crate::recording::{Format, GestureArgs, InputArgs, RecordingReader};
+use crate::recording::RecordingArgs;
 
 /// Arguments of `dqhand replay`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The recording (glove CSV, or joints/landmarks JSON lines).
-    #[arg(long)]
-    input: PathBuf,
-    /// Its format (default: `.csv` is glove, anything else JSON lines).
-    #[arg(long)]
-    format: Option<Format>,
     #[command(flatten)]
-    common: InputArgs,
-    #[command(flatten)]
-    recognition: GestureArgs,
+    recording: RecordingArgs,
     /// Write the retargeted pose of every record here (JSON lines: `t`, `tracking` and a
     /// pose file's `model`, `wrist`, `angles_deg`).
     #[arg(long)]
@@ -48,22 +40,22 @@ pub struct Args {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = Arc::new(args.model.load()?);
-    let gestures = args.recognition.set()?;
-    let mapper = Some(args.common.mapper(args.joint_model)?);
-    let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
-    let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.common.config()?, gestures)?;
+    let gestures = args.recording.recognition.set()?;
+    let mapper = Some(args.recording.common.mapper(args.joint_model)?);
+    let mut reader = args.recording.reader()?;
+    let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.recording.common.config()?, gestures)?;
     let mut out = match &args.out {
         Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path).with_context(|| path.display().to_string())?)),
         None => None,
     };
     let stdout = std::io::stdout();
     let mut events_out = std::io::BufWriter::new(stdout.lock());
-    let mut record = Record { time: 0.0, side: args.common.hand, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None };
     let (mut records, mut times_us, mut sizes) = (0u64, Vec::new(), Vec::new());
     let start = Instant::now();
     loop {
         let t0 = Instant::now();
-        let Some(read) = reader.next(&mut record).with_context(|| args.input.display().to_string())? else { break };
+        let Some(read) = reader.next(&mut record).with_context(|| args.recording.input.display().to_string())? else { break };
         records += 1;
         if let Err(rejection) = read {
             gesture_loop.reject(rejection);
@@ -101,9 +93,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let elapsed = start.elapsed().as_secs_f64();
     let pipeline = gesture_loop.pipeline();
     for line in pipeline.rejections().summary() {
-        eprintln!("dqhand: {}: {line}", args.input.display());
+        eprintln!("dqhand: {}: {line}", args.recording.input.display());
     }
-    eprintln!("{}: {records} records, {} taken, {} rejected{}", args.input.display(), pipeline.accepted(), pipeline.rejections().total(), if pipeline.tracking() == Tracking::Lost { ", tracking lost at the end" } else { "" });
+    eprintln!("{}: {records} records, {} taken, {} rejected{}", args.recording.input.display(), pipeline.accepted(), pipeline.rejections().total(), if pipeline.tracking() == Tracking::Lost { ", tracking lost at the end" } else { "" });
     if args.stats {
         let median = Distribution::of(&mut times_us).map_or(0.0, |d| d.median);
         eprintln!("{:.0} records per second, {median:.1} µs per taken record (median: read, filter, retarget, FK, features, recogniser)", records as f64 / elapsed);

@@ -224,6 +224,55 @@ fn a_dropped_ball_bounces_and_rests_on_the_table_a_thrown_one_flies() {
 }
 
 #[test]
+fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
+    use dqhand::collision::{fit_proxies, pose_of, HandProxies, PROXY_MARGIN};
+    use parry3d::bounding_volume::BoundingVolume;
+    let scene = Scene::from_json(
+        r#"{"table": {"height": 0.7}, "objects": [{"name": "ball", "shape": "sphere", "radius": 0.04, "position": [0, 0.74, 0], "mass": 0.15}]}"#,
+        "roll.json",
+        Path::new("."),
+    )
+    .unwrap();
+    let objects = ObjectColliders::new(&scene).unwrap();
+    let model = model();
+    let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), &model.skeleton);
+    // The hand at rest (flat), moved to lie on the table 10 cm along +X from the ball.
+    let rest = model.skeleton.rest_world();
+    let boxes = proxies.colliders().iter().map(|p| p.shape.compute_aabb(&pose_of(&rest[p.joint])));
+    let b = boxes.reduce(|a, b| a.merged(&b)).unwrap();
+    let shift = Vec3::new(0.04 + 0.1 - b.mins.x, 0.7 + 0.001 - b.mins.y, -b.center().z);
+    let world: Vec<glam::Affine3A> = rest.iter().map(|w| glam::Affine3A::from_translation(shift) * *w).collect();
+    let ball = parry3d::shape::Ball::new(0.04);
+    // Rolled at the hand at 1.5 m/s, with the hand in the world and without: how deep the
+    // ball goes into the hand's proxies.
+    let roll = |with_hand: bool| {
+        let mut physics = ScenePhysics::new(&scene, &objects);
+        if with_hand {
+            physics.add_hand(&proxies);
+            physics.move_hand(&world);
+        }
+        physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.74, 0.0));
+        physics.step(1.0 / 60.0);
+        physics.release(0, Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO);
+        let mut deepest = 0.0f32;
+        for _ in 0..60 {
+            physics.move_hand(&world);
+            physics.step(1.0 / 60.0);
+            let at = parry3d::math::Pose::from_translation(physics.pose(0).1);
+            for p in proxies.colliders() {
+                if let Ok(Some(c)) = parry3d::query::contact(&at, &ball, &pose_of(&world[p.joint]), &*p.shape, 0.0) {
+                    deepest = deepest.max(-c.dist);
+                }
+            }
+        }
+        deepest
+    };
+    assert!(roll(false) > 0.02, "without the hand the ball rolls through where it lies");
+    let deepest = roll(true);
+    assert!(deepest < 0.002, "the ball went {deepest} m into the hand");
+}
+
+#[test]
 fn skin_depth_is_measured_against_the_true_surface_of_primitives_and_meshes() {
     // A closed cube mesh, 10 cm, and a 4 cm ball, against plain geometry (mesh depths within
     // MESH_DEPTH_RANGE_M of the surface, as measured).

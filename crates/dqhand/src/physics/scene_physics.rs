@@ -11,6 +11,12 @@ use crate::scene::Scene;
 /// Gravity, m/s² along −Y.
 pub const GRAVITY: f32 = 9.81;
 
+/// The table top's friction and restitution: a varnished wooden top (objects keep their own,
+/// and rapier combines the two by average).
+pub const TABLE_FRICTION: f32 = 0.8;
+/// See [`TABLE_FRICTION`].
+pub const TABLE_RESTITUTION: f32 = 0.3;
+
 /// The scene's free objects and table, simulated.
 pub struct ScenePhysics {
     world: PhysicsWorld,
@@ -43,7 +49,7 @@ impl ScenePhysics {
             initial.push(pose);
         }
         if let Some(slab) = colliders.table_collider() {
-            world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(0.8).restitution(0.3).build(), None);
+            world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         }
         Self { world, bodies, initial, held: None, hand: Vec::new() }
     }
