@@ -62,7 +62,8 @@ fn check_primitive_accessors(bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-/// The bytes of every buffer: the GLB binary chunk, a `data:` URI, or a file beside `path`.
+/// The bytes of every buffer: the GLB binary chunk, a `data:` URI, or a file in `path`'s
+/// folder (see [`buffer_file`]), read up to its declared length.
 fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
     let mut out = Vec::new();
     for buffer in gltf.buffers() {
@@ -79,11 +80,8 @@ fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
                     .map_err(|e| Error::Gltf(format!("buffer {} has invalid base64: {e}", buffer.index())))?
             }
             gltf::buffer::Source::Uri(uri) => {
-                if uri.contains("://") {
-                    return Err(Error::Gltf(format!("buffer {} refers to {uri:?}; only local files are read", buffer.index())));
-                }
-                let file = path.parent().unwrap_or(Path::new(".")).join(uri);
-                std::fs::read(&file).map_err(|e| Error::Gltf(format!("buffer {} file {}: {e}", buffer.index(), file.display())))?
+                let file = buffer_file(path, uri).map_err(|why| Error::Gltf(format!("buffer {} refers to {uri:?}: {why}", buffer.index())))?;
+                read_at_most(&file, buffer.length()).map_err(|e| Error::Gltf(format!("buffer {} file {}: {e}", buffer.index(), file.display())))?
             }
         };
         if data.len() < buffer.length() {
@@ -136,5 +134,80 @@ pub fn check_accessor(a: Option<gltf::Accessor<'_>>, what: &str, kind: (Dimensio
         None if a.count() == 0 => bad("has no elements".into()),
         Some(end) if end <= view.length() => Ok(()),
         _ => bad(format!("({} elements) reaches past the end of buffer view {}", a.count(), view.index())),
+    }
+}
+
+/// The file a buffer's `uri` names, if it may be read: a relative URI (percent-escapes
+/// decoded) that stays inside the folder of the glTF at `path`, even through symbolic links,
+/// naming a regular file. Anything else (another scheme, an absolute path, `..` out of the
+/// folder, a device or a pipe, which could never end or never answer) is refused with why.
+fn buffer_file(path: &Path, uri: &str) -> std::result::Result<std::path::PathBuf, String> {
+    let decoded = percent_decode(uri).ok_or("a malformed percent-escape")?;
+    let scheme = decoded.split_once(':').is_some_and(|(s, _)| !s.is_empty() && !s.contains(['/', '\\']));
+    if scheme {
+        return Err("only data: URIs and files beside the glTF are read".into());
+    }
+    let relative = Path::new(&decoded);
+    if decoded.contains(['\\', '\0']) || !relative.components().all(|c| matches!(c, std::path::Component::Normal(_))) {
+        return Err("not a plain relative path inside the glTF's folder".into());
+    }
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let folder = folder.canonicalize().map_err(|e| format!("the glTF's folder: {e}"))?;
+    let file = folder.join(relative).canonicalize().map_err(|e| e.to_string())?;
+    if !file.starts_with(&folder) {
+        return Err("leads out of the glTF's folder".into());
+    }
+    if !file.metadata().map_err(|e| e.to_string())?.is_file() {
+        return Err("not a regular file".into());
+    }
+    Ok(file)
+}
+
+/// The first `length` bytes of `file` (all of it when shorter; the caller checks the length).
+fn read_at_most(file: &Path, length: usize) -> std::io::Result<Vec<u8>> {
+    use std::io::Read as _;
+    let mut data = Vec::with_capacity(length.min(1 << 20));
+    std::fs::File::open(file)?.take(length as u64).read_to_end(&mut data)?;
+    Ok(data)
+}
+
+/// `uri` with its `%XX` escapes decoded; `None` when an escape is malformed or the result is
+/// not UTF-8.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes.get(i + 1..i + 3).filter(|h| h.iter().all(u8::is_ascii_hexdigit))?;
+            out.push(u8::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_buffer_file_is_read_up_to_the_length_asked() {
+        let file = std::env::temp_dir().join(format!("dqhand-read-at-most-{}", std::process::id()));
+        std::fs::write(&file, [7u8; 100]).unwrap();
+        assert_eq!(read_at_most(&file, 10).unwrap(), [7u8; 10]);
+        assert_eq!(read_at_most(&file, 1000).unwrap().len(), 100);
+    }
+
+    #[test]
+    fn percent_escapes_decode_or_are_refused() {
+        assert_eq!(percent_decode("a%20b%2Fc").as_deref(), Some("a b/c"));
+        assert_eq!(percent_decode("plain.bin").as_deref(), Some("plain.bin"));
+        for bad in ["%", "%2", "%zz", "%+f", "%FF"] {
+            assert_eq!(percent_decode(bad), None, "{bad}");
+        }
     }
 }

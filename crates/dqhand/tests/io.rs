@@ -862,3 +862,56 @@ fn a_glb_declaring_less_than_its_header_is_an_error_not_a_panic() {
     let e = io::load_gltf_slice(&glb, Path::new("short.glb")).unwrap_err().to_string();
     assert!(e.starts_with("short.glb: GLB header declares 0 bytes"), "{e}");
 }
+
+/// The minimal glTF with its buffer's `uri` replaced (the file `model.bin` stays beside it).
+fn gltf_with_buffer_uri(test: &str, uri: &str) -> PathBuf {
+    let path = faulty_gltf(test, Fault::None);
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    doc["buffers"][0]["uri"] = json!(uri);
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+/// A buffer URI reads only a regular file inside the glTF's folder: a device that never ends
+/// or never answers, an absolute path, `..` out of the folder (plain, percent-escaped or
+/// through a symbolic link), another scheme and a pipe are refused with the URI named, at
+/// once.
+#[test]
+fn buffer_uris_stay_inside_the_models_folder() {
+    for (test, uri) in [
+        ("uri-dev-zero", "/dev/zero"),
+        ("uri-dev-stdin", "/dev/stdin"),
+        ("uri-absolute", "/etc/hostname"),
+        ("uri-parent", "../model.bin"),
+        ("uri-parent-escaped", "%2E%2E/model.bin"),
+        ("uri-inner-parent", "sub/../../model.bin"),
+        ("uri-scheme", "file:///etc/hostname"),
+        ("uri-http", "http://example.com/model.bin"),
+        ("uri-bad-escape", "model%zz.bin"),
+    ] {
+        let path = gltf_with_buffer_uri(test, uri);
+        expect_load_error(&path, &["buffer 0", &format!("{uri:?}")]);
+    }
+    // A symbolic link beside the model that leads out of its folder, and a named pipe.
+    let path = gltf_with_buffer_uri("uri-symlink", "link.bin");
+    let outside = temp_dir("uri-symlink-target").join("secret.bin");
+    std::fs::write(&outside, [0u8; 4096]).unwrap();
+    std::os::unix::fs::symlink(&outside, path.with_file_name("link.bin")).unwrap();
+    expect_load_error(&path, &["\"link.bin\"", "out of the glTF's folder"]);
+    let path = gltf_with_buffer_uri("uri-fifo", "pipe.bin");
+    let fifo = path.with_file_name("pipe.bin");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    expect_load_error(&path, &["\"pipe.bin\"", "not a regular file"]);
+}
+
+/// A buffer file far longer than the buffer's declared length (sparse, 1 GiB) loads (only the
+/// declared bytes are read: `gltf_file`'s unit test), and percent-escaped names are decoded.
+#[test]
+fn buffer_files_longer_than_declared_load_and_escaped_names_decode() {
+    let path = gltf_with_buffer_uri("uri-escaped-name", "model%20data.bin");
+    let bin = path.with_file_name("model.bin");
+    let big = path.with_file_name("model data.bin");
+    std::fs::copy(&bin, &big).unwrap();
+    std::fs::OpenOptions::new().write(true).open(&big).unwrap().set_len(1 << 30).unwrap();
+    io::load_gltf(&path).unwrap();
+}
