@@ -125,7 +125,11 @@ pub fn check_accessor(a: Option<gltf::Accessor<'_>>, what: &str, kind: (Dimensio
         ));
     }
     let elem = a.dimensions().multiplicity() * a.data_type().size();
+    // glTF allows any stride from 4 bytes; the `gltf` crate's reader asserts one element fits.
     let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return bad(format!("uses buffer view {} with a stride of {stride} bytes, less than its {elem}-byte elements", view.index()));
+    }
     let end = (a.count().checked_sub(1))
         .and_then(|last| stride.checked_mul(last))
         .and_then(|x| x.checked_add(a.offset()))

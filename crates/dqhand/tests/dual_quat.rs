@@ -71,11 +71,11 @@ proptest! {
         assert_close!(s.direction.length(), 1.0, 1e-4);
         // The moment is perpendicular to the axis; points on the axis only slide along it.
         // A nearly pure translation has its axis far away (|m| ~ |t| / θ), and f32 keeps
-        // these relations only relative to that distance.
-        let far = s.moment.length().max(1.0);
-        assert_close!(s.moment.dot(s.direction), 0.0, 1e-4 * far);
+        // these relations only to a few ulps of that distance.
+        let far = s.moment.length();
+        assert_close!(s.moment.dot(s.direction), 0.0, 1e-4 + 1e-6 * far);
         let on_axis = s.closest_point_to_origin();
-        assert_close!(q.transform_point3(on_axis), on_axis + s.direction * s.pitch, 2e-3 * far);
+        assert_close!(q.transform_point3(on_axis), on_axis + s.direction * s.pitch, 2e-3 + 1e-6 * far);
         assert_close!(DualQuat::from_screw(s).transform_point3(p), q.transform_point3(p), 2e-3);
     }
 

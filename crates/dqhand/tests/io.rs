@@ -915,3 +915,16 @@ fn buffer_files_longer_than_declared_load_and_escaped_names_decode() {
     std::fs::OpenOptions::new().write(true).open(&big).unwrap().set_len(1 << 30).unwrap();
     io::load_gltf(&path).unwrap();
 }
+
+/// A buffer view whose stride is shorter than the elements read through it is refused (the
+/// `gltf` crate's reader asserts on it).
+#[test]
+fn a_stride_shorter_than_an_element_is_an_error() {
+    let path = faulty_gltf("short-stride", Fault::None);
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    for view in doc["bufferViews"].as_array_mut().unwrap() {
+        view["byteStride"] = json!(4);
+    }
+    std::fs::write(&path, doc.to_string()).unwrap();
+    expect_load_error(&path, &["stride of 4 bytes"]);
+}

@@ -41,9 +41,9 @@ pub const CONTACT_DISTANCE: f32 = 0.002;
 /// skin off.
 pub const STOP_DISTANCE: f32 = 0.0004;
 
-/// A wrist motion that moves no proxy point farther than this (m) is not cast: nothing is
-/// passed through in a micrometre, and a still hand would ask every query of the last frame
-/// again (a hand closing on an object holds its wrist still).
+/// Wrist motions that together move no proxy point farther than this (m) since the last cast
+/// are not cast: nothing is passed through in a micrometre, and a still hand would ask every
+/// query of the last frame again (a hand closing on an object holds its wrist still).
 const STILL_M: f32 = 1e-6;
 
 /// Steps of conservative advancement per finger stage: enough to converge from any start; a
@@ -116,12 +116,16 @@ pub struct ContactConstraint {
     /// The object that carried the rendered hand (its grip) in the last solve, and its pose
     /// there: the contacts with it were found at that pose.
     carried: Option<(usize, parry3d::math::Pose)>,
-    /// Per finger: its last closure ended with every joint stopped on a contact.
+    /// Per finger: its last closure ended with every joint stopped on a contact, the last one
+    /// with the held object.
     settled: [bool; 5],
+    /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
+    /// small to cast add up to [`STILL_M`] at most.
+    uncast: f32,
     /// Per finger: its rendered angles are the last frame's.
     kept: [bool; 5],
-    /// Per joint: the finger whose closure moves it (none for the palm, which only the wrist
-    /// moves).
+    /// Per joint: the finger whose closure moves it (none for the wrist and the metacarpals that
+    /// only the wrist moves; the ring and little metacarpals turn with their fingers).
     moved_by: Vec<Option<usize>>,
     contacts: Vec<Contact>,
     /// The last frame's contacts (a second buffer, swapped with `contacts`).
@@ -204,6 +208,7 @@ impl ContactConstraint {
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
             settled: [false; 5],
+            uncast: 0.0,
             kept: [false; 5],
             moved_by,
             proxies,
@@ -222,13 +227,17 @@ impl ContactConstraint {
         }
     }
 
-    /// Forgets the last rendered wrist: the next [`Self::solve`] starts from the tracked one
-    /// (after a reset, or when tracking comes back).
+    /// Forgets the last rendered hand (its wrist, grip, contacts and settled fingers): the next
+    /// [`Self::solve`] starts from the tracked one (after a reset, or when tracking comes back,
+    /// the wrist perhaps far from where it was).
     pub fn restart(&mut self) {
         self.wrist = None;
         self.held_back_since = None;
         self.grip = None;
         self.carried = None;
+        self.contacts.clear();
+        self.settled = [false; 5];
+        self.uncast = 0.0;
     }
 
     /// Object `object` has been grasped: from the next [`Self::solve`] while it is held, the
@@ -313,10 +322,13 @@ impl ContactConstraint {
         // must not be carried into an object by the wrist either.
         let to_wrist = self.world[rig.wrist()].inverse();
         let reach = self.proxies.colliders().iter().map(|p| (to_wrist * self.world[p.joint]).translation.length() + p.extent).fold(0.0, f32::max);
-        if linvel.length() + angvel.length() * reach < STILL_M {
+        let moved = linvel.length() + angvel.length() * reach;
+        if self.uncast + moved < STILL_M {
+            self.uncast += moved;
             self.held_back_since = None;
             return target;
         }
+        self.uncast = 0.0;
         let mut toi: f32 = 1.0;
         // The fastest any proxy point moves, m per unit of the motion: turns the stop gap
         // into a time.
@@ -415,6 +427,7 @@ impl ContactConstraint {
         self.near.clear();
         self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
         let mut active = 0;
+        let mut stopped_on = None;
         let mut s: f32 = 0.0;
         if !self.near.is_empty() {
             let set = |angles: &mut [f32], active: usize, s: f32, start: &[f32; 4], target: &[f32; 4]| {
@@ -438,8 +451,9 @@ impl ContactConstraint {
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward(rig, limits);
-                // The nearest moving proxy, and the largest step no point of any can overrun.
-                let mut nearest = (f32::INFINITY, 0);
+                // The nearest moving proxy (its distance, last DOF and the object), and the
+                // largest step no point of any can overrun.
+                let mut nearest = (f32::INFINITY, 0, usize::MAX);
                 let mut step = f32::INFINITY;
                 for (p, last, levers) in &chain.proxies {
                     if *last < active {
@@ -447,13 +461,15 @@ impl ContactConstraint {
                     }
                     let proxy = &self.proxies.colliders()[*p];
                     let pose = pose_of(&self.world[proxy.joint]);
-                    let mut d = f32::INFINITY;
+                    let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                     for &o in &self.near {
-                        let o = objects.collider(o);
-                        d = d.min(o.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE));
+                        let here = objects.collider(o).distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE);
+                        if here < d {
+                            (d, to) = (here, o);
+                        }
                     }
                     if d < nearest.0 {
-                        nearest = (d, *last);
+                        nearest = (d, *last, to);
                     }
                     let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
                     if speed > 0.0 {
@@ -479,6 +495,7 @@ impl ContactConstraint {
                         start[k] = self.rendered.angles[chain.dofs[k].0];
                     }
                     active = nearest.1 + 1;
+                    stopped_on = Some(nearest.2);
                     s = 0.0;
                     if active >= chain.dofs.len() {
                         break;
@@ -497,7 +514,7 @@ impl ContactConstraint {
                 self.rendered.angles[i] = target[k];
             }
         }
-        self.settled[f] = active >= chain.dofs.len();
+        self.settled[f] = active >= chain.dofs.len() && held.is_some() && stopped_on == held;
         self.fingers[f] = chain;
     }
 

@@ -38,21 +38,29 @@ impl ObjectMesh {
     /// triangle with an area), or [`Error::Io`].
     pub fn load(path: &Path) -> Result<Self> {
         let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-        let (vertices, indices, mut warnings) = match extension.as_deref() {
+        match extension.as_deref() {
             Some("obj") => {
                 let (vertices, indices) = read_obj(path)?;
-                (vertices, indices, Vec::new())
+                Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))
             }
-            Some("glb" | "gltf") => {
-                let bytes = std::fs::read(path).map_err(Error::io(path))?;
-                read_gltf(&bytes, path).map_err(|e| e.in_file(path))?
-            }
-            _ => return Err(Error::ObjectMesh("not a mesh file (.obj, .glb or .gltf)".into()).in_file(path)),
-        };
-        let mut mesh = Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))?;
-        warnings.append(&mut mesh.warnings);
-        mesh.warnings = warnings;
-        Ok(mesh)
+            Some("glb" | "gltf") => Self::from_gltf_slice(&std::fs::read(path).map_err(Error::io(path))?, path),
+            _ => Err(Error::ObjectMesh("not a mesh file (.obj, .glb or .gltf)".into()).in_file(path)),
+        }
+    }
+
+    /// A mesh from glTF bytes (`.glb`, or `.gltf` JSON) already in memory; `path` names them
+    /// in errors and is where a `.gltf`'s buffer files are looked up.
+    ///
+    /// # Errors
+    /// As [`Self::load`], the file already read.
+    pub fn from_gltf_slice(bytes: &[u8], path: &Path) -> Result<Self> {
+        let read = read_gltf(bytes, path).and_then(|(vertices, indices, mut warnings)| {
+            let mut mesh = Self::from_triangles(vertices, &indices)?;
+            warnings.append(&mut mesh.warnings);
+            mesh.warnings = warnings;
+            Ok(mesh)
+        });
+        read.map_err(|e| e.in_file(path))
     }
 
     /// A mesh from `vertices` and a flat triangle index list, checked and cleaned.
@@ -113,8 +121,9 @@ fn read_obj(path: &Path) -> Result<(Vec<Vec3>, Vec<u32>)> {
 }
 
 /// A glTF's triangles, in the frame of its default scene (else its first; else every node
-/// that has no parent): each mesh node's primitives placed by the node's world transform.
-/// Primitives that are not triangles are skipped (a warning says how many).
+/// that has no parent): each mesh node's primitives placed by the node's world transform (a
+/// mirroring one reverses their winding, as glTF says). Strips and fans are split into
+/// triangles; points and lines are skipped (a warning says how many).
 fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<String>)> {
     let (gltf, buffers) = gltf_file::open(bytes, path)?;
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
@@ -135,8 +144,10 @@ fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<Stri
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         roots.extend(node.children().map(|c| (c, world)));
         let Some(mesh) = node.mesh() else { continue };
+        let mirrored = world.determinant() < 0.0;
         for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
+            use gltf::mesh::Mode;
+            if !matches!(prim.mode(), Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
                 skipped += 1;
                 continue;
             }
@@ -148,15 +159,33 @@ fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<Stri
             let base = vertices.len() as u32;
             vertices.extend(positions.map(|p| world.transform_point3(Vec3::from(p))));
             let n = vertices.len() as u32 - base;
-            match reader.read_indices() {
-                Some(i) => {
-                    let i: Vec<u32> = i.into_u32().collect();
-                    if let Some(&bad) = i.iter().find(|&&i| i >= n) {
-                        return Err(Error::Gltf(format!("{what}: index {bad} is out of range for {n} vertices")));
-                    }
-                    indices.extend(i.iter().map(|i| base + i));
+            let order: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..n).collect(),
+            };
+            if let Some(&bad) = order.iter().find(|&&i| i >= n) {
+                return Err(Error::Gltf(format!("{what}: index {bad} is out of range for {n} vertices")));
+            }
+            let triangle = |k: usize| -> [u32; 3] {
+                match prim.mode() {
+                    // Every other triangle of a strip turns the other way.
+                    Mode::TriangleStrip if k % 2 == 1 => [order[k + 1], order[k], order[k + 2]],
+                    Mode::TriangleStrip => [order[k], order[k + 1], order[k + 2]],
+                    Mode::TriangleFan => [order[0], order[k + 1], order[k + 2]],
+                    _ => [order[3 * k], order[3 * k + 1], order[3 * k + 2]],
                 }
-                None => indices.extend(base..base + n),
+            };
+            let count = match prim.mode() {
+                Mode::Triangles => order.len() / 3,
+                _ => order.len().saturating_sub(2),
+            };
+            if prim.mode() == Mode::Triangles && order.len() % 3 != 0 {
+                return Err(Error::Gltf(format!("{what}: {} indices do not make whole triangles", order.len())));
+            }
+            for k in 0..count {
+                let [a, b, c] = triangle(k);
+                let [a, b, c] = if mirrored { [a, c, b] } else { [a, b, c] };
+                indices.extend([base + a, base + b, base + c]);
             }
         }
     }
