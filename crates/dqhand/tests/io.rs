@@ -928,3 +928,30 @@ fn a_stride_shorter_than_an_element_is_an_error() {
     std::fs::write(&path, doc.to_string()).unwrap();
     expect_load_error(&path, &["stride of 4 bytes"]);
 }
+
+/// A lone surrogate escape in a field the `gltf` crate skips unread once hid a dangling
+/// POSITION accessor from the check that keeps that crate from panicking (found by fuzzing):
+/// such JSON is refused as invalid.
+#[test]
+fn a_lone_surrogate_does_not_hide_a_dangling_accessor() {
+    let dir = temp_dir("lone-surrogate");
+    for name in ["surrogate.gltf", "surrogate.glb"] {
+        let json = r#"{"asset":{"version":"2.0"},"unknown":"\ud800\u0041","meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+        let bytes = if name.ends_with(".glb") {
+            let mut json = json.as_bytes().to_vec();
+            json.resize(json.len().next_multiple_of(4), b' ');
+            let mut glb = b"glTF".to_vec();
+            glb.extend(2u32.to_le_bytes());
+            glb.extend(((12 + 8 + json.len()) as u32).to_le_bytes());
+            glb.extend((json.len() as u32).to_le_bytes());
+            glb.extend(b"JSON");
+            glb.extend(json);
+            glb
+        } else {
+            json.as_bytes().to_vec()
+        };
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        expect_load_error(&path, &["not a valid glTF", "surrogate"]);
+    }
+}
