@@ -116,9 +116,9 @@ pub struct ContactConstraint {
     /// The object that carried the rendered hand (its grip) in the last solve, and its pose
     /// there: the contacts with it were found at that pose.
     carried: Option<(usize, parry3d::math::Pose)>,
-    /// Per finger: its last closure ended with every joint stopped on a contact, the last one
+    /// Per finger: how many of its leading closing joints its last closure stopped on contacts
     /// with the held object.
-    settled: [bool; 5],
+    held_prefix: [usize; 5],
     /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
     /// small to cast add up to [`STILL_M`] at most.
     uncast: f32,
@@ -207,7 +207,7 @@ impl ContactConstraint {
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
-            settled: [false; 5],
+            held_prefix: [0; 5],
             uncast: 0.0,
             kept: [false; 5],
             moved_by,
@@ -227,7 +227,7 @@ impl ContactConstraint {
         }
     }
 
-    /// Forgets the last rendered hand (its wrist, grip, contacts and settled fingers): the next
+    /// Forgets the last rendered hand (its wrist, grip, contacts and joints kept on contacts): the next
     /// [`Self::solve`] starts from the tracked one (after a reset, or when tracking comes back,
     /// the wrist perhaps far from where it was).
     pub fn restart(&mut self) {
@@ -236,7 +236,7 @@ impl ContactConstraint {
         self.grip = None;
         self.carried = None;
         self.contacts.clear();
-        self.settled = [false; 5];
+        self.held_prefix = [0; 5];
         self.uncast = 0.0;
     }
 
@@ -391,9 +391,10 @@ impl ContactConstraint {
     /// finger has gone into the object), turning the object in the hand. Its abduction stays
     /// too: it would slide the touching phalanx sideways, unchecked.
     ///
-    /// A gripping finger that was `still` on the held object (see [`Self::solve`]) and had
-    /// settled on it (every joint stopped on a contact) stays as it was without a query: a
-    /// closure from there stops at once.
+    /// While the hand is `still` on the held object (see [`Self::solve`]), the leading joints of
+    /// a gripping finger that stopped on contacts with it last frame stop there again at once:
+    /// they are kept without a query, and only the joints past them close (none, when every
+    /// joint had stopped on it).
     fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
         let chain = std::mem::take(&mut self.fingers[f]);
         if chain.dofs.is_empty() {
@@ -402,7 +403,8 @@ impl ContactConstraint {
         }
         let opening = self.closure[f].tracked < self.closure[f].rendered;
         let gripping = held.is_some_and(|h| !opening && self.contacts.iter().any(|c| c.object == h && c.part == HandPart::Finger(f)));
-        if gripping && still && self.settled[f] {
+        let kept = if gripping && still { self.held_prefix[f].min(chain.dofs.len()) } else { 0 };
+        if kept == chain.dofs.len() {
             for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
                 self.rendered.angles[i] = self.previous.angles[i];
             }
@@ -426,8 +428,9 @@ impl ContactConstraint {
         let reach = Aabb::from_half_extents(root, Vec3::splat(chain.reach));
         self.near.clear();
         self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
-        let mut active = 0;
-        let mut stopped_on = None;
+        let mut active = kept;
+        // The leading joints stopped on the held object so far.
+        let mut prefix = kept;
         let mut s: f32 = 0.0;
         if !self.near.is_empty() {
             let set = |angles: &mut [f32], active: usize, s: f32, start: &[f32; 4], target: &[f32; 4]| {
@@ -445,6 +448,9 @@ impl ContactConstraint {
             if gripping {
                 for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                     start[k] = self.previous.angles[i];
+                    if k < kept {
+                        self.rendered.angles[i] = start[k];
+                    }
                 }
                 checking = None;
             }
@@ -494,8 +500,10 @@ impl ContactConstraint {
                     for k in active..chain.dofs.len() {
                         start[k] = self.rendered.angles[chain.dofs[k].0];
                     }
+                    if prefix == active && held == Some(nearest.2) {
+                        prefix = nearest.1 + 1;
+                    }
                     active = nearest.1 + 1;
-                    stopped_on = Some(nearest.2);
                     s = 0.0;
                     if active >= chain.dofs.len() {
                         break;
@@ -513,8 +521,9 @@ impl ContactConstraint {
             for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                 self.rendered.angles[i] = target[k];
             }
+            prefix = 0;
         }
-        self.settled[f] = active >= chain.dofs.len() && held.is_some() && stopped_on == held;
+        self.held_prefix[f] = prefix;
         self.fingers[f] = chain;
     }
 
