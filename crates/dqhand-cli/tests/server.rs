@@ -185,6 +185,24 @@ fn on_loopback_a_host_that_is_not_this_machine_is_refused() {
     for host in [format!("localhost:{port}"), format!("127.0.0.1:{port}")] {
         assert_eq!(http(a, &format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n")).0, 200, "{host}");
     }
+    // Issue 15: this machine at another port, or without one, is not this server either; the
+    // input socket refuses a rebound page as the stream does; an Origin must be this server's
+    // http origin (not https, not null).
+    let other_port = port.parse::<u16>().unwrap().wrapping_add(1);
+    for host in [format!("127.0.0.1:{other_port}"), "localhost".to_owned(), "127.0.0.1".to_owned()] {
+        assert_eq!(http(a, &format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n")).0, 403, "{host}");
+    }
+    let upgrade = |path: &str, host: &str, origin: &str| {
+        format!(
+            "GET {path} HTTP/1.1\r\nHost: {host}\r\nOrigin: {origin}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+             Sec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+        )
+    };
+    let evil = format!("evil.example:{port}");
+    assert_eq!(http(a, &upgrade("/input", &evil, &format!("http://{evil}"))).0, 403, "the input socket too");
+    for origin in [format!("https://{a}"), "null".to_owned(), format!("http://{a}.evil.example")] {
+        assert_eq!(http(a, &upgrade("/stream", a, &origin)).0, 403, "{origin}");
+    }
 }
 
 #[test]

@@ -40,7 +40,7 @@ pub struct Shared {
 
 /// Accepts connections forever, one thread each.
 pub fn serve(listener: TcpListener, shared: Shared) -> std::io::Result<()> {
-    let loopback_only = listener.local_addr()?.ip().is_loopback();
+    let bound = listener.local_addr()?;
     let shared = Arc::new(shared);
     let open = Arc::new(AtomicUsize::new(0));
     for stream in listener.incoming() {
@@ -53,7 +53,7 @@ pub fn serve(listener: TcpListener, shared: Shared) -> std::io::Result<()> {
         }
         std::thread::spawn(move || {
             let peer = stream.peer_addr().ok();
-            if let Err(e) = connection(stream, &shared, loopback_only) {
+            if let Err(e) = connection(stream, &shared, bound) {
                 log_error(peer, &e);
             }
             open.fetch_sub(1, Ordering::SeqCst);
@@ -70,10 +70,10 @@ fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
 }
 
 /// One connection: a request for a file, or the upgrade to the engine stream.
-fn connection(stream: TcpStream, shared: &Shared, loopback_only: bool) -> std::io::Result<()> {
+fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr) -> std::io::Result<()> {
     stream.set_read_timeout(Some(REQUEST_TIMEOUT))?;
     stream.set_nodelay(true)?;
-    let request = match request::Request::read(&stream).and_then(|r| r.check_host(loopback_only).map(|()| r)) {
+    let request = match request::Request::read(&stream).and_then(|r| r.check_host(bound).map(|()| r)) {
         Ok(r) => r,
         Err(request::Refusal { status, message }) => {
             return request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false);

@@ -2,7 +2,7 @@
 //! response; the WebSocket opening handshake (RFC 6455 §4.2) on top of it.
 
 use std::io::{Read, Write};
-use std::net::TcpStream;
+use std::net::{IpAddr, SocketAddr, TcpStream};
 
 /// Largest request head accepted (request line and headers).
 const MAX_HEAD_BYTES: usize = 8 * 1024;
@@ -66,15 +66,17 @@ impl Request {
     }
 
     /// Checks that there is a `Host` header (HTTP/1.1 requires one: 400 otherwise) and that
-    /// it names this machine when the server listens on loopback only: a page of another site whose name an attacker re-points at 127.0.0.1 (DNS
-    /// rebinding) sends its own name as `Host`, and is refused here, beside the `Origin`
-    /// check of the WebSocket upgrade.
-    pub fn check_host(&self, loopback_only: bool) -> Result<(), Refusal> {
+    /// it names this server, listening at `bound`: `localhost`, a loopback address or the
+    /// address it is bound to (any address when bound to all of them), at its port. A page of
+    /// another site whose name an attacker re-points at this machine (DNS rebinding) sends its
+    /// own name as `Host`, and is refused here (403), for files, the stream and the input
+    /// socket alike, beside the `Origin` check of the WebSocket upgrade.
+    pub fn check_host(&self, bound: SocketAddr) -> Result<(), Refusal> {
         let Some(host) = self.header("host") else {
             return Err(refuse(400, "Host header missing"));
         };
-        if loopback_only && !is_loopback_host(host) {
-            return Err(refuse(403, format!("host {host:?} is not this machine (the server listens on loopback only)")));
+        if !names_server(host, bound) {
+            return Err(refuse(403, format!("host {host:?} is not this server ({bound}; reach it as localhost or by its address)")));
         }
         Ok(())
     }
@@ -99,10 +101,10 @@ impl Request {
             return Err(refuse(426, "WebSocket version 13 is required"));
         }
         if let Some(origin) = self.header("origin") {
+            // The page's own origin: this server's scheme and the `Host` it was reached by.
             let host = self.header("host").unwrap_or_default();
-            let origin_host = origin.split_once("://").map_or(origin, |(_, h)| h);
-            if !origin_host.eq_ignore_ascii_case(host) {
-                return Err(refuse(403, format!("origin {origin} is not this server ({host})")));
+            if !origin.strip_prefix("http://").is_some_and(|h| h.eq_ignore_ascii_case(host)) {
+                return Err(refuse(403, format!("origin {origin} is not this server (http://{host})")));
             }
         }
         let key = self.header("sec-websocket-key").ok_or_else(|| refuse(400, "Sec-WebSocket-Key missing"))?;
@@ -136,35 +138,63 @@ pub fn respond(mut stream: &TcpStream, status: u16, content_type: &str, body: &[
     stream.flush()
 }
 
-/// Whether a `Host` value (`name[:port]`, `[v6][:port]`) names a loopback address.
-fn is_loopback_host(host: &str) -> bool {
-    let port = |p: &str| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit());
-    let name = match host.strip_prefix('[') {
+/// Whether a `Host` value (`name[:port]`, `[v6][:port]`; port 80 when absent) names the server
+/// listening at `bound`: its port, and `localhost`, a loopback address, or `bound`'s address
+/// (any address when that is unspecified: the server listens on all of them). A name other
+/// than `localhost` never does: a browser sends a name only for a site it resolved, which may
+/// be an attacker's rebound to this machine.
+fn names_server(host: &str, bound: SocketAddr) -> bool {
+    let (name, port) = match host.strip_prefix('[') {
         Some(v6) => match v6.split_once(']') {
-            Some((address, "")) => address,
-            Some((address, rest)) if rest.strip_prefix(':').is_some_and(port) => address,
-            _ => return false,
+            Some((address, "")) => (address, None),
+            Some((address, rest)) => match rest.strip_prefix(':') {
+                Some(port) => (address, Some(port)),
+                None => return false,
+            },
+            None => return false,
         },
         None => match host.rsplit_once(':') {
-            Some((name, p)) if port(p) => name,
-            Some(_) => return false,
-            None => host,
+            Some((name, port)) => (name, Some(port)),
+            None => (host, None),
         },
     };
-    name.eq_ignore_ascii_case("localhost") || name.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback())
+    let port = match port {
+        None => 80,
+        Some(p) if !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()) => match p.parse::<u16>() {
+            Ok(p) => p,
+            Err(_) => return false,
+        },
+        Some(_) => return false,
+    };
+    let address = name.parse::<IpAddr>().ok().filter(|_| host.starts_with('[') == name.contains(':'));
+    let ours = |ip: IpAddr| ip.is_loopback() || ip == bound.ip() || bound.ip().is_unspecified();
+    port == bound.port() && (name.eq_ignore_ascii_case("localhost") || address.is_some_and(ours))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::is_loopback_host;
+    use super::names_server;
 
     #[test]
-    fn loopback_hosts() {
-        for ok in ["127.0.0.1:8080", "127.0.0.1", "localhost:8080", "LOCALHOST", "[::1]:8080", "[::1]", "127.1.2.3:1"] {
-            assert!(is_loopback_host(ok), "{ok}");
+    fn hosts_that_name_this_server() {
+        let loopback = "127.0.0.1:8080".parse().unwrap();
+        for ok in ["127.0.0.1:8080", "localhost:8080", "LOCALHOST:8080", "[::1]:8080", "127.1.2.3:8080"] {
+            assert!(names_server(ok, loopback), "{ok}");
         }
-        for bad in ["evil.example:8080", "evil.example", "10.0.0.1:8080", "[::2]:80", "localhost.evil.example", "127.0.0.1.evil.example", "", "[::1", "[::1]junk", "[::1]:", "localhost:80x"] {
-            assert!(!is_loopback_host(bad), "{bad}");
+        let bad = [
+            "evil.example:8080", "evil.example", "127.0.0.1", "localhost", "127.0.0.1:8081", "localhost:80", "10.0.0.1:8080",
+            "[::2]:8080", "localhost.evil.example:8080", "127.0.0.1.evil.example:8080", "", "[::1", "[::1]junk", "[::1]:",
+            "localhost:80x", "localhost:", "::1:8080", "[127.0.0.1]:8080", "localhost:99999",
+        ];
+        for host in bad {
+            assert!(!names_server(host, loopback), "{host}");
         }
+        // Bound to one LAN address, that address too; bound to all, any address (not a name).
+        let lan = "192.168.1.5:8080".parse().unwrap();
+        assert!(names_server("192.168.1.5:8080", lan) && names_server("localhost:8080", lan));
+        assert!(!names_server("192.168.1.6:8080", lan) && !names_server("evil.example:8080", lan));
+        let all = "0.0.0.0:80".parse().unwrap();
+        assert!(names_server("192.168.1.6", all) && names_server("[fe80::1]:80", all));
+        assert!(!names_server("evil.example", all) && !names_server("mybox.local", all));
     }
 }
