@@ -165,8 +165,8 @@ fn frame(session: &mut Session) -> FrameView {
 
 fn paused() -> Session {
     let mut s = Session::new(HAND.clone(), JointModel::Full).unwrap();
-    s.apply(&Command::Pause).unwrap();
-    s.apply(&Command::Rest).unwrap();
+    s.apply(&Command::Pause {}).unwrap();
+    s.apply(&Command::Rest {}).unwrap();
     s
 }
 
@@ -231,8 +231,13 @@ fn bad_commands_are_refused_and_change_nothing() {
         let e = e.unwrap_err();
         assert!(e.contains(expect), "{json}: {e:?} should mention {expect:?}");
     }
-    for json in ["", "{", "[]", r#"{"type":"fly"}"#, r#"{"type":"angle","dof":"x"}"#] {
+    // Issue 15: commands without fields refuse unknown ones too, as the others do.
+    let unknown = [r#"{"type":"play","evil":1}"#, r#"{"type":"pause","x":null}"#, r#"{"type":"rest","deg":3}"#, r#"{"type":"heatmap","on":true,"x":1}"#];
+    for json in ["", "{", "[]", r#"{"type":"fly"}"#, r#"{"type":"angle","dof":"x"}"#].into_iter().chain(unknown) {
         assert!(Command::parse(json).unwrap_err().starts_with("not a valid command"), "{json}");
+    }
+    for json in [r#"{"type":"play"}"#, r#"{"type":"pause"}"#, r#"{"type":"rest"}"#] {
+        Command::parse(json).unwrap();
     }
     let mut after = frame(&mut s);
     after.header.sequence = before.header.sequence;
@@ -275,7 +280,7 @@ fn the_timeline_plays_loops_and_seeks() {
     assert_eq!(s.pose().angles, expected.angles);
     s.apply(&command(r#"{"type":"angle","dof":"index-finger-phalanx-distal.flex","deg":10}"#)).unwrap();
     assert_eq!(frame(&mut s).header.state & STATE_PLAYING, 0, "an edit stops the timeline");
-    s.apply(&Command::Play).unwrap();
+    s.apply(&Command::Play {}).unwrap();
     assert!(frame(&mut s).header.state & STATE_PLAYING != 0);
 }
 

@@ -47,10 +47,12 @@ pub enum Command {
         #[serde(default)]
         seconds: Option<f32>,
     },
-    /// Play the timeline from its current time.
-    Play,
+    /// Play the timeline from its current time. (The commands without fields are empty
+    /// structs, not unit variants: serde lets a unit variant of a tagged enum carry unknown
+    /// fields unrefused.)
+    Play {},
     /// Stop the timeline where it is.
-    Pause,
+    Pause {},
     /// Jump the timeline to a time (seconds) and show that pose.
     Seek {
         /// Seconds from the start.
@@ -67,7 +69,7 @@ pub enum Command {
         on: bool,
     },
     /// Every angle to zero and the wrist to rest (stops the timeline).
-    Rest,
+    Rest {},
 }
 
 impl Command {

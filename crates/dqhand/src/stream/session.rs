@@ -198,14 +198,14 @@ impl Session {
                 to.wrist = self.wrist;
                 self.transition = Some((Sequence::transition(model, &self.pose, to, seconds), 0.0));
             }
-            Command::Play => {
+            Command::Play {} => {
                 self.transition = None;
                 if self.time >= self.timeline.duration() {
                     self.time = 0.0;
                 }
                 self.playing = true;
             }
-            Command::Pause => self.playing = false,
+            Command::Pause {} => self.playing = false,
             Command::Seek { time } => {
                 finite("seek", &[*time])?;
                 self.transition = None;
@@ -214,7 +214,7 @@ impl Session {
             }
             Command::Heatmap { on } => self.heatmap = *on,
             Command::Limits { on } => self.engine.set_limits(if *on { Limits::Anatomical } else { Limits::Off }),
-            Command::Rest => {
+            Command::Rest {} => {
                 self.stop();
                 self.wrist = None;
                 self.pose = Pose::rest(self.joint_model().dof_count());
