@@ -592,3 +592,32 @@ fn a_bad_scene_file_is_refused_naming_it() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains(&path.display().to_string()) && err.contains("radius"), "{err}");
 }
+
+/// Issue 15: a text message that is not UTF-8 gets the error line and the close RFC 6455 asks
+/// for (1007), not a dropped connection; the server goes on serving.
+#[test]
+fn a_text_message_that_is_not_utf8_is_answered_and_closed_with_1007() {
+    let server = start("not-utf8", &[]);
+    let mut ws = connect(&server);
+    // A masked text frame (mask 0: the payload as is) of two bytes that are not UTF-8.
+    if let MaybeTlsStream::Plain(s) = ws.get_mut() {
+        s.write_all(&[0x81, 0x82, 0, 0, 0, 0, 0xff, 0xfe]).unwrap();
+    }
+    let (mut error, mut close) = (None, None);
+    while close.is_none() {
+        match ws.read() {
+            Ok(Message::Text(t)) => {
+                let v: Value = serde_json::from_str(&t).unwrap();
+                if v["type"] == "error" {
+                    error = Some(v["message"].as_str().unwrap().to_owned());
+                }
+            }
+            Ok(Message::Close(frame)) => close = Some(frame.map(|f| u16::from(f.code))),
+            Ok(_) => {}
+            Err(e) => panic!("the connection ended without a close frame: {e}"),
+        }
+    }
+    assert!(error.as_deref().is_some_and(|m| m.contains("not UTF-8")), "{error:?}");
+    assert_eq!(close, Some(Some(1007)));
+    assert_eq!(get(&server.address, "/").0, 200, "still serving");
+}

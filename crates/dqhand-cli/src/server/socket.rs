@@ -7,6 +7,8 @@ use std::net::TcpStream;
 use std::time::{Duration, Instant};
 
 use dqhand::stream::{Applied, Command, LiveInput, Session};
+use tungstenite::protocol::frame::coding::CloseCode;
+use tungstenite::protocol::CloseFrame;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 
@@ -119,18 +121,28 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
 pub(super) fn read_failure(ws: &mut WebSocket<TcpStream>, e: tungstenite::Error) -> Option<std::io::Result<()>> {
     match e {
         tungstenite::Error::Io(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => None,
-        tungstenite::Error::Capacity(e) => {
-            let _ = send_error(ws, &format!("message refused: {e}; closing"));
-            let _ = ws.close(None);
-            let _ = ws.flush();
-            linger(ws.get_mut());
-            Some(Ok(()))
+        tungstenite::Error::Capacity(e) => Some(refuse_and_close(ws, &format!("message refused: {e}; closing"), None)),
+        // A text message that is not UTF-8: the error line, then the close RFC 6455 asks for
+        // (1007); no log line, so a client cannot fill the log with them.
+        tungstenite::Error::Utf8(e) => {
+            let invalid = CloseFrame { code: CloseCode::Invalid, reason: "text message not UTF-8".into() };
+            Some(refuse_and_close(ws, &format!("a text message that is not UTF-8 ({e}); closing"), Some(invalid)))
         }
         tungstenite::Error::ConnectionClosed
         | tungstenite::Error::AlreadyClosed
         | tungstenite::Error::Protocol(tungstenite::error::ProtocolError::ResetWithoutClosingHandshake) => Some(Ok(())),
         e => Some(Err(io(e))),
     }
+}
+
+/// Sends `message` as an error, closes (with `frame`, if any) and lingers: the end of a
+/// connection whose client broke the protocol.
+fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<CloseFrame>) -> std::io::Result<()> {
+    let _ = send_error(ws, message);
+    let _ = ws.close(frame);
+    let _ = ws.flush();
+    linger(ws.get_mut());
+    Ok(())
 }
 
 /// Closes our side and reads (and drops) what the client is still sending, for up to a
