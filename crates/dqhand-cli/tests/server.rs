@@ -621,3 +621,40 @@ fn a_text_message_that_is_not_utf8_is_answered_and_closed_with_1007() {
     assert_eq!(close, Some(Some(1007)));
     assert_eq!(get(&server.address, "/").0, 200, "still serving");
 }
+
+/// Issue 15: slowloris. 200 sockets that drip a request head hold only their own places
+/// among the heads still arriving: a page GET and a new viewer are served meanwhile (before,
+/// 64 such sockets took every connection and everyone got 503), and a dripped head gets 408
+/// once its deadline (5 s for the whole head) is past, however steadily it drips.
+#[test]
+fn clients_dripping_request_heads_lock_nobody_out() {
+    let server = start("slowloris", &[]);
+    let a = server.address.clone();
+    let mut drippers: Vec<TcpStream> = (0..200)
+        .map(|_| {
+            let mut s = TcpStream::connect(&a).unwrap();
+            s.write_all(b"G").unwrap();
+            s
+        })
+        .collect();
+    assert_eq!(get(&a, "/").0, 200, "the page is served while 200 heads drip");
+    let mut viewer = connect(&server);
+    assert_eq!(text(&mut viewer)["type"], "hello", "a new viewer is served too");
+    // One keeps dripping a byte every 400 ms: refused once its 5 s are up.
+    let slow = &mut drippers[0];
+    slow.set_read_timeout(Some(Duration::from_millis(400))).unwrap();
+    let mut answer = Vec::new();
+    for _ in 0..25 {
+        if slow.write_all(b"E").is_err() {
+            break;
+        }
+        let mut buf = [0u8; 512];
+        match slow.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => answer.extend_from_slice(&buf[..n]),
+            Err(_) => {}
+        }
+    }
+    let answer = String::from_utf8_lossy(&answer);
+    assert!(answer.starts_with("HTTP/1.1 408"), "{answer:?}");
+}

@@ -11,17 +11,22 @@ use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 
 use crate::feed::Feed;
 
-/// Connections served at once; more are answered 503 (each holds a thread).
+/// Requests served at once (files, streams, input senders) once their heads are in; more are
+/// answered 503.
 const MAX_CONNECTIONS: usize = 64;
-/// Time a client has to send its request line and headers.
-const REQUEST_TIMEOUT: Duration = Duration::from_secs(10);
+/// Connections still sending their request heads, counted apart so that they cannot take the
+/// served ones' places (a client dripping a head a byte at a time holds only its own thread,
+/// for [`HEAD_DEADLINE`]); more are answered 503 at once.
+const MAX_PENDING_HEADS: usize = 512;
+/// Time a client has for its whole request line and headers, however it spreads them.
+const HEAD_DEADLINE: Duration = Duration::from_secs(5);
 
 /// What every connection shares.
 pub struct Shared {
@@ -38,25 +43,49 @@ pub struct Shared {
     pub feed: Option<Arc<Feed>>,
 }
 
+/// One place of a bounded count, taken while it lives.
+struct Place(Arc<AtomicUsize>);
+
+impl Place {
+    /// A place of `count` if fewer than `max` are taken.
+    fn take(count: &Arc<AtomicUsize>, max: usize) -> Option<Self> {
+        (count.fetch_add(1, Ordering::SeqCst) < max).then(|| Self(Arc::clone(count))).or_else(|| {
+            count.fetch_sub(1, Ordering::SeqCst);
+            None
+        })
+    }
+}
+
+impl Drop for Place {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// The connection counts: heads still arriving, and requests being served.
+#[derive(Default)]
+struct Counts {
+    heads: Arc<AtomicUsize>,
+    served: Arc<AtomicUsize>,
+}
+
 /// Accepts connections forever, one thread each.
 pub fn serve(listener: TcpListener, shared: Shared) -> std::io::Result<()> {
     let bound = listener.local_addr()?;
     let shared = Arc::new(shared);
-    let open = Arc::new(AtomicUsize::new(0));
+    let counts = Arc::new(Counts::default());
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
-        let (shared, open) = (Arc::clone(&shared), Arc::clone(&open));
-        if open.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
-            open.fetch_sub(1, Ordering::SeqCst);
+        let Some(head) = Place::take(&counts.heads, MAX_PENDING_HEADS) else {
             let _ = request::respond(&stream, 503, "text/plain", b"too many connections\n", false);
             continue;
-        }
+        };
+        let (shared, counts) = (Arc::clone(&shared), Arc::clone(&counts));
         std::thread::spawn(move || {
             let peer = stream.peer_addr().ok();
-            if let Err(e) = connection(stream, &shared, bound) {
+            if let Err(e) = connection(stream, &shared, bound, head, &counts) {
                 log_error(peer, &e);
             }
-            open.fetch_sub(1, Ordering::SeqCst);
         });
     }
     Ok(())
@@ -70,14 +99,20 @@ fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
 }
 
 /// One connection: a request for a file, or the upgrade to the engine stream.
-fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr) -> std::io::Result<()> {
-    stream.set_read_timeout(Some(REQUEST_TIMEOUT))?;
+/// `head` is this connection's place among the heads still arriving, given up once its head
+/// is in (or refused).
+fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place, counts: &Counts) -> std::io::Result<()> {
     stream.set_nodelay(true)?;
-    let request = match request::Request::read(&stream).and_then(|r| r.check_host(bound).map(|()| r)) {
+    let read = request::Request::read(&stream, Instant::now() + HEAD_DEADLINE);
+    drop(head);
+    let request = match read.and_then(|r| r.check_host(bound).map(|()| r)) {
         Ok(r) => r,
         Err(request::Refusal { status, message }) => {
             return request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false);
         }
+    };
+    let Some(_served) = Place::take(&counts.served, MAX_CONNECTIONS) else {
+        return request::respond(&stream, 503, "text/plain", b"too many connections\n", false);
     };
     let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
     if request.path == socket::PATH || feed.is_some() {

@@ -3,6 +3,7 @@
 
 use std::io::{Read, Write};
 use std::net::{IpAddr, SocketAddr, TcpStream};
+use std::time::Instant;
 
 /// Largest request head accepted (request line and headers).
 const MAX_HEAD_BYTES: usize = 8 * 1024;
@@ -31,12 +32,22 @@ pub struct Request {
 }
 
 impl Request {
-    /// Reads the request head.
-    pub fn read(mut stream: &TcpStream) -> Result<Self, Refusal> {
+    /// Reads the request head, all of it by `deadline` (408 after it: a head dripped a byte at
+    /// a time gets no longer than one sent at once).
+    pub fn read(mut stream: &TcpStream, deadline: Instant) -> Result<Self, Refusal> {
         let mut buf = Vec::with_capacity(1024);
         let mut chunk = [0u8; 1024];
+        let late = || refuse(408, "request head not complete in time");
         loop {
-            let n = stream.read(&mut chunk).map_err(|e| refuse(408, format!("request not received: {e}")))?;
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Err(late());
+            }
+            stream.set_read_timeout(Some(left)).map_err(|e| refuse(400, format!("request not received: {e}")))?;
+            let n = stream.read(&mut chunk).map_err(|e| match e.kind() {
+                std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut => late(),
+                _ => refuse(400, format!("request not received: {e}")),
+            })?;
             if n == 0 {
                 return Err(refuse(400, "connection closed before the request was complete"));
             }
