@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use tungstenite::Message;
 
-use super::request::{respond, Request};
+use super::request::{answer_refusal, refuse, Request};
 use super::socket::{read_failure, send_error, upgrade};
 use crate::feed::{Feed, MAX_INPUT_CLIENTS};
 
@@ -32,7 +32,7 @@ impl Drop for Client<'_> {
 pub fn run(stream: TcpStream, request: Request, accept: &str, feed: &Feed) -> std::io::Result<()> {
     if feed.clients.fetch_add(1, Ordering::SeqCst) >= MAX_INPUT_CLIENTS {
         feed.clients.fetch_sub(1, Ordering::SeqCst);
-        return respond(&stream, 503, "text/plain", format!("{MAX_INPUT_CLIENTS} input senders already\n").as_bytes(), false);
+        return answer_refusal(&stream, &refuse(503, format!("{MAX_INPUT_CLIENTS} input senders already")));
     }
     let _client = Client(feed);
     let mut ws = upgrade(stream, request, accept)?;

@@ -107,12 +107,10 @@ fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place
     drop(head);
     let request = match read.and_then(|r| r.check_host(bound).map(|()| r)) {
         Ok(r) => r,
-        Err(request::Refusal { status, message }) => {
-            return request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false);
-        }
+        Err(refusal) => return request::answer_refusal(&stream, &refusal),
     };
     let Some(_served) = Place::take(&counts.served, MAX_CONNECTIONS) else {
-        return request::respond(&stream, 503, "text/plain", b"too many connections\n", false);
+        return request::answer_refusal(&stream, &request::refuse(503, "too many connections"));
     };
     let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
     if request.path == socket::PATH || feed.is_some() {
@@ -121,9 +119,7 @@ fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place
                 Some(feed) => input_socket::run(stream, request, &accept, feed),
                 None => socket::run(stream, request, &accept, shared),
             },
-            Err(request::Refusal { status, message }) => {
-                request::respond(&stream, status, "text/plain", format!("{message}\n").as_bytes(), false)
-            }
+            Err(refusal) => request::answer_refusal(&stream, &refusal),
         }
     } else if let Some(root) = &shared.assets {
         assets::serve(&stream, &request, root)

@@ -3,7 +3,7 @@
 
 use std::io::{Read, Write};
 use std::net::{IpAddr, SocketAddr, TcpStream};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Largest request head accepted (request line and headers).
 const MAX_HEAD_BYTES: usize = 8 * 1024;
@@ -16,7 +16,7 @@ pub struct Refusal {
     pub message: String,
 }
 
-fn refuse(status: u16, message: impl Into<String>) -> Refusal {
+pub fn refuse(status: u16, message: impl Into<String>) -> Refusal {
     Refusal { status, message: message.into() }
 }
 
@@ -120,6 +120,33 @@ impl Request {
         }
         let key = self.header("sec-websocket-key").ok_or_else(|| refuse(400, "Sec-WebSocket-Key missing"))?;
         Ok(tungstenite::handshake::derive_accept_key(key.trim().as_bytes()))
+    }
+}
+
+/// Answers a refused request with its status and reason, then lingers: the client may still be
+/// sending (an oversized head, a body), and closing on unread data would reset the connection
+/// before it read the answer.
+pub fn answer_refusal(stream: &TcpStream, refusal: &Refusal) -> std::io::Result<()> {
+    let answered = respond(stream, refusal.status, "text/plain", format!("{}\n", refusal.message).as_bytes(), false);
+    linger(stream);
+    answered
+}
+
+/// Closes our side and reads (and drops) what the client is still sending, for up to a
+/// second, before the socket goes: closing with unread data makes the kernel reset the
+/// connection, and the client would lose the error message sent just before.
+pub fn linger(mut stream: &TcpStream) {
+    let _ = stream.shutdown(std::net::Shutdown::Write);
+    let deadline = Instant::now() + Duration::from_secs(1);
+    let mut sink = [0u8; 16 * 1024];
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(100)));
+    while Instant::now() < deadline {
+        match stream.read(&mut sink) {
+            Ok(0) => return,
+            Ok(_) => {}
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {}
+            Err(_) => return,
+        }
     }
 }
 

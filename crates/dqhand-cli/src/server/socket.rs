@@ -12,7 +12,7 @@ use tungstenite::protocol::CloseFrame;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 
-use super::request::Request;
+use super::request::{linger, Request};
 use super::Shared;
 
 /// The path of the stream.
@@ -141,26 +141,8 @@ fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<
     let _ = send_error(ws, message);
     let _ = ws.close(frame);
     let _ = ws.flush();
-    linger(ws.get_mut());
+    linger(ws.get_ref());
     Ok(())
-}
-
-/// Closes our side and reads (and drops) what the client is still sending, for up to a
-/// second, before the socket goes: closing with unread data makes the kernel reset the
-/// connection, and the client would lose the error message sent just before.
-fn linger(stream: &mut TcpStream) {
-    let _ = stream.shutdown(std::net::Shutdown::Write);
-    let deadline = Instant::now() + Duration::from_secs(1);
-    let mut sink = [0u8; 16 * 1024];
-    let _ = stream.set_read_timeout(Some(Duration::from_millis(100)));
-    while Instant::now() < deadline {
-        match std::io::Read::read(stream, &mut sink) {
-            Ok(0) => return,
-            Ok(_) => {}
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-            Err(_) => return,
-        }
-    }
 }
 
 pub(super) fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungstenite::Result<()> {
