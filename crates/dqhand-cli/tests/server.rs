@@ -680,3 +680,29 @@ fn a_refusal_reaches_a_client_still_sending() {
     let response = String::from_utf8_lossy(&response);
     assert!(response.starts_with("HTTP/1.1 431"), "{read:?}: {response:?}");
 }
+
+/// Issue 15: a viewer that neither reads nor acknowledges is pinged, then closed with an
+/// error after 15 s of silence, instead of holding one of the server's places for ever.
+#[test]
+fn a_viewer_that_never_acknowledges_is_closed() {
+    let server = start("silent", &[]);
+    let mut silent = connect(&server);
+    std::thread::sleep(Duration::from_secs(17));
+    let (mut pinged, mut error, mut closed) = (false, None, false);
+    while !closed {
+        match silent.read() {
+            Ok(Message::Ping(_)) => pinged = true,
+            Ok(Message::Text(t)) => {
+                let v: Value = serde_json::from_str(&t).unwrap();
+                if v["type"] == "error" {
+                    error = Some(v["message"].as_str().unwrap().to_owned());
+                }
+            }
+            Ok(Message::Close(_)) | Err(_) => closed = true,
+            Ok(_) => {}
+        }
+    }
+    assert!(pinged, "pinged before it was closed");
+    assert!(error.as_deref().is_some_and(|m| m.contains("no acknowledgement for 15 s")), "{error:?}");
+    assert_eq!(get(&server.address, "/").0, 200, "still serving");
+}

@@ -26,6 +26,11 @@ const MAX_WIRE_BYTES: usize = 64 * 1024;
 const WINDOW: u32 = 3;
 /// A send that cannot complete in this time (the client stopped reading) ends the connection.
 const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+/// A viewer that sends nothing this long while frames wait for its acknowledgement is pinged
+/// (a live page answers with a pong, or acknowledges)...
+const PING_AFTER: Duration = Duration::from_secs(5);
+/// ...and one silent this long is closed: it would hold one of the server's places for ever.
+const SILENT_LIMIT: Duration = Duration::from_secs(15);
 
 /// Completes the WebSocket handshake (the server's answer to a checked upgrade request).
 pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> std::io::Result<WebSocket<TcpStream>> {
@@ -56,6 +61,7 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     let mut next_frame = last_frame;
     let mut rate = Rate::new();
     let mut frame = Vec::new();
+    let (mut heard, mut pinged) = (Instant::now(), false);
     loop {
         // Read edits until the next frame is due (or, with the window full, until an ack).
         loop {
@@ -64,9 +70,20 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
             if window_open && now >= next_frame {
                 break;
             }
+            if !window_open && now - heard > SILENT_LIMIT {
+                return refuse_and_close(&mut ws, &format!("no acknowledgement for {} s; closing", SILENT_LIMIT.as_secs()), None);
+            }
+            if !window_open && !pinged && now - heard > PING_AFTER {
+                ws.send(Message::Ping(Default::default())).map_err(io)?;
+                pinged = true;
+            }
             let wait = if window_open { next_frame - now } else { Duration::from_millis(50) };
             ws.get_ref().set_read_timeout(Some(wait.max(Duration::from_millis(1))))?;
-            match ws.read() {
+            let read = ws.read();
+            if read.is_ok() {
+                (heard, pinged) = (Instant::now(), false);
+            }
+            match read {
                 Ok(Message::Text(text)) => {
                     if text.len() > MAX_COMMAND_BYTES {
                         send_error(&mut ws, &format!("message of {} bytes refused (at most {MAX_COMMAND_BYTES})", text.len())).map_err(io)?;
@@ -149,8 +166,13 @@ pub(super) fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungst
     ws.send(Message::text(serde_json::json!({ "type": "error", "message": message }).to_string()))
 }
 
+/// A failed send as an I/O error; one that timed out says what happened (reads that time out
+/// never get here: [`read_failure`] reads on).
 fn io(e: tungstenite::Error) -> std::io::Error {
     match e {
+        tungstenite::Error::Io(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+            std::io::Error::new(ErrorKind::TimedOut, format!("the client stopped reading: nothing could be sent for {} s; closed", WRITE_TIMEOUT.as_secs()))
+        }
         tungstenite::Error::Io(e) => e,
         e => std::io::Error::other(e),
     }
