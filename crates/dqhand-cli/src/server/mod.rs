@@ -81,7 +81,8 @@ pub fn serve(listener: TcpListener, shared: Shared) -> std::io::Result<()> {
             continue;
         };
         let (shared, counts) = (Arc::clone(&shared), Arc::clone(&counts));
-        std::thread::spawn(move || {
+        // Without a thread to spare the connection is dropped (its place with it), not the server.
+        let _ = std::thread::Builder::new().spawn(move || {
             let peer = stream.peer_addr().ok();
             if let Err(e) = connection(stream, &shared, bound, head, &counts) {
                 log_error(peer, &e);
@@ -98,32 +99,37 @@ fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
     }
 }
 
-/// One connection: a request for a file, or the upgrade to the engine stream.
-/// `head` is this connection's place among the heads still arriving, given up once its head
-/// is in (or refused).
+/// One connection: a request for a file, or the upgrade to the engine stream. `head` is this
+/// connection's place among the heads still arriving, kept until its request is accepted (a
+/// refusal lingers in it); a served place is taken only then.
 fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place, counts: &Counts) -> std::io::Result<()> {
     stream.set_nodelay(true)?;
+    // A client that stops reading holds its thread no longer than this, a file's too.
+    stream.set_write_timeout(Some(socket::WRITE_TIMEOUT))?;
     let read = request::Request::read(&stream, Instant::now() + HEAD_DEADLINE);
-    drop(head);
     let request = match read.and_then(|r| r.check_host(bound).map(|()| r)) {
         Ok(r) => r,
         Err(refusal) => return request::answer_refusal(&stream, &refusal),
     };
+    let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
+    let accept = if request.path == socket::PATH || feed.is_some() {
+        match request.websocket_accept() {
+            Ok(accept) => Some(accept),
+            Err(refusal) => return request::answer_refusal(&stream, &refusal),
+        }
+    } else {
+        None
+    };
+    drop(head);
     let Some(_served) = Place::take(&counts.served, MAX_CONNECTIONS) else {
         return request::answer_refusal(&stream, &request::refuse(503, "too many connections"));
     };
-    let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
-    if request.path == socket::PATH || feed.is_some() {
-        match request.websocket_accept() {
-            Ok(accept) => match feed {
-                Some(feed) => input_socket::run(stream, request, &accept, feed),
-                None => socket::run(stream, request, &accept, shared),
-            },
-            Err(refusal) => request::answer_refusal(&stream, &refusal),
-        }
-    } else if let Some(root) = &shared.assets {
-        assets::serve(&stream, &request, root)
-    } else {
-        request::respond(&stream, 404, "text/plain", b"not found\n", false)
+    match (accept, feed) {
+        (Some(accept), Some(feed)) => input_socket::run(stream, request, &accept, feed),
+        (Some(accept), None) => socket::run(stream, request, &accept, shared),
+        (None, _) => match &shared.assets {
+            Some(root) => assets::serve(&stream, &request, root),
+            None => request::respond(&stream, 404, "text/plain", b"not found\n", false),
+        },
     }
 }

@@ -24,8 +24,9 @@ pub const MAX_COMMAND_BYTES: usize = 4 * 1024;
 const MAX_WIRE_BYTES: usize = 64 * 1024;
 /// Frames sent but not yet acknowledged, at most.
 const WINDOW: u32 = 3;
-/// A send that cannot complete in this time (the client stopped reading) ends the connection.
-const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+/// A send that cannot complete in this time (the client stopped reading) ends the connection,
+/// a file's or a stream's.
+pub(super) const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
 /// A viewer that sends nothing this long while frames wait for its acknowledgement is pinged
 /// (a live page answers with a pong, or acknowledges)...
 const PING_AFTER: Duration = Duration::from_secs(5);
@@ -38,7 +39,6 @@ pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> 
         "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
     );
     stream.write_all(response.as_bytes())?;
-    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
     let config = WebSocketConfig::default().max_message_size(Some(MAX_WIRE_BYTES)).max_frame_size(Some(MAX_WIRE_BYTES));
     Ok(WebSocket::from_partially_read(stream, request.rest, Role::Server, Some(config)))
 }
