@@ -706,3 +706,19 @@ fn a_viewer_that_never_acknowledges_is_closed() {
     assert!(error.as_deref().is_some_and(|m| m.contains("no acknowledgement for 15 s")), "{error:?}");
     assert_eq!(get(&server.address, "/").0, 200, "still serving");
 }
+
+/// A viewer that acknowledges late (every 3 s, its window full in between) is not closed: it
+/// is heard from well within the 15 s.
+#[test]
+fn a_viewer_that_acknowledges_slowly_stays() {
+    let server = start("slow-ack", &[]);
+    let mut slow = connect(&server);
+    for _ in 0..6 {
+        std::thread::sleep(Duration::from_secs(3));
+        next_frame(&mut slow);
+    }
+    // Still streaming after 18 s: frames keep coming once acknowledged, and no error came.
+    for _ in 0..3 {
+        next_frame(&mut slow);
+    }
+}
