@@ -145,6 +145,29 @@ pub fn check_accessor(a: Option<gltf::Accessor<'_>>, what: &str, kind: (Dimensio
     }
 }
 
+/// What a primitive's index accessor may hold (the `gltf` crate reads no other).
+pub const INDEX_KIND: (Dimensions, &[DataType]) = (Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32]);
+
+/// A primitive's vertex order: its indices, read through `reader` (their accessor checked
+/// with [`check_accessor`] against [`INDEX_KIND`]), or 0..n when it has none; each below its
+/// `n` vertices. `what` names the primitive in the error.
+///
+/// # Errors
+/// [`Error::Gltf`] for an index out of range.
+pub fn vertex_order<'a, 's, F>(reader: &gltf::mesh::Reader<'a, 's, F>, n: usize, what: &str) -> Result<Vec<u32>>
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    let order: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    match order.iter().find(|&&i| i as usize >= n) {
+        Some(i) => Err(Error::Gltf(format!("{what}: index {i} is out of range for {n} vertices"))),
+        None => Ok(order),
+    }
+}
+
 /// The file a buffer's `uri` names, if it may be read: a relative URI (percent-escapes
 /// decoded) that stays inside the folder of the glTF at `path`, even through symbolic links,
 /// naming a regular file. Anything else (another scheme, an absolute path, `..` out of the

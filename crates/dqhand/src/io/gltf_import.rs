@@ -168,8 +168,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
         for (semantic, label, kind) in kinds {
             check_accessor(prim.get(&semantic), &format!("{where_} {label}"), kind, &buffers)?;
         }
-        let index_types = &[DataType::U8, DataType::U16, DataType::U32][..];
-        check_accessor(prim.indices(), &format!("{where_} index"), (Dimensions::Scalar, index_types), &buffers)?;
+        check_accessor(prim.indices(), &format!("{where_} index"), gltf_file::INDEX_KIND, &buffers)?;
         let reader = prim.reader(get);
         let positions: Vec<[f32; 3]> =
             reader.read_positions().ok_or_else(|| bad(format!("{where_} has no POSITION accessor")))?.collect();
@@ -198,13 +197,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
         }
         let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(Iterator::collect);
         let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..n as u32).collect(),
-        };
-        if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
-            return Err(bad(format!("{where_}: index {i} is out of range for {n} vertices")));
-        }
+        let indices = gltf_file::vertex_order(&reader, n, &where_)?;
         if normals.as_ref().is_some_and(|v| v.len() != n) || uvs.as_ref().is_some_and(|v| v.len() != n) {
             return Err(bad(format!("{where_}: NORMAL or TEXCOORD_0 count differs from POSITION ({n})")));
         }

@@ -153,19 +153,12 @@ fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<Stri
             }
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
             gltf_file::check_accessor(prim.get(&gltf::Semantic::Positions), &format!("{what} POSITION"), (Dimensions::Vec3, &[DataType::F32]), &buffers)?;
-            gltf_file::check_accessor(prim.indices(), &format!("{what} index"), (Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32]), &buffers)?;
+            gltf_file::check_accessor(prim.indices(), &format!("{what} index"), gltf_file::INDEX_KIND, &buffers)?;
             let reader = prim.reader(get);
             let positions = reader.read_positions().ok_or_else(|| Error::Gltf(format!("{what} has no POSITION accessor")))?;
             let base = vertices.len() as u32;
             vertices.extend(positions.map(|p| world.transform_point3(Vec3::from(p))));
-            let n = vertices.len() as u32 - base;
-            let order: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n).collect(),
-            };
-            if let Some(&bad) = order.iter().find(|&&i| i >= n) {
-                return Err(Error::Gltf(format!("{what}: index {bad} is out of range for {n} vertices")));
-            }
+            let order = gltf_file::vertex_order(&reader, vertices.len() - base as usize, &what)?;
             let triangle = |k: usize| -> [u32; 3] {
                 match prim.mode() {
                     // Every other triangle of a strip turns the other way.
