@@ -122,8 +122,6 @@ pub struct ContactConstraint {
     /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
     /// small to cast add up to [`STILL_M`] at most.
     uncast: f32,
-    /// Per finger: its rendered angles are the last frame's.
-    kept: [bool; 5],
     /// Per joint: the finger whose closure moves it (none for the wrist and the metacarpals that
     /// only the wrist moves; the ring and little metacarpals turn with their fingers).
     moved_by: Vec<Option<usize>>,
@@ -209,7 +207,6 @@ impl ContactConstraint {
             carried: None,
             held_prefix: [0; 5],
             uncast: 0.0,
-            kept: [false; 5],
             moved_by,
             proxies,
             fingers,
@@ -290,14 +287,16 @@ impl ContactConstraint {
         self.previous.clone_from(&self.rendered);
         self.rendered.clone_from(&self.tracked);
         self.rendered.wrist = Some(wrist);
-        for f in 0..FINGERS.len() {
+        // Per finger: its rendered angles are the last frame's.
+        let mut kept = [false; 5];
+        for (f, kept) in kept.iter_mut().enumerate() {
             self.close_finger(rig, limits, f, objects, held, still_on.is_some());
             let chain = &self.fingers[f];
             let same = |i: usize| self.rendered.angles[i].to_bits() == self.previous.angles[i].to_bits();
-            self.kept[f] = chain.dofs.iter().all(|&(i, _)| same(i)) && chain.others.iter().all(|&i| same(i));
+            *kept = chain.dofs.iter().all(|&(i, _)| same(i)) && chain.others.iter().all(|&i| same(i));
         }
         self.forward(rig, limits);
-        self.find_contacts(objects, still_on);
+        self.find_contacts(objects, still_on, kept);
         self.carried = carrier.map(|o| (o, objects.collider(o).pose));
         for (f, chain) in self.fingers.iter().enumerate() {
             self.closure[f].rendered = chain.dofs.iter().map(|&(i, _)| self.rendered.angles[i]).sum();
@@ -322,23 +321,21 @@ impl ContactConstraint {
         // must not be carried into an object by the wrist either.
         let to_wrist = self.world[rig.wrist()].inverse();
         let reach = self.proxies.colliders().iter().map(|p| (to_wrist * self.world[p.joint]).translation.length() + p.extent).fold(0.0, f32::max);
-        let moved = linvel.length() + angvel.length() * reach;
-        if self.uncast + moved < STILL_M {
-            self.uncast += moved;
+        // The fastest any proxy point moves, m per unit of the motion: how far the hand moves,
+        // and what turns the stop gap into a time.
+        let speed = linvel.length() + angvel.length() * reach;
+        if self.uncast + speed < STILL_M {
+            self.uncast += speed;
             self.held_back_since = None;
             return target;
         }
         self.uncast = 0.0;
         let mut toi: f32 = 1.0;
-        // The fastest any proxy point moves, m per unit of the motion: turns the stop gap
-        // into a time.
-        let mut speed: f32 = 0.0;
         for p in self.proxies.colliders() {
             let offset = to_wrist * self.world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
             let radius = offset.translation.length() + p.extent;
-            speed = speed.max(linvel.length() + angvel.length() * radius);
             // The arc a turning point sweeps bulges out of the two end boxes by at most
             // radius · angle / 2.
             let bulge = radius * angvel.length().min(core::f32::consts::PI) / 2.0;
@@ -529,12 +526,12 @@ impl ContactConstraint {
 
     /// The contacts of the rendered pose. Where the hand was `still_on` an object (carried by
     /// it last frame and this one, at the pose given), the contacts with it of every joint the
-    /// fingers kept still are last frame's, moved with the object: rigidly attached, they are
-    /// the same.
-    fn find_contacts(&mut self, objects: &ObjectColliders, still_on: Option<(usize, parry3d::math::Pose)>) {
+    /// fingers `kept` still (per finger) are last frame's, moved with the object: rigidly
+    /// attached, they are the same.
+    fn find_contacts(&mut self, objects: &ObjectColliders, still_on: Option<(usize, parry3d::math::Pose)>, kept: [bool; 5]) {
         std::mem::swap(&mut self.contacts, &mut self.last_contacts);
         self.contacts.clear();
-        let (moved_by, kept) = (&self.moved_by, &self.kept);
+        let moved_by = &self.moved_by;
         let unmoved = |j: usize| still_on.is_some() && moved_by[j].is_none_or(|f| kept[f]);
         if let Some((object, then)) = still_on {
             let now = objects.collider(object).pose;
