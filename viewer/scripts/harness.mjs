@@ -48,13 +48,16 @@ export function startServer({ port = 0, args = [] } = {}) {
   });
 }
 
-/** Headless Chromium with software WebGL (SwiftShader), as on a machine without a GPU. */
-export function launchBrowser() {
+/**
+ * Headless Chromium with software WebGL (SwiftShader), as on a machine without a GPU.
+ * @param {string[]} [args] - more command-line switches (e.g. a fake camera's)
+ */
+export function launchBrowser(args = []) {
   const executablePath = process.env.CHROMIUM ?? '/usr/bin/chromium';
   if (!existsSync(executablePath)) throw new Error(`${executablePath} not found: install Debian's chromium (make test does)`);
   return chromium.launch({
     executablePath,
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox'],
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox', ...args],
   });
 }
 

@@ -3,7 +3,7 @@
 
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand,
-  type Command, type Frame, type Hello, type InputMessage, type SceneMessage, type Topology,
+  type Command, type Frame, type Hello, type InputMessage, type RecordingMessage, type SceneMessage, type Topology,
 } from './protocol';
 
 export interface ConnectionEvents {
@@ -14,6 +14,8 @@ export interface ConnectionEvents {
   input(message: InputMessage): void;
   /** The scene's objects, the object held and the contacts (only when the hello has a scene). */
   scene(message: SceneMessage): void;
+  /** A recording of the live input started or ended (the answer to a `record` command). */
+  recording(message: RecordingMessage): void;
   error(message: string): void;
   status(connected: boolean): void;
 }
@@ -57,6 +59,7 @@ export class Connection {
         if (message.type === 'hello') this.events.hello(message);
         else if (message.type === 'input') this.events.input(message);
         else if (message.type === 'scene') this.events.scene(message);
+        else if (message.type === 'recording') this.events.recording(message);
         else this.events.error(message.message);
         return;
       }

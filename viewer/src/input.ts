@@ -41,6 +41,8 @@ export class InputPanel {
   source: HelloInput | null = null;
   tracking: Tracking = 'waiting';
   gesture: string | null = null;
+  /** The tracked hand's side (null before a record). */
+  side: 'left' | 'right' | null = null;
   accepted = 0;
   rejected = 0;
   readonly log = new InputLog();
@@ -68,14 +70,14 @@ export class InputPanel {
 
   /** Forgets the previous session's state (its counters and times restart with the new one). */
   reset(): void {
-    Object.assign(this, { tracking: 'waiting', gesture: null, accepted: 0, rejected: 0 });
+    Object.assign(this, { tracking: 'waiting', gesture: null, side: null, accepted: 0, rejected: 0 });
     this.setHeld(null);
     this.log.clear();
     this.render();
   }
 
   update(message: InputMessage): void {
-    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, accepted: message.accepted, rejected: message.rejected });
+    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, side: message.side, accepted: message.accepted, rejected: message.rejected });
     this.log.add(message);
     this.render();
   }
@@ -93,9 +95,9 @@ export class InputPanel {
   }
 
   /** The test hook's view: null without an input. */
-  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; accepted: number; rejected: number; log: string[] } | null {
+  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: 'left' | 'right' | null; accepted: number; rejected: number; log: string[] } | null {
     if (!this.source) return null;
-    const { tracking, gesture, accepted, rejected } = this;
-    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, accepted, rejected, log: [...this.log.lines] };
+    const { tracking, gesture, side, accepted, rejected } = this;
+    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, accepted, rejected, log: [...this.log.lines] };
   }
 }

@@ -4,9 +4,12 @@ import './style.css';
 import { Vector3 } from 'three';
 import { Connection } from './connection';
 import { InputPanel } from './input';
-import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS } from './protocol';
+import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
+import { InputSender } from './sender';
+import { Webcam } from './webcam';
 import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
+import { XRInput } from './xr';
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 const params = new URLSearchParams(location.search);
@@ -29,7 +32,15 @@ const status = (text: string, kind: '' | 'ok' | 'error') => {
   s.className = kind;
 };
 
-const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/stream`, {
+const wsOrigin = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}`;
+/** The page's own live input to the engine (an XR session's tracked hand). */
+const sender = new InputSender(`${wsOrigin}/input`);
+const xr = new XRInput(scene.renderer, sender, $, {
+  changed: () => showLive(),
+  error: (message) => status(message, 'error'),
+});
+
+const connection = new Connection(`${wsOrigin}/stream`, {
   hello(h) {
     hello = h;
     $('model-line').textContent = `${h.description}, ${h.triangles.toLocaleString()} triangles`;
@@ -39,6 +50,7 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
     select.replaceChildren(...h.joint_models.map((m) => new Option(`${m} (${m === h.joint_model ? h.dofs.length + ' DOF' : '…'})`, m, false, m === h.joint_model)));
     $<HTMLInputElement>('timeline').max = String(h.sequence.duration);
     inputPanel.setSource(h.input);
+    webcam.anchor = cameraAnchor(h);
     if (!sceneSet) {
       sceneSet = true;
       scene.setScene(h.scene);
@@ -57,10 +69,24 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
   },
   input(message) {
     inputPanel.update(message);
+    if (message.mirrored !== mirrored) {
+      mirrored = message.mirrored;
+      showLive();
+    }
   },
   scene(message) {
     scene.showScene(message);
     inputPanel.setHeld(message.held);
+  },
+  recording(message) {
+    recording = message.on;
+    const record = $('record');
+    record.classList.toggle('on', recording);
+    record.textContent = recording ? 'Stop recording' : 'Record';
+    $('recording-status').textContent = message.on
+      ? `recording to ${message.path}`
+      : message.path ? `saved ${message.records.toLocaleString()} records to ${message.path}` : '';
+    recordings.push(message);
   },
   error(message) {
     errors.push(message);
@@ -68,10 +94,47 @@ const connection = new Connection(`${location.protocol === 'https:' ? 'wss' : 'w
   },
   status(connected) {
     if (connected) inputPanel.reset();
+    $<HTMLButtonElement>('record').disabled = !connected;
     sceneSet = false;
     status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
 });
+
+// --- the user's own hand: camera and recording ------------------------------------------------
+/** Whether the engine is recording the live input (as its last `recording` message said). */
+let recording = false;
+/** The `recording` messages received, oldest first (for the tests). */
+const recordings: RecordingMessage[] = [];
+const webcam = new Webcam(sender, $<HTMLCanvasElement>('camera-preview'), (s) => {
+  $('camera').textContent = s.on ? 'Stop camera' : 'Camera';
+  $('camera-status').textContent = s.on && s.status === 'running'
+    ? `${s.hands.length ? `following your ${s.hands[0]} hand` : 'no hand in view'} · ${s.detectMs.toFixed(0)} ms/frame · ${s.fps.toFixed(0)} fps`
+    : s.status;
+  showLive();
+});
+$('camera').addEventListener('click', () => void webcam.toggle());
+$('record').addEventListener('click', () => connection.send({ type: 'record', on: !recording }));
+
+/** Whether the engine shows the tracked hand as our hand's mirror image (a hand of the other side). */
+let mirrored = false;
+/** Whether the hand was drawn where the user's is, at the last `showLive`. */
+let liveShown = false;
+/**
+ * Draws the hand where the user's is while this page's own input drives it (the camera, an
+ * XR session), mirrored back when the engine mirrored it; the camera behind and above it.
+ */
+function showLive(): void {
+  const live = webcam.state.on || xr.active;
+  scene.setWorld(live, mirrored ? 'left' : 'right');
+  if (live !== liveShown && !xr.active) scene.setView(live ? [0, 0.45, 1] : 'default', live ? new Vector3(...webcam.anchor) : undefined, live ? 0.6 : undefined);
+  liveShown = live;
+}
+
+/** Where a hand before the camera lands: above the table's centre with a scene, else about where the resting hand is (m). */
+function cameraAnchor(h: Hello): [number, number, number] {
+  const table = h.scene?.table;
+  return table ? [table.centre[0], table.height + 0.15, table.centre[1]] : [0, 0, -0.09];
+}
 
 // --- skinning view ---------------------------------------------------------------------------
 const selectedMethod = (): Method => (METHODS.find((m) => $<HTMLInputElement>(`method-${m}`).checked) ?? 'dqb');
@@ -215,7 +278,8 @@ function syncControls(f: Frame): void {
 let frames = 0;
 let since = performance.now();
 let engineUs = 0;
-function loop(now: number): void {
+function loop(now: number, xrFrame?: XRFrame): void {
+  xr.update(now, xrFrame);
   scene.render();
   frames++;
   if (now - since >= 1000) {
@@ -242,9 +306,9 @@ function loop(now: number): void {
       span.style.top = `${y}px`;
     });
   }
-  requestAnimationFrame(loop);
 }
-requestAnimationFrame(loop);
+// three.js's loop: the window's animation frames, or the XR session's while one runs.
+scene.renderer.setAnimationLoop(loop);
 
 // --- hooks for the browser tests and `make figures` ------------------------------------------
 declare global {
@@ -267,6 +331,12 @@ window.dqhand = {
     /** The manipulation scene, null without one: the objects drawn (placed by a scene message), the one held, contacts shown, scene messages shown. */
     scene: scene.objects && { drawn: scene.objects.drawn(), held: scene.objects.held, contacts: scene.objects.contacts, updates: scene.objects.updates },
     geometries: scene.renderer.info.memory.geometries,
+    /** The WebXR input: modes offered, the session, records sent, the side of the hand sent. */
+    xr: xr.state(),
+    /** The camera: on, status, frames given to MediaPipe and with a hand, records sent, hands seen, ms per detection, rate. */
+    camera: { ...webcam.state, hands: [...webcam.state.hands] },
+    /** The `recording` messages received, oldest first. */
+    recordings: [...recordings],
     frame: frame && {
       sequence: frame.header.sequence,
       methods: frame.header.methods,

@@ -177,9 +177,22 @@ export interface InputMessage {
   accepted: number;
   /** Records refused since the input started (a running total). */
   rejected: number;
+  /** The tracked hand's side, null before the first record (an older server omits it: null). */
+  side: 'left' | 'right' | null;
+  /** Our hand, of the other side, shows the tracked one mirrored (x → −x in the world). */
+  mirrored: boolean;
 }
 
-export type ServerText = Hello | InputMessage | SceneMessage | { type: 'error'; message: string };
+/** The answer to a `record` command: the recording started (`records` 0) or ended, and its file. */
+export interface RecordingMessage {
+  type: 'recording';
+  on: boolean;
+  /** The file, as the server names it; null when a stop found no recording. */
+  path: string | null;
+  records: number;
+}
+
+export type ServerText = Hello | InputMessage | SceneMessage | RecordingMessage | { type: 'error'; message: string };
 
 /** Which binary message this is, from its magic; null if neither. */
 export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
@@ -291,6 +304,7 @@ export function decodeText(text: string): ServerText {
   if (type === 'hello') return checkHello(value as Record<string, unknown>);
   if (type === 'input') return checkInput(value as Record<string, unknown>);
   if (type === 'scene') return checkSceneMessage(value as Record<string, unknown>);
+  if (type === 'recording') return checkRecording(value as Record<string, unknown>);
   if (type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
   return value as ServerText;
 }
@@ -396,14 +410,27 @@ function checkInput(v: Record<string, unknown>): InputMessage {
   });
   if (!isCount(v.accepted)) throw bad('accepted', v.accepted);
   if (!isCount(v.rejected)) throw bad('rejected', v.rejected);
+  const side = v.side ?? null;
+  if (side !== null && side !== 'left' && side !== 'right') throw bad('side', v.side);
+  const mirrored = v.mirrored ?? false;
+  if (typeof mirrored !== 'boolean') throw bad('mirrored', v.mirrored);
   const events = v.events as GestureEvent[];
   const actions = v.actions as ActionEvent[];
   return {
     type: 'input', tracking: v.tracking, gesture: v.gesture as string | null,
     events: events.map(({ t, event, gesture }) => ({ t, event, gesture })),
     actions: actions.map(({ t, gesture, action }) => ({ t, gesture, action })),
-    accepted: v.accepted, rejected: v.rejected,
+    accepted: v.accepted, rejected: v.rejected, side, mirrored,
   };
+}
+
+/** Checks a recording message; the message names the first bad field. */
+function checkRecording(v: Record<string, unknown>): RecordingMessage {
+  const bad = (field: string, value: unknown) => new ProtocolError(`recording message: ${field} ${show(value)}`);
+  if (typeof v.on !== 'boolean') throw bad('on', v.on);
+  if (v.path !== null && !isString(v.path)) throw bad('path', v.path);
+  if (!isCount(v.records)) throw bad('records', v.records);
+  return { type: 'recording', on: v.on, path: v.path, records: v.records };
 }
 
 /** The commands the engine accepts (crates/dqhand/src/stream/command.rs). */
@@ -419,7 +446,8 @@ export type Command =
   | { type: 'seek'; time: number }
   | { type: 'heatmap'; on: boolean }
   | { type: 'limits'; on: boolean }
-  | { type: 'rest' };
+  | { type: 'rest' }
+  | { type: 'record'; on: boolean };
 
 export function encodeCommand(command: Command): string {
   return JSON.stringify(command);

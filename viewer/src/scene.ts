@@ -27,9 +27,9 @@ export function heatColor(value: number, out: THREE.Color): THREE.Color {
 const PRESENT = new THREE.Quaternion().setFromEuler(new THREE.Euler(Math.PI / 2, Math.PI, 0, 'YXZ'));
 
 class HandView {
-  /** Placed side by side in the scene. */
+  /** Placed side by side in the scene (mirrored by `HandScene.place` for a left hand in the world). */
   readonly group = new THREE.Group();
-  /** Engine coordinates inside. */
+  /** Engine coordinates inside (turned for viewing or not by `HandScene.place`). */
   readonly oriented = new THREE.Group();
   /** The skin, its vertex arrays rewritten by each frame. */
   readonly mesh: THREE.Mesh<THREE.BufferGeometry, THREE.MeshPhysicalMaterial>;
@@ -39,7 +39,7 @@ class HandView {
   readonly jointDots: THREE.Points<THREE.BufferGeometry, THREE.PointsMaterial>;
   method: Method | null = null;
 
-  constructor(topology: Topology, present: THREE.Quaternion) {
+  constructor(topology: Topology) {
     const n = topology.vertexCount;
     const geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(topology.indices, 1));
@@ -67,7 +67,6 @@ class HandView {
       o.renderOrder = 10;
       o.frustumCulled = false;
     }
-    this.oriented.quaternion.copy(present);
     this.oriented.add(this.mesh, this.bones, this.jointDots);
     this.group.add(this.oriented);
   }
@@ -142,6 +141,10 @@ export class HandScene {
   readonly bounds = new THREE.Box3();
   /** The manipulation scene, or null: then hands are turned for viewing (PRESENT); with one, they stay in the world the objects are in. */
   objects: SceneObjects | null = null;
+  /** One hand in the world, mirrored back (left) or not, while the page's own input drives it; null: not. */
+  private world: 'left' | 'right' | null = null;
+  /** The camera of an XR session: three.js moves the camera it renders with to the headset's pose, so not the desktop's. */
+  private readonly xrCamera = new THREE.PerspectiveCamera(70, 1, 0.01, 20);
   showSkeleton = false;
   lastFrame: Frame | null = null;
 
@@ -179,8 +182,11 @@ export class HandScene {
       this.scene.remove(v.group);
       v.dispose();
     }
-    this.views = [0, 1, 2].map(() => new HandView(topology, this.objects ? new THREE.Quaternion() : PRESENT));
-    for (const v of this.views) this.scene.add(v.group);
+    this.views = [0, 1, 2].map(() => new HandView(topology));
+    for (const v of this.views) {
+      this.place(v);
+      this.scene.add(v.group);
+    }
     this.parents = topology.parents;
     this.framed = false;
   }
@@ -197,8 +203,24 @@ export class HandScene {
     }
     this.objects = scene && new SceneObjects(scene);
     if (this.objects) this.scene.add(this.objects.group);
-    for (const v of this.views) v.oriented.quaternion.copy(this.objects ? new THREE.Quaternion() : PRESENT);
+    for (const v of this.views) this.place(v);
     this.framed = false;
+  }
+
+  /**
+   * Draws one hand (DQB) in the engine's world, where the user's tracked hand is (an XR
+   * session, the camera), or turned for viewing again (off). `left`: the engine mirrored the
+   * tracked hand onto its own (x → −x about the world's origin), so it is mirrored back.
+   */
+  setWorld(on: boolean, side: 'left' | 'right'): void {
+    this.world = on ? side : null;
+    for (const v of this.views) this.place(v);
+  }
+
+  /** Turns and mirrors a hand for the scene, the world or viewing. */
+  private place(v: HandView): void {
+    v.oriented.quaternion.copy(this.objects || this.world ? new THREE.Quaternion() : PRESENT);
+    v.group.scale.x = this.world === 'left' ? -1 : 1;
   }
 
   /** Shows a scene message; the first frames the camera on the objects (the floor's shadow at y = 0). */
@@ -214,14 +236,15 @@ export class HandScene {
   }
 
   /**
-   * Shows a frame: one hand per mesh in it, side by side; with a scene one hand, in the world
-   * (DQB in a split view: three hands side by side would not be where the objects are).
+   * Shows a frame: one hand per mesh in it, side by side; with a scene or in the world one
+   * hand (DQB in a split view: three hands side by side would not be where the objects are).
    */
   showFrame(frame: Frame): void {
     if (this.views.length === 0 || frame.header.vertexCount !== this.views[0].mesh.geometry.getAttribute('position').count) return;
     this.lastFrame = frame;
-    const count = this.objects ? 1 : frame.meshes.length;
-    const first = this.objects ? Math.max(0, frame.header.methods.indexOf('dqb')) : 0;
+    const world = this.objects !== null || this.world !== null;
+    const count = world ? 1 : frame.meshes.length;
+    const first = world ? Math.max(0, frame.header.methods.indexOf('dqb')) : 0;
     this.views.forEach((view, i) => {
       view.group.visible = i < count;
       if (i >= count) return;
@@ -229,7 +252,7 @@ export class HandScene {
       view.group.position.x = (i - (count - 1) / 2) * this.spacing;
       view.bones.visible = view.jointDots.visible = this.showSkeleton;
     });
-    if (!this.framed && !this.objects) {
+    if (!this.framed && !world) {
       this.framed = true;
       const first = this.views[0];
       first.mesh.geometry.computeBoundingBox();
@@ -302,6 +325,7 @@ export class HandScene {
   }
 
   render(): void {
+    if (this.renderer.xr.isPresenting) return this.renderer.render(this.scene, this.xrCamera);
     const { clientWidth: w, clientHeight: h } = this.canvas;
     if (this.canvas.width !== Math.floor(w * this.renderer.getPixelRatio()) || this.canvas.height !== Math.floor(h * this.renderer.getPixelRatio())) {
       this.renderer.setSize(w, h, false);

@@ -66,6 +66,10 @@ pub struct Args {
     /// replacing the file, each record written out as it is taken).
     #[arg(long)]
     record: Option<PathBuf>,
+    /// Where the page's Record button writes its recordings (JSON lines, one new file per
+    /// recording, named for the time).
+    #[arg(long, default_value = "recordings")]
+    recordings: PathBuf,
     #[command(flatten)]
     common: InputArgs,
     /// Gesture definitions to recognise instead of the built-in ones.
@@ -143,7 +147,7 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
             anyhow::bail!("{}: --record would replace the recording being played", record.display());
         }
     }
-    let records = LiveRecords::new(&args.common, args.record.as_deref())?;
+    let records = LiveRecords::new(&args.common, args.record.as_deref(), Some(args.recordings.clone()))?;
     let udp = match args.udp {
         Some(port) => {
             let address = SocketAddr::new(host, port);

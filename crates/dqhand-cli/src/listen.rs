@@ -56,7 +56,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let gestures = args.recognition.set()?;
     let mapper = Some(args.common.mapper(args.joint_model)?);
     let mut gesture_loop = GestureLoop::new(model, args.joint_model, mapper, args.common.config()?, gestures)?;
-    let live = LiveRecords::new(&args.common, args.record.as_deref())?;
+    let live = LiveRecords::new(&args.common, args.record.as_deref(), None)?;
     let address = SocketAddr::new(args.host, args.udp);
     let socket = UdpSocket::bind(address).with_context(|| format!("cannot receive on udp {address} (try another --udp port)"))?;
     socket.set_read_timeout(Some(TICK))?;

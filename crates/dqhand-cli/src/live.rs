@@ -20,16 +20,25 @@ pub const MAX_DATAGRAM_BYTES: usize = 64 * 1024;
 pub struct LiveRecords {
     side: Side,
     sensors: Vec<String>,
-    recorder: Option<Recorder>,
+    /// The recording being written, if any (`--record`, or a viewer's Record button).
+    recorder: Mutex<Option<Recorder>>,
+    /// Where a viewer's recordings go (`demo --recordings`); `None`: viewers cannot record.
+    directory: Option<PathBuf>,
+}
+
+/// A recording that was written: its file and how many records it holds.
+pub struct Recorded {
+    pub path: PathBuf,
+    pub records: u64,
 }
 
 impl LiveRecords {
     /// Records of `args`' default side and glove, recorded to `record` if given (a new file,
-    /// replacing one that is there).
-    pub fn new(args: &InputArgs, record: Option<&Path>) -> anyhow::Result<Self> {
+    /// replacing one that is there); viewers may start recordings in `directory`.
+    pub fn new(args: &InputArgs, record: Option<&Path>, directory: Option<PathBuf>) -> anyhow::Result<Self> {
         let sensors = args.table()?.layout().sensors().iter().map(|s| s.name.clone()).collect();
-        let recorder = record.map(Recorder::create).transpose()?;
-        Ok(Self { side: args.hand, sensors, recorder })
+        let recorder = record.map(|path| Recorder::create(path, File::create(path))).transpose()?;
+        Ok(Self { side: args.hand, sensors, recorder: Mutex::new(recorder), directory })
     }
 
     /// A blank record to decode into.
@@ -47,9 +56,42 @@ impl LiveRecords {
 
     /// Appends a record the input took to the recording, if there is one.
     pub fn keep(&self, record: &Record) {
-        if let Some(r) = &self.recorder {
+        if let Some(r) = self.lock().as_mut() {
             r.append(record, &self.sensors);
         }
+    }
+
+    /// Starts a new recording in the viewers' directory, named for the time
+    /// (`live-<unix seconds>.jsonl`, never replacing a file), ending the one being written.
+    ///
+    /// # Errors
+    /// No directory for viewers' recordings, or the file cannot be created.
+    pub fn start(&self) -> anyhow::Result<PathBuf> {
+        let Some(directory) = &self.directory else { anyhow::bail!("record: this server does not record (no recordings directory)") };
+        std::fs::create_dir_all(directory).with_context(|| format!("{}: cannot create the recordings directory", directory.display()))?;
+        let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+        let mut guard = self.lock();
+        for n in 1.. {
+            let name = if n == 1 { format!("live-{stamp}.jsonl") } else { format!("live-{stamp}-{n}.jsonl") };
+            let path = directory.join(name);
+            match File::options().write(true).create_new(true).open(&path) {
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+                file => {
+                    *guard = Some(Recorder::create(&path, file)?);
+                    return Ok(path);
+                }
+            }
+        }
+        unreachable!("some name is free")
+    }
+
+    /// Ends the recording being written, if any: what it holds.
+    pub fn stop(&self) -> Option<Recorded> {
+        self.lock().take().map(|r| Recorded { path: r.path, records: r.records })
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Option<Recorder>> {
+        self.recorder.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 
@@ -67,23 +109,27 @@ pub fn log_refusals(source: &str, taken: u64, refused: u64, lines: &[String]) {
 struct Recorder {
     path: PathBuf,
     /// The file and a line buffer (reused); `None` once a write has failed.
-    file: Mutex<Option<(File, Vec<u8>)>>,
+    file: Option<(File, Vec<u8>)>,
+    /// Records written.
+    records: u64,
 }
 
 impl Recorder {
-    fn create(path: &Path) -> anyhow::Result<Self> {
-        let file = File::create(path).with_context(|| format!("{}: cannot create the recording", path.display()))?;
-        Ok(Self { path: path.into(), file: Mutex::new(Some((file, Vec::with_capacity(4096)))) })
+    fn create(path: &Path, file: std::io::Result<File>) -> anyhow::Result<Self> {
+        let file = file.with_context(|| format!("{}: cannot create the recording", path.display()))?;
+        Ok(Self { path: path.into(), file: Some((file, Vec::with_capacity(4096))), records: 0 })
     }
 
-    fn append(&self, record: &Record, sensors: &[String]) {
-        let mut guard = self.file.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let Some((file, line)) = guard.as_mut() else { return };
+    fn append(&mut self, record: &Record, sensors: &[String]) {
+        let Some((file, line)) = self.file.as_mut() else { return };
         line.clear();
         let written = write_record(line, record, sensors).and_then(|()| file.write_all(line));
-        if let Err(e) = written {
-            eprintln!("dqhand: {}: {e}; recording stopped (the records before are kept)", self.path.display());
-            *guard = None;
+        match written {
+            Ok(()) => self.records += 1,
+            Err(e) => {
+                eprintln!("dqhand: {}: {e}; recording stopped (the records before are kept)", self.path.display());
+                self.file = None;
+            }
         }
     }
 }

@@ -722,3 +722,77 @@ fn a_viewer_that_acknowledges_slowly_stays() {
         next_frame(&mut slow);
     }
 }
+
+/// The page's Record button: `record` on the stream starts a new file in `--recordings`, every
+/// record `/input` takes is written to it whole as it is taken, and stopping says how many; the
+/// file reads back as a recording. The input messages say which side is tracked and whether our
+/// hand shows it mirrored.
+#[test]
+fn record_writes_the_live_input_to_a_new_file_and_input_messages_name_the_side() {
+    let dir = site("record");
+    let config = dir.join("config.json");
+    std::fs::write(&config, r#"{"grace_s": 5.0, "max_latency_s": 5.0}"#).unwrap();
+    let recordings = dir.join("recordings");
+    let server = start("record-server", &["--config", config.to_str().unwrap(), "--recordings", recordings.to_str().unwrap()]);
+    let (lines, _) = recording("record-rec");
+    let mut viewer = connect(&server);
+    text(&mut viewer);
+    viewer.send(Message::text(r#"{"type":"record","on":false}"#)).unwrap();
+    assert_eq!(next_text(&mut viewer), serde_json::json!({"type": "recording", "on": false, "path": null, "records": 0}), "a stop with no recording");
+    viewer.send(Message::text(r#"{"type":"record","on":true}"#)).unwrap();
+    let started = next_text(&mut viewer);
+    assert_eq!((&started["type"], &started["on"], &started["records"]), (&"recording".into(), &true.into(), &0.into()), "{started}");
+    let path = PathBuf::from(started["path"].as_str().unwrap());
+    assert_eq!(path.parent(), Some(recordings.as_path()), "{started}");
+    assert!(path.file_name().unwrap().to_str().unwrap().starts_with("live-"));
+    // 200 right-hand records, then 50 of the same hand labelled left, one refused between.
+    let (mut input, _) = tungstenite::connect(format!("ws://{}/input", server.address)).unwrap();
+    let sent: Vec<String> = lines[..250].iter().enumerate().map(|(i, l)| if i < 200 { l.clone() } else { l.replacen("\"hand\":\"right\"", "\"hand\":\"left\"", 1) }).collect();
+    assert!(sent[249].contains("\"left\""), "the synthetic records name their hand: {}", sent[249]);
+    // The side and mirroring the viewer is told once the records up to `taken` are in.
+    let mut told = |taken: u64| {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        loop {
+            let m = next_text(&mut viewer);
+            assert!(Instant::now() < deadline, "{taken} records were never all taken");
+            if m["type"] == "input" && m["accepted"] == taken {
+                return (m["side"].as_str().unwrap_or("none").to_owned(), m["mirrored"] == true);
+            }
+        }
+    };
+    for (i, line) in sent.iter().enumerate() {
+        input.send(Message::text(line.as_str())).unwrap();
+        if i == 100 {
+            input.send(Message::text(r#"{"t": 0.0, "landmarks": []}"#)).unwrap();
+            assert!(matches!(input.read().unwrap(), Message::Text(t) if t.contains("error")));
+        }
+        if i == 199 {
+            assert_eq!(told(200), ("right".to_owned(), false), "our right hand shows a right hand as it is");
+        }
+    }
+    assert_eq!(told(250), ("left".to_owned(), true), "and a left one mirrored");
+    viewer.send(Message::text(r#"{"type":"record","on":false}"#)).unwrap();
+    let stopped = loop {
+        let m = next_text(&mut viewer);
+        if m["type"] == "recording" {
+            break m;
+        }
+    };
+    assert_eq!(stopped, serde_json::json!({"type": "recording", "on": false, "path": path.display().to_string(), "records": 250}));
+    let written: Vec<Value> = std::fs::read_to_string(&path).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(written.len(), 250, "every record taken, none refused");
+    assert_eq!(written[0]["t"], serde_json::from_str::<Value>(&sent[0]).unwrap()["t"]);
+    assert_eq!((written[199]["hand"].as_str(), written[249]["hand"].as_str()), (Some("right"), Some("left")));
+    let replay = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["replay", "--input"]).arg(&path).output().unwrap();
+    assert!(replay.status.success() && String::from_utf8_lossy(&replay.stderr).contains("250 records, 250 taken"), "{}", String::from_utf8_lossy(&replay.stderr));
+    // A new recording is a new file; the one before is kept.
+    viewer.send(Message::text(r#"{"type":"record","on":true}"#)).unwrap();
+    let again = loop {
+        let m = next_text(&mut viewer);
+        if m["type"] == "recording" {
+            break m;
+        }
+    };
+    assert_ne!(again["path"], started["path"]);
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 250);
+}

@@ -103,6 +103,30 @@ fn a_dropout_holds_the_pose_marks_it_lost_and_recovers_smoothly() {
 }
 
 #[test]
+fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
+    let config = unfiltered();
+    let (grace, rest_after, recover) = (config.grace_s, config.rest_after_s, f64::from(config.recover_s));
+    let mut p = InputPipeline::new(&rig(), None, config).unwrap();
+    let mut fist = gesture("fist").unwrap().pose(JointModel::Full);
+    fist.wrist = Some(dqhand::math::DualQuat::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.1, 1.2, -0.3)));
+    p.push(&joints_record(0.0, &fist), None).unwrap();
+    p.push(&joints_record(0.1, &fist), None).unwrap();
+    let wrist = p.pose().wrist;
+    p.advance(0.1 + grace + rest_after - 0.01);
+    assert_eq!(p.tracking(), Tracking::Lost);
+    assert!(max_diff_deg(p.pose(), &fist) < 0.5, "a short dropout holds the pose");
+    p.advance(0.1 + grace + rest_after + recover / 2.0);
+    let halfway = p.pose().angles.iter().zip(&fist.angles).filter(|(_, f)| f.abs() > 0.1).map(|(a, f)| a / f).collect::<Vec<_>>();
+    assert!(halfway.iter().all(|r| (r - 0.5).abs() < 0.01), "half way through the ease, half the bend: {halfway:?}");
+    p.advance(0.1 + grace + rest_after + recover + 0.01);
+    assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1e-3, "at rest");
+    assert_eq!(p.pose().wrist, wrist, "the wrist stays where the hand was lost");
+    // Records return: the hand blends from rest to them.
+    p.push(&joints_record(3.0, &fist), None).unwrap();
+    assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1.0);
+}
+
+#[test]
 fn unusable_geometry_is_refused() {
     let mut p = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
     let mut r = joints_record(0.0, &Pose::rest(JointModel::Full.dof_count()));

@@ -94,6 +94,10 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                         Ok(command) => match session.apply(&command) {
                             Ok(Applied::Frame) => {}
                             Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
+                            Ok(Applied::Record(on)) => match record(shared, on) {
+                                Ok(message) => ws.send(Message::text(message)).map_err(io)?,
+                                Err(e) => send_error(&mut ws, &format!("{e:#}")).map_err(io)?,
+                            },
                             Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
                         },
                         Err(e) => send_error(&mut ws, &e).map_err(io)?,
@@ -131,6 +135,22 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
             next_frame = now; // after a stall, resume the rate instead of bursting to catch up
         }
     }
+}
+
+/// Starts (`on`) or stops recording the live input: the `recording` message that says so.
+/// A start ends the recording being written; a stop with none is answered all the same.
+///
+/// ```json
+/// {"type": "recording", "on": false, "path": "recordings/live-1795000000.jsonl", "records": 412}
+/// ```
+fn record(shared: &Shared, on: bool) -> anyhow::Result<String> {
+    let Some(feed) = shared.feed.as_deref() else { anyhow::bail!("record: this server has no live input") };
+    let (path, records) = if on {
+        (Some(feed.records.start()?), 0)
+    } else {
+        feed.records.stop().map_or((None, 0), |r| (Some(r.path), r.records))
+    };
+    Ok(serde_json::json!({ "type": "recording", "on": on, "path": path.map(|p| p.display().to_string()), "records": records }).to_string())
 }
 
 /// What a failed read means: `None` to read on (a timeout), else how the connection ends

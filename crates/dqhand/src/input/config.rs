@@ -31,8 +31,13 @@ pub struct InputConfig {
     /// Seconds without a good record before the hand is marked "tracking lost" (it holds its
     /// last good pose meanwhile).
     pub grace_s: f64,
-    /// Seconds over which the hand blends from the held pose back to the tracked one.
+    /// Seconds over which the hand blends from the held pose back to the tracked one (and,
+    /// lost, to rest).
     pub recover_s: f32,
+    /// Seconds a lost hand holds its last pose before its fingers relax to rest (over
+    /// `recover_s`, the wrist staying where it was lost): a hand gone from view for good is
+    /// not left frozen mid-gesture, and a short dropout is not seen.
+    pub rest_after_s: f64,
     /// A live record arriving more than this after its capture time (relative to the
     /// stream's fastest delivery) is late and refused, seconds.
     pub max_latency_s: f64,
@@ -79,6 +84,7 @@ impl Default for InputConfig {
             rotation_filter: OneEuroParams::ROTATION,
             grace_s: 0.25,
             recover_s: 0.3,
+            rest_after_s: 1.0,
             max_latency_s: 0.25,
             max_rate_hz: 1_000.0,
             tracker_mount: MountingOffset::default(),
@@ -124,6 +130,9 @@ impl InputConfig {
         }
         if !(self.recover_s.is_finite() && self.recover_s >= 0.0) {
             return bad("recover_s: must be a number of seconds, 0 or more");
+        }
+        if !(self.rest_after_s.is_finite() && self.rest_after_s >= 0.0) {
+            return bad("rest_after_s: must be a number of seconds, 0 or more");
         }
         if !(self.max_latency_s.is_finite() && self.max_latency_s > 0.0) {
             return bad("max_latency_s: must be a positive number of seconds");

@@ -1,8 +1,9 @@
 //! The input pipeline: records in, poses of the engine step out. Each record is checked
 //! (time order, rate, latency), turned into a pose (glove mapping and tracker, or
 //! retargeting of tracked joints or landmarks), filtered, and shown; when good records stop
-//! the hand holds its last pose, is marked "tracking lost" after the grace time, and blends
-//! back smoothly when they return.
+//! the hand holds its last pose, is marked "tracking lost" after the grace time, relaxes its
+//! fingers to rest if they stay away (`rest_after_s`), and blends back smoothly when they
+//! return.
 //!
 //! A live stream is timed by two clocks: the records' capture times and their local arrival.
 //! The stream's clock offset is its fastest delivery (smallest `arrival − capture`); a record
@@ -18,6 +19,7 @@ use glam::Vec3;
 
 use super::record::JOINT_COUNT;
 use super::{GloveMapper, HandData, InputConfig, OneEuro, OneEuroRotation, OneEuroVec3, Record, RejectKind, Rejection, Rejections, Retargeter};
+use crate::hand::Side;
 use crate::kinematics::{HandRig, Pose};
 use crate::math::DualQuat;
 
@@ -73,6 +75,10 @@ pub struct InputPipeline {
     positions: [Vec3; JOINT_COUNT],
     rejections: Rejections,
     accepted: u64,
+    /// The side of the last record taken.
+    side: Option<Side>,
+    /// How much of the held pose a lost hand still shows (1 until it relaxes, 0 at rest).
+    kept: f32,
 }
 
 impl InputPipeline {
@@ -107,6 +113,8 @@ impl InputPipeline {
             positions: [Vec3::ZERO; JOINT_COUNT],
             rejections: Rejections::default(),
             accepted: 0,
+            side: None,
+            kept: 1.0,
             config,
         })
     }
@@ -135,6 +143,13 @@ impl InputPipeline {
         self.accepted
     }
 
+    /// The side of the hand the last record taken tracked (`None` before the first): a
+    /// viewer mirrors our hand back for a tracked hand of the other side.
+    #[must_use]
+    pub fn side(&self) -> Option<Side> {
+        self.side
+    }
+
     /// The configuration.
     #[must_use]
     pub fn config(&self) -> &InputConfig {
@@ -158,14 +173,32 @@ impl InputPipeline {
         self.rejections.add(rejection);
     }
 
-    /// Marks the hand lost if no good record came for the grace time before `now`: the local
-    /// arrival clock of [`Self::push`] on a live stream, the records' clock for a file.
-    pub fn advance(&mut self, now: f64) {
-        if let (Tracking::Tracking, Some(last)) = (self.state, self.last_arrival.or(self.last_time)) {
-            if now - last > self.config.grace_s {
-                self.state = Tracking::Lost;
-            }
+    /// Marks the hand lost if no good record came for the grace time before `now` (the local
+    /// arrival clock of [`Self::push`] on a live stream, the records' clock for a file), and
+    /// relaxes a hand lost for `rest_after_s` more: its angles ease to rest over `recover_s`,
+    /// its wrist stays. Returns whether the pose to show changed. Allocates nothing.
+    pub fn advance(&mut self, now: f64) -> bool {
+        let Some(last) = self.last_arrival.or(self.last_time) else { return false };
+        let lost_for = now - last - self.config.grace_s;
+        if self.state == Tracking::Tracking && lost_for > 0.0 {
+            self.state = Tracking::Lost;
+            self.held.clone_from(&self.output);
+            self.kept = 1.0;
         }
+        let relaxing = lost_for - self.config.rest_after_s;
+        if self.state != Tracking::Lost || relaxing <= 0.0 {
+            return false;
+        }
+        let s = (relaxing as f32 / self.config.recover_s.max(f32::EPSILON)).min(1.0);
+        let keep = 1.0 - s * s * (3.0 - 2.0 * s);
+        if keep == self.kept {
+            return false;
+        }
+        self.kept = keep;
+        for (o, h) in self.output.angles.iter_mut().zip(&self.held.angles) {
+            *o = h * keep;
+        }
+        true
     }
 
     /// Takes one record: from a file with `arrival` `None`, live with its local arrival time
@@ -211,6 +244,7 @@ impl InputPipeline {
         self.state = Tracking::Tracking;
         self.last_time = Some(t);
         self.accepted += 1;
+        self.side = Some(record.side);
         Ok(())
     }
 

@@ -98,9 +98,10 @@ impl GestureLoop {
         self.pipeline.reject(rejection);
     }
 
-    /// Marks the hand lost after the grace time without records ([`InputPipeline::advance`]).
-    pub fn advance(&mut self, now: f64) {
-        self.pipeline.advance(now);
+    /// Marks the hand lost after the grace time without records, and relaxes it after
+    /// `rest_after_s` more ([`InputPipeline::advance`]): whether the pose to show changed.
+    pub fn advance(&mut self, now: f64) -> bool {
+        self.pipeline.advance(now)
     }
 
     /// The current gesture, with recognition on.

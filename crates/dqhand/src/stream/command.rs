@@ -70,6 +70,13 @@ pub enum Command {
     },
     /// Every angle to zero and the wrist to rest (stops the timeline).
     Rest {},
+    /// Start or stop recording the live input (the records every source sends, as the
+    /// recording files `dqhand replay` plays) to a new file the server names. The session
+    /// itself is unchanged: the transport owns the recording ([`super::Applied::Record`]).
+    Record {
+        /// Start (a new file) or stop.
+        on: bool,
+    },
 }
 
 impl Command {

@@ -6,11 +6,15 @@
 //! the events in `input` messages (`reset`: a scene's action):
 //!
 //! ```json
-//! {"type": "input", "tracking": "tracking", "gesture": "fist",
+//! {"type": "input", "tracking": "tracking", "gesture": "fist", "side": "left", "mirrored": true,
 //!  "events": [{"t": 1.25, "event": "start", "gesture": "fist"}],
 //!  "actions": [{"t": 1.75, "gesture": "thumbs_up", "action": "next_method"}],
 //!  "accepted": 120, "rejected": 0}
 //! ```
+//!
+//! `side` is the tracked hand's (null before the first record); `mirrored`: our hand, of the
+//! other side, shows it mirrored (x → −x in the world), which a viewer undoes to draw it where
+//! the user's hand is.
 //!
 //! With a scene, viewers are also sent `scene` messages ([`super::frame::scene_message`]):
 //! at once when the object held changes, otherwise at most every [`SCENE_PERIOD`] while the
@@ -31,6 +35,7 @@ use serde_json::{json, Value};
 use super::frame::{check_scene, scene_hello, scene_message};
 use super::Session;
 use crate::gesture::{Event, EventKind, Events};
+use crate::hand::Side;
 use crate::input::{Action, Record, Rejection, Tracking};
 use crate::interaction::{GestureLoop, ManipulationLoop};
 use crate::kinematics::{JointModel, Pose};
@@ -153,6 +158,7 @@ pub struct InputView {
 #[derive(Clone, Copy, Debug)]
 struct Sent {
     tracking: Tracking,
+    side: Option<Side>,
     gesture: Option<usize>,
     accepted: u64,
     rejected: u64,
@@ -310,7 +316,11 @@ impl LiveInput {
         let mut guard = self.lock();
         let state = &mut *guard;
         match &mut state.driver {
-            Driver::Gestures(g) => g.advance(arrival),
+            Driver::Gestures(g) => {
+                if g.advance(arrival) {
+                    state.posed += 1; // a lost hand relaxing: viewers follow it
+                }
+            }
             Driver::Scene(s) if arrival - s.stepped >= STEP_PERIOD => {
                 s.step(arrival);
                 state.posed += 1;
@@ -347,11 +357,12 @@ impl LiveInput {
         }
         view.next = state.logged;
         let gesture = gesture_loop.gesture().and_then(|g| self.index(g));
-        let sent = Sent { tracking: pipeline.tracking(), gesture, accepted, rejected, at: arrival };
+        let sent = Sent { tracking: pipeline.tracking(), side: pipeline.side(), gesture, accepted, rejected, at: arrival };
         let due = match view.sent {
             None => true,
             Some(last) => {
                 last.tracking != sent.tracking
+                    || last.side != sent.side
                     || last.gesture != sent.gesture
                     || (last.accepted, last.rejected) != (accepted, rejected) && arrival - last.at >= COUNTER_PERIOD.as_secs_f64()
             }
@@ -362,6 +373,8 @@ impl LiveInput {
                     "type": "input",
                     "tracking": sent.tracking.as_str(),
                     "gesture": gesture.map(|g| &self.gestures[g]),
+                    "side": sent.side.map(Side::name),
+                    "mirrored": sent.side.is_some_and(|s| s != pipeline.retargeter().side()),
                     "events": events,
                     "actions": actions,
                     "accepted": accepted,

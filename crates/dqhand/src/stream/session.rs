@@ -32,6 +32,8 @@ pub enum Applied {
     Frame,
     /// The joint model changed: send [`Session::hello`] again (the DOF list is new).
     Hello,
+    /// Start (true) or stop recording the live input: the transport's to do.
+    Record(bool),
 }
 
 /// The state of one connected viewer: the pose source (edits, the timeline, a move to a
@@ -219,6 +221,7 @@ impl Session {
                 self.wrist = None;
                 self.pose = Pose::rest(self.joint_model().dof_count());
             }
+            Command::Record { on } => return Ok(Applied::Record(*on)),
         }
         Ok(Applied::Frame)
     }

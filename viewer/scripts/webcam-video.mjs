@@ -1,0 +1,113 @@
+// The camera test's video: our own hand, rendered by the real page, held in known gestures
+// before a camera that sees its palm, written as a YUV4MPEG2 (.y4m) file that Chromium plays as
+// a webcam (--use-file-for-fake-video-capture), with a labels file saying which gesture each
+// stretch of frames shows.
+//
+//   node scripts/webcam-video.mjs OUT_DIR    → OUT_DIR/hand.y4m, OUT_DIR/hand.labels.json
+//
+// The frames are the page's canvas read back at SIZE, converted to 4:2:0 (BT.601, full range,
+// as `C420jpeg` says), at FPS. The hand is the built-in one in the page's front view (fingers
+// up, palm to the camera), as a user's right hand before a webcam.
+
+import { mkdirSync, openSync, writeSync, closeSync, writeFileSync } from 'node:fs';
+import path from 'node:path';
+import { launchBrowser, startServer, waitState, settle } from './harness.mjs';
+
+/** The gestures shown, in order, each held for HOLD_FRAMES after a move of MOVE_FRAMES. */
+const GESTURES = ['open_palm', 'fist', 'victory', 'open_palm', 'point', 'fist'];
+const SIZE = [320, 240];
+const FPS = 10;
+const HOLD_FRAMES = 30;
+const MOVE_FRAMES = 3;
+/** How long the engine takes to move to a gesture (s) — the frames of the move sample it. */
+const MOVE_S = 0.5;
+
+const out = process.argv[2];
+if (!out) throw new Error('usage: node scripts/webcam-video.mjs OUT_DIR');
+mkdirSync(out, { recursive: true });
+
+const server = await startServer();
+const browser = await launchBrowser();
+const file = path.join(out, 'hand.y4m');
+const fd = openSync(file, 'w');
+try {
+  const page = await browser.newPage({ viewport: { width: SIZE[0], height: SIZE[1] } });
+  await page.goto(`${server.url}?figure`);
+  await waitState(page, 's.connected && s.frame !== null');
+  await page.evaluate(() => window.dqhand.send({ type: 'pause' }));
+  await page.evaluate(() => window.dqhand.view([0.25, -0.2, 1], undefined, 0.42));
+  writeSync(fd, `YUV4MPEG2 W${SIZE[0]} H${SIZE[1]} F${FPS}:1 Ip A1:1 C420jpeg\n`);
+  const labels = [];
+  let frame = 0;
+  const capture = async () => {
+    await settle(page, 2);
+    const rgba = Buffer.from(await page.evaluate(readCanvas, SIZE), 'base64');
+    writeSync(fd, 'FRAME\n');
+    writeSync(fd, toI420(rgba, SIZE[0], SIZE[1]));
+    frame++;
+  };
+  for (const name of GESTURES) {
+    await page.evaluate(([name, seconds]) => window.dqhand.send({ type: 'gesture', name, seconds }), [name, MOVE_S]);
+    const moveStart = performance.now();
+    for (let k = 0; k < MOVE_FRAMES; k++) {
+      const due = moveStart + ((k + 1) * MOVE_S * 1000) / MOVE_FRAMES;
+      await new Promise((r) => setTimeout(r, Math.max(0, due - performance.now())));
+      await capture();
+    }
+    await new Promise((r) => setTimeout(r, 200)); // the move has ended: the pose is the gesture's
+    const from = frame;
+    await capture();
+    // The hand is still: the rest of the hold repeats the frame.
+    const still = Buffer.from(await page.evaluate(readCanvas, SIZE), 'base64');
+    for (let k = 1; k < HOLD_FRAMES; k++) {
+      writeSync(fd, 'FRAME\n');
+      writeSync(fd, toI420(still, SIZE[0], SIZE[1]));
+      frame++;
+    }
+    labels.push({ gesture: name, from_s: from / FPS, to_s: frame / FPS });
+  }
+  writeFileSync(path.join(out, 'hand.labels.json'), JSON.stringify({ fps: FPS, size: SIZE, frames: frame, side: 'right', gestures: labels }, null, 1));
+  console.log(`${file}: ${frame} frames of ${SIZE.join('×')} at ${FPS} fps, ${GESTURES.join(', ')}`);
+} finally {
+  closeSync(fd);
+  await browser.close();
+  await server.stop();
+}
+
+/** In the page: the canvas scaled to `size`, as base64 RGBA. */
+function readCanvas([w, h]) {
+  const c = document.getElementById('view');
+  const g = Object.assign(document.createElement('canvas'), { width: w, height: h }).getContext('2d');
+  g.drawImage(c, 0, 0, w, h);
+  const bytes = g.getImageData(0, 0, w, h).data;
+  let s = '';
+  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+  return btoa(s);
+}
+
+/** RGBA to planar Y, U, V at half resolution in both directions (BT.601 full range, JPEG's). */
+function toI420(rgba, w, h) {
+  const out = Buffer.alloc((w * h * 3) / 2);
+  const [cw, ch] = [w / 2, h / 2];
+  for (let y = 0; y < h; y++) {
+    for (let x = 0; x < w; x++) {
+      const i = 4 * (y * w + x);
+      out[y * w + x] = Math.round(0.299 * rgba[i] + 0.587 * rgba[i + 1] + 0.114 * rgba[i + 2]);
+    }
+  }
+  for (let y = 0; y < ch; y++) {
+    for (let x = 0; x < cw; x++) {
+      let [r, g, b] = [0, 0, 0];
+      for (const [dx, dy] of [[0, 0], [1, 0], [0, 1], [1, 1]]) {
+        const i = 4 * ((2 * y + dy) * w + 2 * x + dx);
+        r += rgba[i] / 4;
+        g += rgba[i + 1] / 4;
+        b += rgba[i + 2] / 4;
+      }
+      const clamp = (v) => Math.min(255, Math.max(0, Math.round(v)));
+      out[w * h + y * cw + x] = clamp(128 - 0.168736 * r - 0.331264 * g + 0.5 * b);
+      out[w * h + cw * ch + y * cw + x] = clamp(128 + 0.5 * r - 0.418688 * g - 0.081312 * b);
+    }
+  }
+  return out;
+}

@@ -1,0 +1,119 @@
+// WebXR live input: in an immersive session with hand tracking, each XR frame's 25 joint poses
+// of one tracked hand go to the engine as a record (`/input`), and the engine's hand is drawn
+// where the user's hand is. The Enter VR / Enter AR buttons show only where the browser offers
+// the mode; leaving the session gives the desktop view back (three.js restores the canvas).
+
+import type { WebGLRenderer } from 'three';
+import type { InputSender } from './sender';
+
+export type XRMode = 'immersive-vr' | 'immersive-ar';
+export type Side = 'left' | 'right';
+
+/** One joint of a record (crates/dqhand/src/input/json_record.rs): metres, `[x, y, z, w]`, radius. */
+interface JointRecord {
+  p: [number, number, number];
+  q: [number, number, number, number];
+  r?: number;
+}
+
+/** What the page's test hook reports. */
+export interface XRState {
+  supported: { vr: boolean; ar: boolean };
+  active: boolean;
+  mode: XRMode | null;
+  /** Records the sender took (a closed socket drops them) in all sessions. */
+  sent: number;
+  /** The side of the hand last sent in this session; null before its first record. */
+  side: Side | null;
+}
+
+const MODES = { vr: 'immersive-vr', ar: 'immersive-ar' } as const;
+/** The sides in order of preference: the engine drives one hand, the right when tracked. */
+const SIDES: readonly Side[] = ['right', 'left'];
+
+export class XRInput {
+  readonly supported = { vr: false, ar: false };
+  mode: XRMode | null = null;
+  side: Side | null = null;
+  sent = 0;
+  /** Time (s) of the last record: the engine wants it strictly increasing. */
+  private lastT = -Infinity;
+
+  /**
+   * `changed` hears a session start or end and a change of the side sent (the page then draws
+   * the hand in the world or not); `error` hears a session refused.
+   */
+  constructor(
+    private readonly renderer: WebGLRenderer,
+    private readonly sender: InputSender,
+    $: (id: string) => HTMLElement,
+    private readonly events: { changed(): void; error(message: string): void },
+  ) {
+    renderer.xr.enabled = true;
+    renderer.xr.setReferenceSpaceType('local-floor'); // the engine's world: metres, +Y up, floor at 0
+    for (const key of ['vr', 'ar'] as const) {
+      const button = $(`enter-${key}`) as HTMLButtonElement;
+      button.addEventListener('click', () => this.start(MODES[key]).catch((e: Error) => events.error(`${button.textContent}: ${e.message}`)));
+      void navigator.xr?.isSessionSupported(MODES[key]).then((yes) => {
+        this.supported[key] = yes;
+        button.hidden = !yes;
+      }, () => {});
+    }
+  }
+
+  get active(): boolean {
+    return this.mode !== null;
+  }
+
+  state(): XRState {
+    return { supported: { ...this.supported }, active: this.active, mode: this.mode, sent: this.sent, side: this.side };
+  }
+
+  /** Starts a session that must track hands (a browser that cannot refuses it: `error`). */
+  private async start(mode: XRMode): Promise<void> {
+    if (this.active) return;
+    const session = await navigator.xr!.requestSession(mode, { requiredFeatures: ['local-floor', 'hand-tracking'] });
+    session.addEventListener('end', () => {
+      this.mode = this.side = null;
+      this.sender.close(); // the engine sees the input stop at once
+      this.events.changed();
+    });
+    await this.renderer.xr.setSession(session);
+    this.mode = mode;
+    this.events.changed();
+  }
+
+  /**
+   * Sends the frame's tracked hand, the right one when all its joints are tracked, else the
+   * left; the render loop calls it with the XR frame (none outside a session).
+   */
+  update(time: number, frame: XRFrame | undefined): void {
+    const space = this.renderer.xr.getReferenceSpace();
+    const t = time / 1000;
+    if (!frame || !space || t <= this.lastT) return;
+    for (const side of SIDES) {
+      const hand = Array.from(frame.session.inputSources).find((s) => s.handedness === side)?.hand;
+      const joints = hand && jointRecords(frame, hand, space);
+      if (!joints) continue;
+      this.lastT = t;
+      if (this.sender.send({ t, hand: side, joints })) this.sent++;
+      if (side !== this.side) {
+        this.side = side;
+        this.events.changed();
+      }
+      return;
+    }
+  }
+}
+
+/** The hand's joints in `space`, in XRHand's order (the engine's); null unless all are tracked. */
+function jointRecords(frame: XRFrame, hand: XRHand, space: XRReferenceSpace): JointRecord[] | null {
+  const joints: JointRecord[] = [];
+  for (const joint of hand.values()) {
+    const pose = frame.getJointPose?.(joint, space);
+    if (!pose) return null;
+    const { position: p, orientation: q } = pose.transform;
+    joints.push({ p: [p.x, p.y, p.z], q: [q.x, q.y, q.z, q.w], r: pose.radius });
+  }
+  return joints;
+}
