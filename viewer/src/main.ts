@@ -121,11 +121,12 @@ let mirrored = false;
 let liveShown = false;
 /**
  * Draws the hand where the user's is while this page's own input drives it (the camera, an
- * XR session), mirrored back when the engine mirrored it; the camera behind and above it.
+ * XR session), mirrored back when the engine mirrored it (not with a scene: there the
+ * engine's contacts are those of the hand it poses); the camera behind and above it.
  */
 function showLive(): void {
   const live = webcam.state.on || xr.active;
-  scene.setWorld(live, mirrored ? 'left' : 'right');
+  scene.setWorld(live, mirrored && !scene.objects ? 'left' : 'right');
   if (live !== liveShown && !xr.active) scene.setView(live ? [0, 0.45, 1] : 'default', live ? new Vector3(...webcam.anchor) : undefined, live ? 0.6 : undefined);
   liveShown = live;
 }

@@ -98,7 +98,7 @@ describe('live input', () => {
     type: 'input', tracking: 'tracking', gesture: 'fist',
     events: [{ t: 1.25, event: 'start', gesture: 'fist' }, { t: 1.0, event: 'end', gesture: 'open_palm' }],
     actions: [{ t: 1.8, gesture: 'thumbs_up', action: 'next_method' }],
-    accepted: 1234, rejected: 5,
+    accepted: 1234, rejected: 5, side: 'left', mirrored: true,
   };
   const text = (edit: Record<string, unknown> = {}) => JSON.stringify({ ...good, ...edit });
 
@@ -106,6 +106,18 @@ describe('live input', () => {
     expect(decodeText(text())).toEqual(good);
     const quiet = decodeText(text({ tracking: 'lost', gesture: null, events: [], actions: [] })) as InputMessage;
     expect(quiet).toMatchObject({ tracking: 'lost', gesture: null, events: [], actions: [], accepted: 1234 });
+    // An older server says nothing of the side: none, not mirrored.
+    expect(decodeText(text({ side: undefined, mirrored: undefined }))).toMatchObject({ side: null, mirrored: false });
+  });
+
+  test('a recording message is parsed, and a malformed one refused naming the field', () => {
+    const recording = { type: 'recording', on: false, path: 'recordings/live-1.jsonl', records: 412 };
+    expect(decodeText(JSON.stringify(recording))).toEqual(recording);
+    expect(decodeText(JSON.stringify({ ...recording, path: null, records: 0 }))).toEqual({ ...recording, path: null, records: 0 });
+    for (const [edit, message] of [[{ on: 'yes' }, /on "yes"/], [{ path: 3 }, /path 3/], [{ records: -2 }, /records -2/]] as const) {
+      expect(() => decodeText(JSON.stringify({ ...recording, ...edit }))).toThrow(message);
+    }
+    expect(JSON.parse(encodeCommand({ type: 'record', on: true }))).toEqual({ type: 'record', on: true });
   });
 
   test('a malformed input message is refused, naming the field', () => {
@@ -120,6 +132,8 @@ describe('live input', () => {
       [text({ actions: undefined }), /actions undefined/],
       [text({ accepted: -1 }), /accepted -1/],
       [text({ rejected: 1.5 }), /rejected 1.5/],
+      [text({ side: 'both' }), /side "both"/],
+      [text({ mirrored: 'no' }), /mirrored "no"/],
     ];
     for (const [t, message] of cases) {
       expect(() => decodeText(t)).toThrow(ProtocolError);
