@@ -2,7 +2,7 @@
 // tracking, the gesture recognised now, record counters and a log of gesture events and the
 // actions they triggered. `InputLog` holds no DOM, so the tests run it in Node.
 
-import type { HelloInput, InputMessage, Tracking } from './protocol';
+import type { HelloInput, InputMessage, Side, Tracking } from './protocol';
 
 /** Entries the event log keeps. */
 export const LOG_LENGTH = 30;
@@ -42,7 +42,7 @@ export class InputPanel {
   tracking: Tracking = 'waiting';
   gesture: string | null = null;
   /** The tracked hand's side (null before a record). */
-  side: 'left' | 'right' | null = null;
+  side: Side | null = null;
   accepted = 0;
   rejected = 0;
   readonly log = new InputLog();
@@ -95,7 +95,7 @@ export class InputPanel {
   }
 
   /** The test hook's view: null without an input. */
-  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: 'left' | 'right' | null; accepted: number; rejected: number; log: string[] } | null {
+  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: Side | null; accepted: number; rejected: number; log: string[] } | null {
     if (!this.source) return null;
     const { tracking, gesture, side, accepted, rejected } = this;
     return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, accepted, rejected, log: [...this.log.lines] };

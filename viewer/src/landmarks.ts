@@ -15,8 +15,9 @@ export interface Point {
   z: number;
 }
 
+import type { Side } from './protocol';
+
 export type Vec3 = [number, number, number];
-export type Side = 'left' | 'right';
 
 /** Horizontal field of view assumed for a webcam, degrees (most are 55° to 78°). */
 export const CAMERA_FOV_DEG = 60;

@@ -33,10 +33,13 @@ const status = (text: string, kind: '' | 'ok' | 'error') => {
 };
 
 const wsOrigin = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}`;
-/** The page's own live input to the engine (an XR session's tracked hand). */
+/** The page's own live input to the engine: the camera's hand or an XR session's. */
 const sender = new InputSender(`${wsOrigin}/input`);
 const xr = new XRInput(scene.renderer, sender, $, {
-  changed: () => showLive(),
+  changed: () => {
+    if (xr.active && webcam.state.on) webcam.stop('stopped for the VR or AR session');
+    showLive();
+  },
   error: (message) => status(message, 'error'),
 });
 
@@ -79,13 +82,11 @@ const connection = new Connection(`${wsOrigin}/stream`, {
     inputPanel.setHeld(message.held);
   },
   recording(message) {
-    recording = message.on;
-    const record = $('record');
-    record.classList.toggle('on', recording);
-    record.textContent = recording ? 'Stop recording' : 'Record';
+    showRecording(message.on);
+    const failed = message.failed ? ' — writing failed (disk full?): the records before are kept' : '';
     $('recording-status').textContent = message.on
-      ? `recording to ${message.path}`
-      : message.path ? `saved ${message.records.toLocaleString()} records to ${message.path}` : '';
+      ? `recording to ${message.path}${failed}`
+      : message.path ? `saved ${message.records.toLocaleString()} records to ${message.path}${failed}` : '';
     recordings.push(message);
   },
   error(message) {
@@ -95,6 +96,7 @@ const connection = new Connection(`${wsOrigin}/stream`, {
   status(connected) {
     if (connected) inputPanel.reset();
     $<HTMLButtonElement>('record').disabled = !connected;
+    showRecording(false); // a recording going on is announced by the new session
     sceneSet = false;
     status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
@@ -105,6 +107,12 @@ const connection = new Connection(`${wsOrigin}/stream`, {
 let recording = false;
 /** The `recording` messages received, oldest first (for the tests). */
 const recordings: RecordingMessage[] = [];
+/** Shows the Record button for a recording on or off. */
+function showRecording(on: boolean): void {
+  recording = on;
+  $('record').classList.toggle('on', on);
+  $('record').textContent = on ? 'Stop recording' : 'Record';
+}
 const webcam = new Webcam(sender, $<HTMLCanvasElement>('camera-preview'), (s) => {
   $('camera').textContent = s.on ? 'Stop camera' : 'Camera';
   $('camera-status').textContent = s.on && s.status === 'running'
@@ -112,7 +120,13 @@ const webcam = new Webcam(sender, $<HTMLCanvasElement>('camera-preview'), (s) =>
     : s.status;
   showLive();
 });
-$('camera').addEventListener('click', () => void webcam.toggle());
+// One live source at a time (the engine follows one hand): a session stops the camera, and
+// the camera waits for the session's end.
+$('camera').addEventListener('click', () => {
+  if (xr.active) $('camera-status').textContent = 'leave the VR or AR session first';
+  else void webcam.toggle();
+});
+$('insecure').hidden = window.isSecureContext;
 $('record').addEventListener('click', () => connection.send({ type: 'record', on: !recording }));
 
 /** Whether the engine shows the tracked hand as our hand's mirror image (a hand of the other side). */

@@ -178,18 +178,27 @@ export interface InputMessage {
   /** Records refused since the input started (a running total). */
   rejected: number;
   /** The tracked hand's side, null before the first record (an older server omits it: null). */
-  side: 'left' | 'right' | null;
+  side: Side | null;
   /** Our hand, of the other side, shows the tracked one mirrored (x → −x in the world). */
   mirrored: boolean;
 }
 
-/** The answer to a `record` command: the recording started (`records` 0) or ended, and its file. */
+/** A hand's side. */
+export type Side = 'left' | 'right';
+
+/**
+ * The viewers' recording of the live input, sent to every viewer when it changes (a `record`
+ * command) and to one arriving while there is one: on (the file being written) or off (the
+ * last file written), the records in it then, and whether writing failed (a full disk).
+ */
 export interface RecordingMessage {
   type: 'recording';
   on: boolean;
-  /** The file, as the server names it; null when a stop found no recording. */
+  /** The file, as the server names it; null before any recording. */
   path: string | null;
   records: number;
+  /** Writing failed; the records before the failure are kept (an older server omits it: false). */
+  failed: boolean;
 }
 
 export type ServerText = Hello | InputMessage | SceneMessage | RecordingMessage | { type: 'error'; message: string };
@@ -430,7 +439,9 @@ function checkRecording(v: Record<string, unknown>): RecordingMessage {
   if (typeof v.on !== 'boolean') throw bad('on', v.on);
   if (v.path !== null && !isString(v.path)) throw bad('path', v.path);
   if (!isCount(v.records)) throw bad('records', v.records);
-  return { type: 'recording', on: v.on, path: v.path, records: v.records };
+  const failed = v.failed ?? false;
+  if (typeof failed !== 'boolean') throw bad('failed', v.failed);
+  return { type: 'recording', on: v.on, path: v.path, records: v.records, failed };
 }
 
 /** The commands the engine accepts (crates/dqhand/src/stream/command.rs). */

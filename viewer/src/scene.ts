@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { SceneObjects } from './objects';
-import type { Frame, HelloScene, Method, SceneMessage, Topology } from './protocol';
+import type { Frame, HelloScene, Method, SceneMessage, Side, Topology } from './protocol';
 
 const SKIN = new THREE.Color(0xe0a98f);
 /** Distortion that maps to the top of the heat scale (30 % mean edge-length change). */
@@ -25,6 +25,8 @@ export function heatColor(value: number, out: THREE.Color): THREE.Color {
  * fingers up, palm toward the default camera.
  */
 const PRESENT = new THREE.Quaternion().setFromEuler(new THREE.Euler(Math.PI / 2, Math.PI, 0, 'YXZ'));
+/** The engine's frame as it is: hands in the world (a scene's, or where the user's is). */
+const UNTURNED = new THREE.Quaternion();
 
 class HandView {
   /** Placed side by side in the scene (mirrored by `HandScene.place` for a left hand in the world). */
@@ -142,7 +144,7 @@ export class HandScene {
   /** The manipulation scene, or null: then hands are turned for viewing (PRESENT); with one, they stay in the world the objects are in. */
   objects: SceneObjects | null = null;
   /** One hand in the world, mirrored back (left) or not, while the page's own input drives it; null: not. */
-  private world: 'left' | 'right' | null = null;
+  private world: Side | null = null;
   /** The camera of an XR session: three.js moves the camera it renders with to the headset's pose, so not the desktop's. */
   private readonly xrCamera = new THREE.PerspectiveCamera(70, 1, 0.01, 20);
   showSkeleton = false;
@@ -212,14 +214,14 @@ export class HandScene {
    * session, the camera), or turned for viewing again (off). `left`: the engine mirrored the
    * tracked hand onto its own (x → −x about the world's origin), so it is mirrored back.
    */
-  setWorld(on: boolean, side: 'left' | 'right'): void {
+  setWorld(on: boolean, side: Side): void {
     this.world = on ? side : null;
     for (const v of this.views) this.place(v);
   }
 
   /** Turns and mirrors a hand for the scene, the world or viewing. */
   private place(v: HandView): void {
-    v.oriented.quaternion.copy(this.objects || this.world ? new THREE.Quaternion() : PRESENT);
+    v.oriented.quaternion.copy(this.objects || this.world ? UNTURNED : PRESENT);
     v.group.scale.x = this.world === 'left' ? -1 : 1;
   }
 

@@ -1,38 +1,29 @@
 // The page's own live input (the webcam, a WebXR session) to the engine: one JSON record per
 // message on the server's `/input` WebSocket. Records are live, so none is queued: one sent
-// while the socket is not open is dropped (the engine would refuse it as late anyway), and
-// the socket reopens on the next record after it closed.
+// while the socket is not open is dropped (the engine would refuse it as late anyway). A
+// closed socket is opened again by a later record, after a wait that doubles while opening
+// fails (the server down, or its senders full), so a page does not hammer it.
 
-/** The engine's answer to a refused record: `{"type": "error", "message": …}`. */
-interface Refusal {
-  type: 'error';
-  message: string;
-}
+/** The first wait before opening the socket again, and the longest (ms). */
+const RETRY_MS = [250, 5000] as const;
 
 export class InputSender {
   private socket: WebSocket | null = null;
-  /** Records handed to the socket. */
-  sent = 0;
-  /** Records dropped while the socket was not open. */
-  dropped = 0;
-  /** The engine's latest refusal of a record (it names the record and the problem), or null. */
-  refusal: string | null = null;
+  /** When the socket may be opened again (performance.now(), ms), and the wait after the next failure. */
+  private retryAt = 0;
+  private wait: number = RETRY_MS[0];
 
   constructor(private readonly url: string) {}
 
-  /** Sends one record now, or drops it (returns false) while the socket opens. */
+  /** Sends one record now, or drops it (returns false) while the socket is not open. */
   send(record: object): boolean {
-    const socket = this.socket ?? this.open();
-    if (socket.readyState !== WebSocket.OPEN) {
-      this.dropped++;
-      return false;
-    }
+    const socket = this.socket ?? (performance.now() >= this.retryAt ? this.open() : null);
+    if (socket?.readyState !== WebSocket.OPEN) return false;
     socket.send(JSON.stringify(record));
-    this.sent++;
     return true;
   }
 
-  /** Closes the socket (the engine then sees the input stop, and marks the hand lost). */
+  /** Closes the socket: the records stop, and the engine marks the hand lost after its grace time. */
   close(): void {
     const socket = this.socket;
     this.socket = null;
@@ -42,16 +33,12 @@ export class InputSender {
   private open(): WebSocket {
     const socket = new WebSocket(this.url);
     this.socket = socket;
-    socket.onmessage = (event) => {
-      try {
-        const message = JSON.parse(String(event.data)) as Refusal;
-        if (message.type === 'error') this.refusal = message.message;
-      } catch {
-        this.refusal = `unreadable answer from the engine: ${String(event.data).slice(0, 80)}`;
-      }
-    };
+    socket.onopen = () => (this.wait = RETRY_MS[0]);
     socket.onclose = () => {
-      if (this.socket === socket) this.socket = null;
+      if (this.socket !== socket) return;
+      this.socket = null;
+      this.retryAt = performance.now() + this.wait;
+      this.wait = Math.min(2 * this.wait, RETRY_MS[1]);
     };
     return socket;
   }

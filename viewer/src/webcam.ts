@@ -5,7 +5,8 @@
 // vite.config.ts), loaded on the first press: nothing comes from the network, and no frame
 // or landmark leaves the page except to the local engine.
 
-import { chosenHand, landmarkRecord, SideFilter, userSide, type Point, type Side, type Vec3 } from './landmarks';
+import { chosenHand, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from './landmarks';
+import type { Side } from './protocol';
 import type { InputSender } from './sender';
 
 /** MediaPipe Hands' solution API, as its script defines it on `window` (@mediapipe/hands index.d.ts). */
@@ -55,7 +56,10 @@ export interface WebcamState {
 
 export class Webcam {
   private video: HTMLVideoElement | null = null;
-  private hands: Hands | null = null;
+  /** MediaPipe, loading or loaded (one for the page's life: it holds its WebAssembly and models). */
+  private hands: Promise<Hands> | null = null;
+  /** Starts so far (see `toggle`). */
+  private starts = 0;
   private busy = false;
   private lastFrameAt = 0;
   private readonly side = new SideFilter();
@@ -72,27 +76,40 @@ export class Webcam {
   /** Starts the camera and the detection, or stops them. */
   async toggle(): Promise<void> {
     if (this.state.on) return this.stop();
-    this.state.on = true;
+    // Each start has its own number: a stop (or another start) while this one awaits the
+    // camera or MediaPipe makes it give back what it opened and end.
+    const start = ++this.starts;
+    const current = () => start === this.starts && this.state.on;
+    Object.assign(this.state, { on: true, frames: 0, detected: 0, sent: 0, detectMs: 0, fps: 0 });
+    this.lastFrameAt = 0;
     this.report('starting the camera');
+    let stream: MediaStream | null = null;
     try {
-      const stream = await navigator.mediaDevices.getUserMedia({ video: { width: { ideal: 640 }, height: { ideal: 480 } }, audio: false });
+      // Browsers offer cameras (and WebXR) only to secure pages: https, or this machine.
+      if (!navigator.mediaDevices) throw new Error(`no camera access for ${location.origin} (a browser gives it to https pages and to localhost only: open this page as http://localhost:${location.port})`);
+      stream = await navigator.mediaDevices.getUserMedia({ video: { width: { ideal: 640 }, height: { ideal: 480 } }, audio: false });
       const video = Object.assign(document.createElement('video'), { muted: true, playsInline: true, srcObject: stream });
       await video.play();
+      if (!current()) return stream.getTracks().forEach((t) => t.stop());
       this.video = video;
       Object.assign(this.state, { width: video.videoWidth, height: video.videoHeight });
       this.report('loading hand tracking');
-      this.hands ??= await loadHands((r) => this.results(r));
-      if (!this.state.on) return; // stopped while loading
+      this.hands ??= loadHands((r) => this.results(r));
+      await this.hands;
+      if (!current()) return; // stopped while loading: stop() took the stream
       this.report('running');
       this.next();
     } catch (e) {
+      if (!current()) return void stream?.getTracks().forEach((t) => t.stop());
       const reason = e instanceof DOMException ? `${e.name}: ${e.message}` : (e as Error).message;
+      this.hands = null; // a failed load is tried again on the next start
       this.stop(`camera: ${reason}`);
     }
   }
 
-  /** Stops the camera (the engine marks the hand lost and rests it after its grace time). */
+  /** Stops the camera (the engine marks the hand lost after its grace time, and rests it). */
   stop(status = 'off'): void {
+    this.starts++;
     this.state.on = false;
     const stream = this.video?.srcObject as MediaStream | null | undefined;
     stream?.getTracks().forEach((t) => t.stop());
@@ -115,7 +132,7 @@ export class Webcam {
     this.busy = true;
     const start = performance.now();
     try {
-      await this.hands.send({ image: video });
+      await (await this.hands).send({ image: video });
     } catch (e) {
       this.stop(`hand tracking: ${(e as Error).message}`);
     } finally {

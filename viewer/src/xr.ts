@@ -4,10 +4,10 @@
 // the mode; leaving the session gives the desktop view back (three.js restores the canvas).
 
 import type { WebGLRenderer } from 'three';
+import type { Side } from './protocol';
 import type { InputSender } from './sender';
 
 export type XRMode = 'immersive-vr' | 'immersive-ar';
-export type Side = 'left' | 'right';
 
 /** One joint of a record (crates/dqhand/src/input/json_record.rs): metres, `[x, y, z, w]`, radius. */
 interface JointRecord {
@@ -75,7 +75,7 @@ export class XRInput {
     const session = await navigator.xr!.requestSession(mode, { requiredFeatures: ['local-floor', 'hand-tracking'] });
     session.addEventListener('end', () => {
       this.mode = this.side = null;
-      this.sender.close(); // the engine sees the input stop at once
+      this.sender.close(); // the records stop: the engine marks the hand lost after its grace time
       this.events.changed();
     });
     await this.renderer.xr.setSession(session);

@@ -111,10 +111,10 @@ describe('live input', () => {
   });
 
   test('a recording message is parsed, and a malformed one refused naming the field', () => {
-    const recording = { type: 'recording', on: false, path: 'recordings/live-1.jsonl', records: 412 };
+    const recording = { type: 'recording', on: false, path: 'recordings/live-1.jsonl', records: 412, failed: false };
     expect(decodeText(JSON.stringify(recording))).toEqual(recording);
     expect(decodeText(JSON.stringify({ ...recording, path: null, records: 0 }))).toEqual({ ...recording, path: null, records: 0 });
-    for (const [edit, message] of [[{ on: 'yes' }, /on "yes"/], [{ path: 3 }, /path 3/], [{ records: -2 }, /records -2/]] as const) {
+    for (const [edit, message] of [[{ on: 'yes' }, /on "yes"/], [{ path: 3 }, /path 3/], [{ records: -2 }, /records -2/], [{ failed: 1 }, /failed 1/]] as const) {
       expect(() => decodeText(JSON.stringify({ ...recording, ...edit }))).toThrow(message);
     }
     expect(JSON.parse(encodeCommand({ type: 'record', on: true }))).toEqual({ type: 'record', on: true });

@@ -723,9 +723,10 @@ fn a_viewer_that_acknowledges_slowly_stays() {
     }
 }
 
-/// The page's Record button: `record` on the stream starts a new file in `--recordings`, every
-/// record `/input` takes is written to it whole as it is taken, and stopping says how many; the
-/// file reads back as a recording. The input messages say which side is tracked and whether our
+/// The page's Record button: `record` on the stream starts a new file in `--recordings` (or
+/// joins the one being written), every viewer is told, every record `/input` takes is written
+/// whole as it is taken, and stopping says how many; the file reads back as a recording, and
+/// `--record` goes on beside it. The input messages say which side is tracked and whether our
 /// hand shows it mirrored.
 #[test]
 fn record_writes_the_live_input_to_a_new_file_and_input_messages_name_the_side() {
@@ -733,15 +734,24 @@ fn record_writes_the_live_input_to_a_new_file_and_input_messages_name_the_side()
     let config = dir.join("config.json");
     std::fs::write(&config, r#"{"grace_s": 5.0, "max_latency_s": 5.0}"#).unwrap();
     let recordings = dir.join("recordings");
-    let server = start("record-server", &["--config", config.to_str().unwrap(), "--recordings", recordings.to_str().unwrap()]);
+    let fixed = dir.join("fixed.jsonl");
+    let server = start("record-server", &["--config", config.to_str().unwrap(), "--recordings", recordings.to_str().unwrap(), "--record", fixed.to_str().unwrap()]);
     let (lines, _) = recording("record-rec");
     let mut viewer = connect(&server);
     text(&mut viewer);
     viewer.send(Message::text(r#"{"type":"record","on":false}"#)).unwrap();
-    assert_eq!(next_text(&mut viewer), serde_json::json!({"type": "recording", "on": false, "path": null, "records": 0}), "a stop with no recording");
+    assert_eq!(next_text(&mut viewer), serde_json::json!({"type": "recording", "on": false, "path": null, "records": 0, "failed": false}), "a stop with no recording");
     viewer.send(Message::text(r#"{"type":"record","on":true}"#)).unwrap();
     let started = next_text(&mut viewer);
     assert_eq!((&started["type"], &started["on"], &started["records"]), (&"recording".into(), &true.into(), &0.into()), "{started}");
+    // Another viewer is told at once, and its Record joins the same file.
+    let mut other = connect(&server);
+    text(&mut other);
+    assert_eq!(next_text(&mut other), started, "a viewer arriving is told of the recording");
+    other.send(Message::text(r#"{"type":"record","on":true}"#)).unwrap();
+    assert_eq!(next_text(&mut other)["path"], started["path"], "no second file");
+    assert_eq!(next_text(&mut viewer)["path"], started["path"], "every viewer is told");
+    drop(other);
     let path = PathBuf::from(started["path"].as_str().unwrap());
     assert_eq!(path.parent(), Some(recordings.as_path()), "{started}");
     assert!(path.file_name().unwrap().to_str().unwrap().starts_with("live-"));
@@ -778,7 +788,7 @@ fn record_writes_the_live_input_to_a_new_file_and_input_messages_name_the_side()
             break m;
         }
     };
-    assert_eq!(stopped, serde_json::json!({"type": "recording", "on": false, "path": path.display().to_string(), "records": 250}));
+    assert_eq!(stopped, serde_json::json!({"type": "recording", "on": false, "path": path.display().to_string(), "records": 250, "failed": false}));
     let written: Vec<Value> = std::fs::read_to_string(&path).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(written.len(), 250, "every record taken, none refused");
     assert_eq!(written[0]["t"], serde_json::from_str::<Value>(&sent[0]).unwrap()["t"]);
@@ -795,4 +805,5 @@ fn record_writes_the_live_input_to_a_new_file_and_input_messages_name_the_side()
     };
     assert_ne!(again["path"], started["path"]);
     assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 250);
+    assert_eq!(std::fs::read_to_string(&fixed).unwrap().lines().count(), 250, "--record kept every record, whatever the viewers did");
 }

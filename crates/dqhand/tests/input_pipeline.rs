@@ -109,12 +109,21 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     let mut p = InputPipeline::new(&rig(), None, config).unwrap();
     let mut fist = gesture("fist").unwrap().pose(JointModel::Full);
     fist.wrist = Some(dqhand::math::DualQuat::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.1, 1.2, -0.3)));
-    p.push(&joints_record(0.0, &fist), None).unwrap();
-    p.push(&joints_record(0.1, &fist), None).unwrap();
+    // Live, arriving as captured.
+    p.push(&joints_record(0.0, &fist), Some(0.0)).unwrap();
+    p.push(&joints_record(0.1, &fist), Some(0.1)).unwrap();
     let wrist = p.pose().wrist;
     p.advance(0.1 + grace + rest_after - 0.01);
     assert_eq!(p.tracking(), Tracking::Lost);
     assert!(max_diff_deg(p.pose(), &fist) < 0.5, "a short dropout holds the pose");
+    // A record of another stream (its clock restarted) that is refused leaves no clock of a
+    // last record: the relax is timed from the loss all the same.
+    let mut unusable = joints_record(0.0, &fist);
+    let Some(HandData::Joints(set)) = &mut unusable.hand else { unreachable!() };
+    for i in 0..25 {
+        set.set(i, TrackedJoint { position: Vec3::ZERO, orientation: None, radius: 0.0 });
+    }
+    assert_eq!(p.push(&unusable, Some(0.1 + grace + 0.1)).unwrap_err().kind, RejectKind::Unusable);
     p.advance(0.1 + grace + rest_after + recover / 2.0);
     let halfway = p.pose().angles.iter().zip(&fist.angles).filter(|(_, f)| f.abs() > 0.1).map(|(a, f)| a / f).collect::<Vec<_>>();
     assert!(halfway.iter().all(|r| (r - 0.5).abs() < 0.01), "half way through the ease, half the bend: {halfway:?}");
@@ -122,7 +131,7 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1e-3, "at rest");
     assert_eq!(p.pose().wrist, wrist, "the wrist stays where the hand was lost");
     // Records return: the hand blends from rest to them.
-    p.push(&joints_record(3.0, &fist), None).unwrap();
+    p.push(&joints_record(3.0, &fist), Some(3.0)).unwrap();
     assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1.0);
 }
 

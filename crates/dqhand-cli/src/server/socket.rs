@@ -62,6 +62,8 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     let mut rate = Rate::new();
     let mut frame = Vec::new();
     let (mut heard, mut pinged) = (Instant::now(), false);
+    // The version of the viewers' recording this viewer was last told of.
+    let mut recording_seen = 0;
     loop {
         // Read edits until the next frame is due (or, with the window full, until an ack).
         loop {
@@ -94,10 +96,11 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                         Ok(command) => match session.apply(&command) {
                             Ok(Applied::Frame) => {}
                             Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
-                            Ok(Applied::Record(on)) => match record(shared, on) {
-                                Ok(message) => ws.send(Message::text(message)).map_err(io)?,
-                                Err(e) => send_error(&mut ws, &format!("{e:#}")).map_err(io)?,
-                            },
+                            Ok(Applied::Record(on)) => {
+                                if let Err(e) = record(shared, on) {
+                                    send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
+                                }
+                            }
                             Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
                         },
                         Err(e) => send_error(&mut ws, &e).map_err(io)?,
@@ -116,6 +119,10 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
         let now = Instant::now();
         session.advance((now - last_frame).as_secs_f32().min(0.1));
         last_frame = now;
+        if let Some(records) = shared.feed.as_deref().map(|f| &f.records).filter(|r| r.version() != recording_seen) {
+            recording_seen = records.version();
+            ws.send(Message::text(records.recording_message())).map_err(io)?;
+        }
         if let (Some(input), Some(view)) = (input, &mut view) {
             let update = input.update(&mut session, view);
             if update.hello {
@@ -137,20 +144,16 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     }
 }
 
-/// Starts (`on`) or stops recording the live input: the `recording` message that says so.
-/// A start ends the recording being written; a stop with none is answered all the same.
-///
-/// ```json
-/// {"type": "recording", "on": false, "path": "recordings/live-1795000000.jsonl", "records": 412}
-/// ```
-fn record(shared: &Shared, on: bool) -> anyhow::Result<String> {
+/// Starts (`on`) or stops the viewers' recording of the live input; every viewer then sends
+/// the new state ([`crate::live::LiveRecords::recording_message`]).
+fn record(shared: &Shared, on: bool) -> anyhow::Result<()> {
     let Some(feed) = shared.feed.as_deref() else { anyhow::bail!("record: this server has no live input") };
-    let (path, records) = if on {
-        (Some(feed.records.start()?), 0)
+    if on {
+        feed.records.start()
     } else {
-        feed.records.stop().map_or((None, 0), |r| (Some(r.path), r.records))
-    };
-    Ok(serde_json::json!({ "type": "recording", "on": on, "path": path.map(|p| p.display().to_string()), "records": records }).to_string())
+        feed.records.stop();
+        Ok(())
+    }
 }
 
 /// What a failed read means: `None` to read on (a timeout), else how the connection ends

@@ -75,10 +75,12 @@ pub struct InputPipeline {
     positions: [Vec3; JOINT_COUNT],
     rejections: Rejections,
     accepted: u64,
-    /// The side of the last record taken.
+    /// The side of the last record taken, if it tracked joints or landmarks.
     side: Option<Side>,
     /// How much of the held pose a lost hand still shows (1 until it relaxes, 0 at rest).
     kept: f32,
+    /// When the hand was marked lost (its clock: arrival when live).
+    lost_at: f64,
 }
 
 impl InputPipeline {
@@ -115,6 +117,7 @@ impl InputPipeline {
             accepted: 0,
             side: None,
             kept: 1.0,
+            lost_at: 0.0,
             config,
         })
     }
@@ -143,8 +146,8 @@ impl InputPipeline {
         self.accepted
     }
 
-    /// The side of the hand the last record taken tracked (`None` before the first): a
-    /// viewer mirrors our hand back for a tracked hand of the other side.
+    /// The side of the hand the last record taken tracked (`None` before the first, and for
+    /// glove records): a viewer mirrors our hand back for a tracked hand of the other side.
     #[must_use]
     pub fn side(&self) -> Option<Side> {
         self.side
@@ -178,14 +181,16 @@ impl InputPipeline {
     /// relaxes a hand lost for `rest_after_s` more: its angles ease to rest over `recover_s`,
     /// its wrist stays. Returns whether the pose to show changed. Allocates nothing.
     pub fn advance(&mut self, now: f64) -> bool {
-        let Some(last) = self.last_arrival.or(self.last_time) else { return false };
-        let lost_for = now - last - self.config.grace_s;
-        if self.state == Tracking::Tracking && lost_for > 0.0 {
-            self.state = Tracking::Lost;
+        if self.state == Tracking::Tracking {
+            let Some(last) = self.last_arrival.or(self.last_time) else { return false };
+            if now - last <= self.config.grace_s {
+                return false;
+            }
+            (self.state, self.lost_at, self.kept) = (Tracking::Lost, last + self.config.grace_s, 1.0);
             self.held.clone_from(&self.output);
-            self.kept = 1.0;
         }
-        let relaxing = lost_for - self.config.rest_after_s;
+        // Timed from the loss itself: a record refused meanwhile may have cleared the clocks.
+        let relaxing = now - self.lost_at - self.config.rest_after_s;
         if self.state != Tracking::Lost || relaxing <= 0.0 {
             return false;
         }
@@ -244,7 +249,8 @@ impl InputPipeline {
         self.state = Tracking::Tracking;
         self.last_time = Some(t);
         self.accepted += 1;
-        self.side = Some(record.side);
+        // Only tracked joints are mirrored onto our hand; a glove drives its own angles.
+        self.side = matches!(record.hand, Some(HandData::Joints(_) | HandData::Landmarks(_))).then_some(record.side);
         Ok(())
     }
 
