@@ -13,7 +13,7 @@ use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::Sequence;
 use dqhand::kinematics::{JointModel, Pose, Transform};
 use dqhand::model::Model;
-use dqhand::skin::Method;
+use dqhand::skin::{Deformed, Deformer, Kernel, Method};
 use glam::Quat;
 use serde_json::json;
 
@@ -23,19 +23,31 @@ pub struct Args {
     /// A .glb or .gltf file, or `builtin` for the built-in hand.
     #[arg(long, default_value = "builtin")]
     mesh: ModelSource,
-    /// Frames timed per method.
+    /// Frames timed per variant.
     #[arg(long, default_value_t = 2000)]
     frames: usize,
-    /// Print one JSON object instead of a table.
+    /// Print one JSON object instead of tables.
     #[arg(long)]
     json: bool,
-    /// Time the portable kernel even where the AVX2 + FMA one would run.
-    #[arg(long)]
-    portable: bool,
+    /// Thread counts to time DQB with, besides one (default: every count up to this
+    /// machine's cores).
+    #[arg(long, value_delimiter = ',')]
+    threads: Vec<usize>,
     /// Instead, measure the viewer stream end to end for this many seconds per run: split
     /// view over a loopback WebSocket, at 120 fps and as fast as it goes.
     #[arg(long, value_name = "SECONDS")]
     stream: Option<f64>,
+}
+
+/// One timed configuration: a method on a kernel, on some threads, with or without normals.
+struct Variant {
+    method: Method,
+    kernel: Kernel,
+    threads: usize,
+    normals: bool,
+    deformer: Deformer,
+    out: Deformed,
+    samples: Vec<f64>,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -48,41 +60,71 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         anyhow::ensure!(seconds > 0.0 && seconds <= 600.0, "--stream takes 0 to 600 seconds");
         return crate::bench_stream::run(model, seconds, args.json);
     }
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let threads: Vec<usize> = if args.threads.is_empty() { (2..=cores).collect() } else { args.threads.iter().copied().filter(|&t| t > 1).collect() };
+    anyhow::ensure!(threads.iter().all(|&t| t <= 256), "--threads: at most 256");
     let model = Arc::new(model);
-    let mut animation = Animation::new(model.clone());
-    if args.portable {
-        animation.engine.use_portable_kernel();
+    let mesh = &model.mesh;
+    let best = Kernel::best();
+    let kernels: Vec<Kernel> = Kernel::ALL.into_iter().filter(|k| k.available()).collect();
+    let mut variants = Vec::new();
+    let mut add = |method, kernel, threads: usize, normals| {
+        let mut deformer = Deformer::new(method, mesh).with_kernel(kernel);
+        if threads > 1 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+            deformer = deformer.with_pool(Arc::new(pool));
+        }
+        let out = if normals { Deformed::new(mesh) } else { Deformed::positions_only(mesh) };
+        variants.push(Variant { method, kernel, threads, normals, deformer, out, samples: Vec::with_capacity(args.frames) });
+    };
+    for &kernel in &kernels {
+        for normals in [true, false] {
+            for m in Method::ALL {
+                add(m, kernel, 1, normals);
+            }
+        }
     }
-    let mut samples = vec![Vec::with_capacity(args.frames); 3];
-    // Warm-up: caches, branch predictors, CPU frequency.
+    for &t in &threads {
+        for normals in [true, false] {
+            add(Method::Dqb, best, t, normals);
+        }
+    }
+    let mut animation = Animation::new(model.clone());
+    // Warm-up: caches, branch predictors, CPU frequency, the pools' threads.
     for f in 0..100 {
         animation.pose(f);
-        for m in Method::ALL {
-            animation.engine.skin(m);
+        for v in &mut variants {
+            v.deformer.deform(mesh, animation.engine.skinning(), &mut v.out);
         }
     }
+    // Interleaved frame by frame, the order rotating: machine noise hits every variant alike.
+    let n = variants.len();
     for f in 0..args.frames {
         animation.pose(f);
-        for k in 0..3 {
-            let m = Method::ALL[(f + k) % 3];
+        for k in 0..n {
+            let v = &mut variants[(f + k) % n];
             let t = Instant::now();
-            let out = animation.engine.skin(m);
-            samples[m.index()].push(t.elapsed().as_secs_f64() * 1e6);
-            std::hint::black_box(out.positions());
+            v.deformer.deform(mesh, animation.engine.skinning(), &mut v.out);
+            v.samples.push(t.elapsed().as_secs_f64() * 1e6);
+            std::hint::black_box(v.out.positions());
         }
     }
-    let mesh = &model.mesh;
-    let animation = animation.name;
-    let stats: Vec<(f64, f64, f64)> = samples.iter_mut().map(|s| (percentile(s, 0.5), percentile(s, 0.1), percentile(s, 0.9))).collect();
-    let median = |m: Method| stats[m.index()].0;
-    let simd = if dqhand::skin::simd_available() && !args.portable { "avx2+fma" } else { "portable" };
-    let methods: serde_json::Map<String, serde_json::Value> = Method::ALL
-        .iter()
-        .map(|&m| {
-            let (med, p10, p90) = stats[m.index()];
-            (m.as_str().to_owned(), json!({ "us_per_frame": med, "fps": 1e6 / med, "p10_us": p10, "p90_us": p90 }))
+    let median = |v: &mut Variant| percentile(&mut v.samples, 0.5);
+    let rows: Vec<serde_json::Value> = variants
+        .iter_mut()
+        .map(|v| {
+            let (med, p10, p90) = (median(v), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
+            json!({ "method": v.method.as_str(), "kernel": v.kernel.name(), "threads": v.threads, "normals": v.normals, "us_per_frame": med, "p10_us": p10, "p90_us": p90, "fps": 1e6 / med })
         })
         .collect();
+    let us = |method: Method, kernel: Kernel, threads: usize, normals: bool| {
+        rows.iter()
+            .find(|r| r["method"] == method.as_str() && r["kernel"] == kernel.name() && r["threads"] == threads && r["normals"] == normals)
+            .and_then(|r| r["us_per_frame"].as_f64())
+            .expect("a timed variant")
+    };
+    let table3 = |m: Method| us(m, best, 1, true);
+    let animation = animation.name;
     let report = json!({
         "mesh": args.mesh.to_string(),
         "vertices": mesh.vertex_count(),
@@ -92,31 +134,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "influences_per_vertex": mesh.influences_per_vertex(),
         "frames": args.frames,
         "animation": animation,
-        "threads": 1,
-        "kernel": simd,
-        "normals": true,
-        "methods": methods,
-        "ratios": {
-            "dqb_over_lb": median(Method::Dqb) / median(Method::Lb),
-            "dqb_over_qb": median(Method::Dqb) / median(Method::Qb),
-        },
+        "cores": cores,
+        "kernel": best.name(),
+        "kernels": kernels.iter().map(|k| k.name()).collect::<Vec<_>>(),
+        "methods": Method::ALL.iter().map(|&m| (m.as_str().to_owned(), json!({ "us_per_frame": table3(m), "fps": 1e6 / table3(m) }))).collect::<serde_json::Map<_, _>>(),
+        "ratios": { "dqb_over_lb": table3(Method::Dqb) / table3(Method::Lb), "dqb_over_qb": table3(Method::Dqb) / table3(Method::Qb) },
+        "variants": rows,
     });
     if args.json {
         println!("{report}");
-    } else {
-        println!(
-            "{}: {} vertices, {} bones, {} frames of {animation}, one thread, {simd} kernel, positions and normals",
-            args.mesh,
-            mesh.vertex_count(),
-            mesh.bone_count(),
-            args.frames
-        );
-        println!("{:<6} {:>12} {:>12} {:>12} {:>14}", "method", "median µs", "p10 µs", "p90 µs", "frames/s");
-        for m in Method::ALL {
-            let (med, p10, p90) = stats[m.index()];
-            println!("{:<6} {med:>12.1} {p10:>12.1} {p90:>12.1} {:>14.0}", m.as_str().to_uppercase(), 1e6 / med);
-        }
-        println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", median(Method::Dqb) / median(Method::Lb), median(Method::Dqb) / median(Method::Qb));
+        return Ok(());
+    }
+    println!(
+        "{}: {} vertices, {} bones, {} frames of {animation} per variant, {} variants interleaved, medians (µs per frame)",
+        args.mesh,
+        mesh.vertex_count(),
+        mesh.bone_count(),
+        args.frames,
+        n
+    );
+    println!("\nthe paper's Table 3: one thread, {} kernel, positions and normals", best.name());
+    println!("{:<6} {:>10} {:>10} {:>10} {:>12}", "method", "median", "p10", "p90", "frames/s");
+    for v in variants.iter_mut().filter(|v| v.kernel == best && v.threads == 1 && v.normals) {
+        let (med, p10, p90) = (median(v), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
+        println!("{:<6} {med:>10.1} {p10:>10.1} {p90:>10.1} {:>12.0}", v.method.as_str().to_uppercase(), 1e6 / med);
+    }
+    println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", table3(Method::Dqb) / table3(Method::Lb), table3(Method::Dqb) / table3(Method::Qb));
+    println!("\nkernels: one thread; positions and normals | positions only");
+    println!("{:<9} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}", "kernel", "LB", "QB", "DQB", "LB", "QB", "DQB");
+    for &k in &kernels {
+        let cell = |normals| Method::ALL.map(|m| format!("{:>8.1}", us(m, k, 1, normals))).join(" ");
+        println!("{:<9} {} | {}", k.name(), cell(true), cell(false));
+    }
+    println!("\nthreads: DQB, {} kernel ({cores} cores here)", best.name());
+    println!("{:<8} {:>18} {:>8} {:>18} {:>8}", "threads", "positions+normals", "speed-up", "positions only", "speed-up");
+    for t in std::iter::once(1).chain(threads.iter().copied()) {
+        let (a, b) = (us(Method::Dqb, best, t, true), us(Method::Dqb, best, t, false));
+        println!("{t:<8} {a:>18.1} {:>8.2} {b:>18.1} {:>8.2}", us(Method::Dqb, best, 1, true) / a, us(Method::Dqb, best, 1, false) / b);
     }
     Ok(())
 }

@@ -1,13 +1,16 @@
-//! `dqhand skin`: pose a mesh and write it with normals.
+//! `dqhand skin`: pose a mesh and write it with normals; or, with `--poses`, a batch of poses
+//! deformed across all cores and written one file each.
 
-use std::path::PathBuf;
-
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Instant;
 
+use anyhow::Context;
 use dqhand::engine::{Engine, ModelSource};
 use dqhand::io::PoseFile;
-use dqhand::kinematics::Limits;
-use dqhand::skin::Method;
+use dqhand::kinematics::{Limits, PoseTarget};
+use dqhand::skin::{Deformed, Deformer, Method};
 
 /// Arguments of `dqhand skin`.
 #[derive(clap::Args)]
@@ -16,12 +19,21 @@ pub struct Args {
     #[arg(long, default_value = "builtin")]
     mesh: ModelSource,
     /// Pose file (JSON, see the README); the rest pose if omitted.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "poses")]
     pose: Option<PathBuf>,
+    /// Many poses, one pose file object per line (JSON lines; `dqhand replay --out` writes
+    /// them: their `t` and `tracking` are ignored): each is deformed, the poses split across
+    /// all cores, and written into the directory `--out` as `pose-00000.<format>`, ….
+    #[arg(long)]
+    poses: Option<PathBuf>,
+    /// The files' format with `--poses`.
+    #[arg(long, default_value = "glb", value_parser = ["glb", "ply", "obj"], requires = "poses")]
+    format: String,
     /// Skinning method.
     #[arg(long, default_value = "dqb")]
     method: Method,
-    /// Output mesh: .ply, .obj or .glb (vertex order and count of the input).
+    /// Output mesh: .ply, .obj or .glb (vertex order and count of the input); with
+    /// `--poses`, a directory.
     #[arg(long)]
     out: PathBuf,
     /// Use joint angles as given instead of clamping them to anatomical limits.
@@ -32,6 +44,9 @@ pub struct Args {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = args.mesh.load()?;
     crate::warn_all(&model.warnings);
+    if let Some(poses) = &args.poses {
+        return batch(args, model, poses);
+    }
     let pose = match &args.pose {
         Some(p) => PoseFile::load(p)?,
         None => PoseFile::default(),
@@ -52,4 +67,80 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.method
     );
     Ok(())
+}
+
+/// `--poses`: every pose's skinning transforms by the kinematics (one thread), then one
+/// batch deformation across all cores ([`Deformer::deform_batch`]), then the files.
+fn batch(args: &Args, model: dqhand::model::Model, path: &Path) -> anyhow::Result<()> {
+    let poses = read_poses(path)?;
+    anyhow::ensure!(!poses.is_empty(), "{}: no pose", path.display());
+    let model = Arc::new(model);
+    let mut engine: Option<Engine> = None;
+    let mut skinning = Vec::with_capacity(poses.len() * model.mesh.inverse_bind().len());
+    for (i, pose) in poses.iter().enumerate() {
+        let at = |e: dqhand::Error| anyhow::anyhow!("{}: line {}: {e}", path.display(), i + 1);
+        let target = pose.resolve(&model.skeleton).map_err(at)?;
+        // Each line may use another joint model, or local rotations: an engine made for it.
+        let wanted = match &target {
+            PoseTarget::Angles { model, .. } => Some(*model),
+            PoseTarget::LocalRotations(_) => None,
+        };
+        let engine = match &mut engine {
+            Some(e) if e.rig().map(|r| r.model()) == wanted => e,
+            slot => {
+                let mut e = Engine::for_target(model.clone(), &target).map_err(at)?;
+                e.set_limits(if args.no_limits { Limits::Off } else { Limits::Anatomical });
+                slot.insert(e)
+            }
+        };
+        for w in engine.pose_target(&target) {
+            eprintln!("dqhand: warning: {}: line {}: {w}", path.display(), i + 1);
+        }
+        skinning.extend_from_slice(engine.skinning());
+    }
+    let mesh = &model.mesh;
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(cores).build()?;
+    let mut out = vec![Deformed::new(mesh); poses.len()];
+    let deformer = Deformer::new(args.method, mesh);
+    let t = Instant::now();
+    deformer.deform_batch(&pool, mesh, &skinning, &mut out);
+    let seconds = t.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the directory", args.out.display()))?;
+    for (i, o) in out.iter().enumerate() {
+        let file = args.out.join(format!("pose-{i:05}.{}", args.format));
+        dqhand::io::write_posed(&file, o.positions(), o.normals(), mesh.uvs(), mesh.indices())?;
+    }
+    println!(
+        "deformed {} poses of {} vertices with {} on {cores} threads ({} kernel) in {:.1} ms: {:.0} frames/s; wrote {}/pose-*.{}",
+        poses.len(),
+        mesh.vertex_count(),
+        args.method,
+        deformer.kernel().name(),
+        seconds * 1e3,
+        poses.len() as f64 / seconds,
+        args.out.display(),
+        args.format
+    );
+    Ok(())
+}
+
+/// The pose files of a JSON lines file; a bad line is an error naming the file and line.
+fn read_poses(path: &Path) -> anyhow::Result<Vec<PoseFile>> {
+    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
+    let mut poses = Vec::new();
+    for (i, line) in std::io::BufReader::new(file).lines().enumerate() {
+        let line = line.with_context(|| format!("{}: line {}", path.display(), i + 1))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad = |e: serde_json::Error| anyhow::anyhow!("{}: line {}: not a pose: {e}", path.display(), i + 1);
+        let mut value: serde_json::Value = serde_json::from_str(&line).map_err(bad)?;
+        if let Some(object) = value.as_object_mut() {
+            object.remove("t");
+            object.remove("tracking");
+        }
+        poses.push(serde_json::from_value(value).map_err(bad)?);
+    }
+    Ok(poses)
 }

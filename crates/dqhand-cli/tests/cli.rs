@@ -365,3 +365,32 @@ fn readme_metrics_table_is_the_commands_output() {
     let end = readme.find("<!-- metrics:end -->").expect("README metrics end marker");
     assert_eq!(&readme[begin..end], run_ok(&["metrics", "--markdown"]), "regenerate the README table with `dqhand metrics --markdown`");
 }
+
+/// `skin --poses`: a batch of pose lines (a replay's output among them) is deformed across
+/// the cores and written one file each, each the file `skin --pose` writes for that pose; a
+/// bad line is an error naming the file and line.
+#[test]
+fn skin_poses_writes_one_file_per_pose_as_skin_pose_does() {
+    let dir = temp_dir("skin-poses");
+    let fist = json!({"angles_deg": {"index-finger-phalanx-proximal.flex": 80, "index-finger-phalanx-intermediate.flex": 95}});
+    let spread = json!({"t": 1.5, "tracking": "tracking", "model": "full", "angles_deg": {"thumb-metacarpal.abd": 30}});
+    let lines = [fist.to_string(), String::new(), spread.to_string(), "{}".to_owned()];
+    let poses = dir.join("poses.jsonl");
+    std::fs::write(&poses, lines.join("\n")).unwrap();
+    let out = dir.join("batch");
+    let printed = run_ok(&["skin", "--poses", &path_arg(&poses), "--out", &path_arg(&out), "--format", "ply"]);
+    assert!(printed.contains("deformed 3 poses") && printed.contains("frames/s"), "{printed}");
+    for (i, pose) in [&fist, &spread, &json!({})].into_iter().enumerate() {
+        let mut single = pose.clone();
+        single.as_object_mut().unwrap().retain(|k, _| k != "t" && k != "tracking");
+        let file = dir.join(format!("single-{i}.json"));
+        write_json(&file, &single);
+        let alone = dir.join(format!("single-{i}.ply"));
+        run_ok(&["skin", "--pose", &path_arg(&file), "--out", &path_arg(&alone)]);
+        assert_eq!(std::fs::read(out.join(format!("pose-{i:05}.ply"))).unwrap(), std::fs::read(&alone).unwrap(), "pose {i}");
+    }
+    assert!(!out.join("pose-00003.ply").exists());
+    std::fs::write(&poses, format!("{fist}\n{{\"angles_deg\": 3}}\n")).unwrap();
+    let e = run_error(&["skin", "--poses", &path_arg(&poses), "--out", &path_arg(&out)]);
+    assert!(e.contains("poses.jsonl: line 2: not a pose"), "{e}");
+}

@@ -7,7 +7,9 @@ use dqhand::hand::{build, HandParams};
 use dqhand::geometry::vertex_normals;
 use dqhand::kinematics::{JointModel, Limits, PoseTarget};
 use dqhand::math::DualQuat;
-use dqhand::skin::{Deformed, Deformer, MeshData, Method, SkinnedMesh};
+use std::sync::Arc;
+
+use dqhand::skin::{Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, MIN_VERTICES_PER_THREAD};
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 use proptest::prelude::*;
 use support::{rotation, vec3};
@@ -218,18 +220,42 @@ fn dqb_and_lb_normals_follow_a_smoothly_bent_surface() {
     }
 }
 
+/// On the built-in hand (the reference tests use small random meshes): every kernel agrees
+/// with the portable one; a deformation split across threads, and a batch of poses, give
+/// exactly what one thread gives.
 #[test]
-fn the_portable_and_simd_kernels_agree() {
-    let (model, skinning) = posed_hand("pinch");
+fn kernels_threads_and_batches_agree_on_the_hand() {
+    let (model, pinch) = posed_hand("pinch");
+    let (_, fist) = posed_hand("fist");
+    let mesh = &model.mesh;
+    let pool = Arc::new(rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap());
+    assert!(mesh.vertex_count() >= 3 * MIN_VERTICES_PER_THREAD, "the hand is split three ways");
     for method in Method::ALL {
-        let mut fast = Deformed::new(&model.mesh);
-        let mut portable = Deformed::new(&model.mesh);
-        Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut fast);
-        Deformer::new(method, &model.mesh).portable().deform(&model.mesh, &skinning, &mut portable);
-        for (a, b) in fast.positions().iter().zip(portable.positions()).chain(fast.normals().iter().zip(portable.normals())) {
-            assert_close!(*a, *b, 1e-5);
+        let mut portable = Deformed::new(mesh);
+        Deformer::new(method, mesh).with_kernel(Kernel::Portable).deform(mesh, &pinch, &mut portable);
+        for kernel in Kernel::ALL.into_iter().filter(|k| k.available()) {
+            let single = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &pinch);
+            for (a, b) in single.positions().iter().zip(portable.positions()).chain(single.normals().iter().zip(portable.normals())) {
+                assert_close!(*a, *b, 1e-5);
+            }
+            let split = deform_with(Deformer::new(method, mesh).with_kernel(kernel).with_pool(Arc::clone(&pool)), mesh, &pinch);
+            assert_eq!(split, single, "{method} on {kernel:?}: three threads");
+            let mut only = Deformed::positions_only(mesh);
+            Deformer::new(method, mesh).with_kernel(kernel).with_pool(Arc::clone(&pool)).deform(mesh, &pinch, &mut only);
+            assert_eq!(only.positions(), single.positions(), "{method} on {kernel:?}: positions only, three threads");
+            let poses: Vec<Affine3A> = [&pinch, &fist, &pinch].into_iter().flatten().copied().collect();
+            let mut batch = vec![Deformed::new(mesh); 3];
+            Deformer::new(method, mesh).with_kernel(kernel).deform_batch(&pool, mesh, &poses, &mut batch);
+            let fisted = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &fist);
+            assert_eq!(batch, vec![single.clone(), fisted, single.clone()], "{method} on {kernel:?}: a batch");
         }
     }
+}
+
+fn deform_with(mut deformer: Deformer, mesh: &SkinnedMesh, skinning: &[Affine3A]) -> Deformed {
+    let mut out = Deformed::new(mesh);
+    deformer.deform(mesh, skinning, &mut out);
+    out
 }
 
 #[test]

@@ -8,7 +8,7 @@ use glam::Affine3A;
 
 use crate::kinematics::{forward_kinematics, HandRig, JointModel, Limits, Pose, PoseTarget, Skeleton, Transform};
 use crate::model::Model;
-use crate::skin::{skinning_transforms, Deformed, Deformer, Method, MethodSet};
+use crate::skin::{skinning_transforms, Deformed, Deformer, Kernel, Method, MethodSet};
 use crate::Result;
 
 /// The virtual hand's engine: a model, its kinematics and its skin, with every per-frame
@@ -106,9 +106,14 @@ impl Engine {
         self.methods = methods;
     }
 
-    /// Runs the portable skinning kernel even where the AVX2 + FMA one would (to compare).
-    pub fn use_portable_kernel(&mut self) {
-        self.deformers = self.deformers.clone().map(Deformer::portable);
+    /// Runs the skinning on `kernel` (to compare kernels; the fastest this CPU runs by default).
+    pub fn use_kernel(&mut self, kernel: Kernel) {
+        self.deformers = self.deformers.clone().map(|d| d.with_kernel(kernel));
+    }
+
+    /// Splits each deformation across `pool`'s threads (large meshes; see [`Deformer::with_pool`]).
+    pub fn use_pool(&mut self, pool: &Arc<rayon::ThreadPool>) {
+        self.deformers = self.deformers.clone().map(|d| d.with_pool(Arc::clone(pool)));
     }
 
     /// The model.

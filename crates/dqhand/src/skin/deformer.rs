@@ -2,8 +2,12 @@
 
 use glam::Affine3A;
 
-use super::kernel::{self, Frame};
-use super::skinned_mesh::SkinnedMesh;
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::kernel::{self, Frame, Kernel};
+use super::skinned_mesh::{SkinnedMesh, LANES};
 use super::Method;
 use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
 
@@ -16,11 +20,18 @@ pub struct Deformed {
 }
 
 impl Deformed {
-    /// Buffers for `mesh`, allocated once and reused every frame.
+    /// Buffers for `mesh`, positions and normals, allocated once and reused every frame.
     #[must_use]
     pub fn new(mesh: &SkinnedMesh) -> Self {
         let padded = mesh.pos[0].len();
         Self { vertex_count: mesh.vertex_count(), positions: vec![[0.0; 3]; padded], normals: vec![[0.0; 3]; padded] }
+    }
+
+    /// Buffers for positions only (collision queries, renderers that compute their own
+    /// normals): the deformers then skip the normals' work.
+    #[must_use]
+    pub fn positions_only(mesh: &SkinnedMesh) -> Self {
+        Self { normals: Vec::new(), ..Self::new(mesh) }
     }
 
     /// Deformed positions (m), #V.
@@ -29,38 +40,52 @@ impl Deformed {
         &self.positions[..self.vertex_count]
     }
 
-    /// Deformed unit normals, #V.
+    /// Deformed unit normals, #V; empty for [`Self::positions_only`] buffers.
     #[must_use]
     pub fn normals(&self) -> &[[f32; 3]] {
-        &self.normals[..self.vertex_count]
+        &self.normals[..self.vertex_count.min(self.normals.len())]
     }
 }
 
-/// A skinning method with its per-frame scratch: bone parameters and the sign table.
+/// Vertices below which a deformation is not split across threads (a split costs a few µs
+/// of waking and joining; the built-in hand's 8,668 vertices take ~10 µs on one core).
+pub const MIN_VERTICES_PER_THREAD: usize = 2048;
+
+/// A skinning method with its per-frame scratch: bone parameters and the sign table; the
+/// kernel it runs and, optionally, a thread pool it splits each deformation across.
 #[derive(Clone, Debug)]
 pub struct Deformer {
     method: Method,
     lb: Vec<[f32; lb::W]>,
     quat: Vec<[f32; dqb::W]>,
     signs: Vec<f32>,
-    portable: bool,
+    kernel: Kernel,
+    pool: Option<Arc<rayon::ThreadPool>>,
 }
 
 impl Deformer {
-    /// A deformer for `mesh` (and meshes with the same joints and influence pairs); all
-    /// buffers are allocated here.
+    /// A deformer for `mesh` (and meshes with the same joints and influence pairs) on the
+    /// fastest kernel this CPU runs, on the calling thread; all buffers are allocated here.
     #[must_use]
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
         let joints = mesh.inverse_bind().len();
         let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
-        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], portable: false }
+        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], kernel: Kernel::best(), pool: None }
     }
 
-    /// The same deformer on the portable kernel, even where the AVX2 + FMA one would run
-    /// (for comparing the two; results agree to rounding).
+    /// The same deformer on `kernel` (one this CPU does not run falls back to the best it
+    /// does; results agree to rounding).
     #[must_use]
-    pub fn portable(self) -> Self {
-        Self { portable: true, ..self }
+    pub fn with_kernel(self, kernel: Kernel) -> Self {
+        Self { kernel, ..self }
+    }
+
+    /// The same deformer splitting each deformation across `pool`'s threads (made once and
+    /// kept: no thread is started per frame), for meshes of at least
+    /// [`MIN_VERTICES_PER_THREAD`] vertices per thread.
+    #[must_use]
+    pub fn with_pool(self, pool: Arc<rayon::ThreadPool>) -> Self {
+        Self { pool: Some(pool), ..self }
     }
 
     /// The method.
@@ -69,12 +94,20 @@ impl Deformer {
         self.method
     }
 
-    /// Deforms `mesh` by the skinning transforms into `out`.
+    /// The kernel that runs.
+    #[must_use]
+    pub fn kernel(&self) -> Kernel {
+        if self.kernel.available() { self.kernel } else { Kernel::best() }
+    }
+
+    /// Deforms `mesh` by the skinning transforms into `out` (positions and normals, or
+    /// positions only, as `out` was made).
     ///
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
     /// and translation, or dual quaternion), and for the quaternion methods one sign per pair
     /// of joints that share a vertex, aligning the other joint's rotation to the hemisphere
-    /// of the heaviest one. Steps 2–6: every vertex is blended. Allocates nothing.
+    /// of the heaviest one. Steps 2–6: every vertex is blended, split across the pool's
+    /// threads if there is one. Allocates nothing.
     ///
     /// * `skinning` — #joints transforms `world · inverse_bind`, from [`skinning_transforms`].
     ///
@@ -83,14 +116,12 @@ impl Deformer {
     pub fn deform(&mut self, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut Deformed) {
         assert_eq!(out.vertex_count, mesh.vertex_count(), "output buffers belong to another mesh");
         assert_eq!(skinning.len(), mesh.inverse_bind().len(), "one skinning transform per joint");
-        let (p, n) = (&mut out.positions, &mut out.normals);
         match self.method {
             Method::Lb => {
                 assert_eq!(self.lb.len(), skinning.len(), "deformer made for another joint count");
                 for (d, m) in self.lb.iter_mut().zip(skinning) {
                     *d = lb::params(m);
                 }
-                kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], portable: self.portable }, p, n);
             }
             Method::Qb | Method::Dqb => {
                 assert_eq!(self.quat.len(), skinning.len(), "deformer made for another joint count");
@@ -104,14 +135,51 @@ impl Deformer {
                     let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
                     *sign = if dot < 0.0 { -1.0 } else { 1.0 };
                 }
-                let frame = Frame { params: &self.quat, signs: &self.signs, portable: self.portable };
-                if self.method == Method::Qb {
-                    kernel::deform::<{ qb::W }, qb::Qb>(mesh, &frame, p, n);
-                } else {
-                    kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &frame, p, n);
-                }
             }
         }
+        let threads = self.pool.as_ref().map_or(1, |p| p.current_num_threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);
+        let (positions, normals) = (&mut out.positions[..], &mut out.normals[..]);
+        match &self.pool {
+            Some(pool) if threads > 1 => {
+                // Whole chunks per thread, an even number so the AVX-512 loop keeps its pairs.
+                let span = (positions.len() / LANES).div_ceil(threads).next_multiple_of(2) * LANES;
+                let this = &*self;
+                pool.install(|| {
+                    if normals.is_empty() {
+                        positions.par_chunks_mut(span).enumerate().for_each(|(i, p)| this.run(mesh, i * span / LANES, p, &mut []));
+                    } else {
+                        positions.par_chunks_mut(span).zip(normals.par_chunks_mut(span)).enumerate().for_each(|(i, (p, n))| this.run(mesh, i * span / LANES, p, n));
+                    }
+                });
+            }
+            _ => self.run(mesh, 0, positions, normals),
+        }
+    }
+
+    /// The vertex loop over the chunks from `first` that `positions` holds.
+    fn run(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+        let kernel = self.kernel;
+        match self.method {
+            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], kernel }, first, positions, normals),
+            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, kernel }, first, positions, normals),
+            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, kernel }, first, positions, normals),
+        }
+    }
+
+    /// Deforms `mesh` once per pose, the poses split across `pool`'s threads (each pose on
+    /// one thread): `skinning` holds the poses' transforms one after another (#joints each),
+    /// `out` one buffer per pose. For data sets of posed hands. Each thread's scratch is made
+    /// once per call.
+    ///
+    /// # Panics
+    /// As [`Self::deform`], or if `skinning` does not hold `out.len()` poses.
+    pub fn deform_batch(&self, pool: &rayon::ThreadPool, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut [Deformed]) {
+        let joints = mesh.inverse_bind().len();
+        assert_eq!(skinning.len(), joints * out.len(), "one pose's transforms per output");
+        let single = Self { pool: None, ..self.clone() };
+        pool.install(|| {
+            out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
+        });
     }
 }
 

@@ -10,8 +10,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{recip, rotate, Blend, Chunk, Lanes};
-use super::skinned_mesh::LANES;
+use super::kernel::{recip, rotate, Blend, Chunk};
 use crate::math::DualQuat;
 
 /// Blend parameters: real part `(x, y, z, w)`, then dual part.
@@ -28,8 +27,8 @@ impl Blend<W> for Dqb {
     const SIGNED: usize = W;
 
     #[inline(always)]
-    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
-        for l in 0..LANES {
+    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+        for l in 0..L {
             let (x, y, z, a0) = (b[0][l], b[1][l], b[2][l], b[3][l]);
             let (ex, ey, ez, ae) = (b[4][l], b[5][l], b[6][l], b[7][l]);
             // Eq. (5) is quadratic in b̂, so dividing once by ‖b₀‖² normalises it exactly.
@@ -42,10 +41,14 @@ impl Blend<W> for Dqb {
                 k * (a0 * ez - ae * z + (x * ey - y * ex)),
             ];
             let p = rotate([x, y, z, a0], inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
-            let n = rotate([x, y, z, a0], inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + t[i];
-                out.n[i][l] = n[i];
+            }
+            if NORMALS {
+                let n = rotate([x, y, z, a0], inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+                for i in 0..3 {
+                    out.n[i][l] = n[i];
+                }
             }
         }
     }

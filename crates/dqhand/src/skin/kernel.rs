@@ -1,21 +1,85 @@
 //! The shared vertex loop of the three deformers.
 //!
 //! Each deformer turns a bone transform into `W` floats once per frame. Per chunk of
-//! [`LANES`] vertices the loop blends those floats per vertex (`Σ wᵢ pᵢ`, contiguous loads,
-//! one fused vector operation per influence), transposes the chunk to one array per
-//! component, and lets the deformer finish all lanes at once (normalise, transform position
-//! and normal) — plain lane loops that the compiler vectorises. On x86-64 the same code is
-//! compiled a second time with AVX2 and FMA enabled and chosen at run time.
+//! vertices the loop blends those floats per vertex (`Σ wᵢ pᵢ`, contiguous loads, one fused
+//! vector operation per influence), transposes the chunk to one array per component, and
+//! lets the deformer finish all lanes at once (normalise, transform position and, unless only
+//! positions are asked for, normal) — plain lane loops that the compiler vectorises.
+//!
+//! The same code is compiled for three instruction sets and one is chosen at run time
+//! ([`Kernel`]): portable; AVX2 + FMA, chunks of 8 vertices; AVX-512, chunks of 16 vertices
+//! (two of the mesh's 8-vertex chunks), two vertices per 512-bit register in the blend and
+//! 16 lanes per register in the finish.
 
 use super::skinned_mesh::{SkinnedMesh, LANES};
 
-/// One lane-wise array per component.
-pub(crate) type Lanes = [f32; LANES];
+/// Which compiled vertex loop runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Kernel {
+    /// Plain Rust, any CPU.
+    Portable,
+    /// x86-64 with AVX2 and FMA.
+    Avx2,
+    /// x86-64 with AVX-512 (F, VL, DQ) besides AVX2 and FMA.
+    Avx512,
+}
 
-/// Rest or deformed geometry of one chunk: positions then normals, x/y/z lanes each.
-pub(crate) struct Chunk {
-    pub p: [Lanes; 3],
-    pub n: [Lanes; 3],
+impl Kernel {
+    /// Every kernel, slowest first.
+    pub const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
+
+    /// The fastest kernel this CPU runs.
+    #[must_use]
+    pub fn best() -> Self {
+        Self::ALL.into_iter().rev().find(|k| k.available()).unwrap_or(Kernel::Portable)
+    }
+
+    /// Whether this CPU runs the kernel.
+    #[must_use]
+    pub fn available(self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            let avx2 = has!("avx2") && has!("fma");
+            match self {
+                Kernel::Portable => true,
+                Kernel::Avx2 => avx2,
+                Kernel::Avx512 => avx2 && has!("avx512f") && has!("avx512vl") && has!("avx512dq"),
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self == Kernel::Portable
+        }
+    }
+
+    /// `portable`, `avx2` or `avx512`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Portable => "portable",
+            Kernel::Avx2 => "avx2",
+            Kernel::Avx512 => "avx512",
+        }
+    }
+}
+
+/// The instruction set a loop is compiled for (a const parameter: one copy per set).
+const PORTABLE: u8 = 0;
+const AVX2: u8 = 1;
+const AVX512: u8 = 2;
+
+/// Rest or deformed geometry of one chunk of `L` vertices: positions then normals, x/y/z
+/// lanes each.
+pub(crate) struct Chunk<const L: usize> {
+    pub p: [[f32; L]; 3],
+    pub n: [[f32; L]; 3],
+}
+
+impl<const L: usize> Chunk<L> {
+    fn new() -> Self {
+        Self { p: [[0.0; L]; 3], n: [[0.0; L]; 3] }
+    }
 }
 
 /// What differs between LB, QB and DQB.
@@ -26,8 +90,9 @@ pub(crate) trait Blend<const W: usize> {
     /// is; DQB aligns the whole dual quaternion (8), whose dual part changes sign with the
     /// real part; LB aligns nothing (0).
     const SIGNED: usize;
-    /// Finishes a chunk from the blended parameters `b[component][lane]`.
-    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk);
+    /// Finishes a chunk of `L` vertices from the blended parameters `b[component][lane]`:
+    /// positions, and normals when `NORMALS` (else `out.n` is left alone).
+    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>);
 }
 
 /// Per-frame inputs of the vertex loop.
@@ -36,108 +101,161 @@ pub(crate) struct Frame<'a, const W: usize> {
     pub params: &'a [[f32; W]],
     /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused when `SIGNED` is 0).
     pub signs: &'a [f32],
-    /// Use the portable kernel even where the AVX2 one would run.
-    pub portable: bool,
+    /// The loop to run (one this CPU does not run falls back to the best it does).
+    pub kernel: Kernel,
 }
 
-/// Deforms every vertex of `mesh`; writes `positions` and `normals` (each padded length).
+/// Deforms the vertices of `mesh`'s chunks from `first` on (of [`LANES`] vertices), as many
+/// as `positions` holds: writes `positions`, and `normals` unless it is empty (positions
+/// only). Both hold whole chunks.
 pub(crate) fn deform<const W: usize, B: Blend<W>>(
     mesh: &SkinnedMesh,
     frame: &Frame<'_, W>,
+    first: usize,
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    #[cfg(target_arch = "x86_64")]
-    if !frame.portable && simd_available() {
-        // SAFETY: the CPU supports the features the function is compiled for.
-        unsafe { deform_avx2::<W, B>(mesh, frame, positions, normals) };
-        return;
+    let kernel = if frame.kernel.available() { frame.kernel } else { Kernel::best() };
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the CPU supports the features each function is compiled for.
+        Kernel::Avx512 => unsafe { deform_avx512::<W, B>(mesh, frame, first, positions, normals) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        Kernel::Avx2 => unsafe { deform_avx2::<W, B>(mesh, frame, first, positions, normals) },
+        _ => deform_any::<W, B, PORTABLE>(mesh, frame, first, positions, normals),
     }
-    deform_any::<W, B, false>(mesh, frame, positions, normals);
 }
 
 /// Whether the AVX2 + FMA kernel runs on this CPU.
 #[must_use]
 pub fn simd_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    Kernel::Avx2.available()
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn deform_avx2<const W: usize, B: Blend<W>>(
-    mesh: &SkinnedMesh,
-    frame: &Frame<'_, W>,
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
-) {
-    deform_any::<W, B, true>(mesh, frame, positions, normals);
+unsafe fn deform_avx2<const W: usize, B: Blend<W>>(mesh: &SkinnedMesh, frame: &Frame<'_, W>, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    deform_any::<W, B, AVX2>(mesh, frame, first, positions, normals);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512dq")]
+unsafe fn deform_avx512<const W: usize, B: Blend<W>>(mesh: &SkinnedMesh, frame: &Frame<'_, W>, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    deform_any::<W, B, AVX512>(mesh, frame, first, positions, normals);
 }
 
 #[inline(always)]
-fn deform_any<const W: usize, B: Blend<W>, const AVX: bool>(
-    mesh: &SkinnedMesh,
-    frame: &Frame<'_, W>,
-    positions: &mut [[f32; 3]],
-    normals: &mut [[f32; 3]],
-) {
-    match mesh.k {
-        4 => chunks::<W, 4, B, AVX>(mesh, frame, positions, normals),
-        _ => chunks::<W, 8, B, AVX>(mesh, frame, positions, normals),
+fn deform_any<const W: usize, B: Blend<W>, const ISA: u8>(mesh: &SkinnedMesh, frame: &Frame<'_, W>, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    match (mesh.k, normals.is_empty()) {
+        (4, false) => chunks::<W, 4, B, ISA, true>(mesh, frame, first, positions, normals),
+        (4, true) => chunks::<W, 4, B, ISA, false>(mesh, frame, first, positions, normals),
+        (_, false) => chunks::<W, 8, B, ISA, true>(mesh, frame, first, positions, normals),
+        (_, true) => chunks::<W, 8, B, ISA, false>(mesh, frame, first, positions, normals),
     }
 }
 
 #[inline(always)]
-fn chunks<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(
+fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORMALS: bool>(
     mesh: &SkinnedMesh,
     frame: &Frame<'_, W>,
+    first: usize,
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    let padded = mesh.pos[0].len();
-    assert!(positions.len() == padded && normals.len() == padded, "output buffers: padded vertex count");
+    let count = positions.len() / LANES;
+    assert!(positions.len() % LANES == 0 && (!NORMALS || normals.len() == positions.len()), "output buffers: whole chunks");
+    assert!((first + count) * LANES <= mesh.pos[0].len(), "chunks of the mesh");
     assert_eq!(mesh.k, K);
     // Every packed joint index is below the mesh's joint count and every sign index below
     // its pair count + 1 (both by construction), so these two checks make every parameter
     // and sign lookup in bounds.
-    let joints = frame.params.len();
-    assert_eq!(joints, mesh.inverse_bind().len(), "one parameter row per joint");
+    assert_eq!(frame.params.len(), mesh.inverse_bind().len(), "one parameter row per joint");
     assert!(B::SIGNED == 0 || frame.signs.len() == mesh.pairs.len() + 1, "one sign per joint pair");
-    let lanes = |a: &[f32], base: usize| -> Lanes { a[base..base + LANES].try_into().unwrap() };
-    let mut rest = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
-    let mut out = Chunk { p: [[0.0; LANES]; 3], n: [[0.0; LANES]; 3] };
-    let mut b = [[0.0f32; LANES]; W];
-    let (all_js, all_ws) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0);
-    let all_ps = mesh.slot_pairs.as_chunks::<K>().0;
-    for (base, &kc) in (0..padded).step_by(LANES).zip(&mesh.chunk_influences) {
-        let js: &[[u16; K]; LANES] = all_js[base..base + LANES].try_into().unwrap();
-        let ws: &[[f32; K]; LANES] = all_ws[base..base + LANES].try_into().unwrap();
-        let ps: &[[u32; K]; LANES] = all_ps[base..base + LANES].try_into().unwrap();
-        blend::<W, K, B, AVX>(frame, usize::from(kc), Slots { js, ws, ps }, &mut b);
-        for c in 0..3 {
-            rest.p[c] = lanes(&mesh.pos[c], base);
-            rest.n[c] = lanes(&mesh.nrm[c], base);
+    let mut c = 0;
+    #[cfg(target_arch = "x86_64")]
+    if ISA == AVX512 {
+        let mut b = [[0.0f32; 2 * LANES]; W];
+        let (mut rest, mut out) = (Chunk::new(), Chunk::new());
+        while c + 2 <= count {
+            let chunk = first + c;
+            let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
+            // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature
+            // detection; lookups are in bounds (above).
+            unsafe { avx512::blend::<W, K, B>(frame, usize::from(kc), Slots::of(mesh, chunk * LANES), &mut b) };
+            run::<W, B, { 2 * LANES }, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+            c += 2;
         }
-        B::finish(&b, &rest, &mut out);
-        for l in 0..LANES {
-            positions[base + l] = [out.p[0][l], out.p[1][l], out.p[2][l]];
-            normals[base + l] = [out.n[0][l], out.n[1][l], out.n[2][l]];
+    }
+    let mut b = [[0.0f32; LANES]; W];
+    let (mut rest, mut out) = (Chunk::new(), Chunk::new());
+    while c < count {
+        let chunk = first + c;
+        let kc = usize::from(mesh.chunk_influences[chunk]);
+        blend::<W, K, B, ISA>(frame, kc, Slots::of(mesh, chunk * LANES), &mut b);
+        run::<W, B, LANES, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        c += 1;
+    }
+}
+
+/// Finishes `L` vertices from mesh vertex `base` and writes them at `at` of the outputs.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn run<const W: usize, B: Blend<W>, const L: usize, const NORMALS: bool, const ISA: u8>(
+    mesh: &SkinnedMesh,
+    b: &[[f32; L]; W],
+    base: usize,
+    rest: &mut Chunk<L>,
+    out: &mut Chunk<L>,
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+    at: usize,
+) {
+    let lanes = |a: &[f32]| -> [f32; L] { a[base..base + L].try_into().unwrap() };
+    for c in 0..3 {
+        rest.p[c] = lanes(&mesh.pos[c]);
+        if NORMALS {
+            rest.n[c] = lanes(&mesh.nrm[c]);
+        }
+    }
+    B::finish::<L, NORMALS>(b, rest, out);
+    #[cfg(target_arch = "x86_64")]
+    if ISA == AVX512 && L == 2 * LANES {
+        // SAFETY: `ISA` is AVX512 only inside `deform_avx512`; each output holds `at + L`
+        // vertices (asserted in `chunks`), 3 floats each.
+        unsafe {
+            avx512::store_interleaved(&out.p, positions[at..at + L].as_mut_ptr().cast());
+            if NORMALS {
+                avx512::store_interleaved(&out.n, normals[at..at + L].as_mut_ptr().cast());
+            }
+        }
+        return;
+    }
+    for (l, p) in positions[at..at + L].iter_mut().enumerate() {
+        *p = [out.p[0][l], out.p[1][l], out.p[2][l]];
+    }
+    if NORMALS {
+        for (l, n) in normals[at..at + L].iter_mut().enumerate() {
+            *n = [out.n[0][l], out.n[1][l], out.n[2][l]];
         }
     }
 }
 
-/// The influence slots of one chunk: joints, weights and sign indices per vertex.
+/// The influence slots of `L` vertices: joints, weights and sign indices per vertex.
 #[derive(Clone, Copy)]
-pub(crate) struct Slots<'a, const K: usize> {
-    js: &'a [[u16; K]; LANES],
-    ws: &'a [[f32; K]; LANES],
-    ps: &'a [[u32; K]; LANES],
+pub(crate) struct Slots<'a, const K: usize, const L: usize> {
+    js: &'a [[u16; K]; L],
+    ws: &'a [[f32; K]; L],
+    ps: &'a [[u32; K]; L],
+}
+
+impl<'a, const K: usize, const L: usize> Slots<'a, K, L> {
+    /// The slots of mesh vertices `base..base + L`.
+    #[inline(always)]
+    fn of(mesh: &'a SkinnedMesh, base: usize) -> Self {
+        let (js, ws, ps) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0, mesh.slot_pairs.as_chunks::<K>().0);
+        Self { js: js[base..base + L].try_into().unwrap(), ws: ws[base..base + L].try_into().unwrap(), ps: ps[base..base + L].try_into().unwrap() }
+    }
 }
 
 /// Blends the parameters of one chunk: `b[c][l] = Σₖ wₗₖ sₗₖ params[jₗₖ][c]` over the
@@ -147,11 +265,11 @@ pub(crate) struct Slots<'a, const K: usize> {
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, B: Blend<W>, const AVX: bool>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K>, b: &mut [Lanes; W]) {
+fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K, LANES>, b: &mut [[f32; LANES]; W]) {
     #[cfg(target_arch = "x86_64")]
-    if AVX {
-        // SAFETY: `AVX` is true only inside `deform_avx2`, entered after feature detection;
-        // joint indices are in bounds (see `chunks`).
+    if ISA != PORTABLE {
+        // SAFETY: `ISA` is AVX2 or AVX512 only inside `deform_avx2` or `deform_avx512`,
+        // entered after feature detection; joint indices are in bounds (see `chunks`).
         unsafe { avx2::blend::<W, K, B>(frame, kc, slots, b) };
         return;
     }
@@ -210,15 +328,15 @@ mod avx2 {
 
     use core::arch::x86_64::*;
 
-    use super::{Blend, Frame, Lanes, Slots, LANES};
+    use super::{Blend, Frame, Slots, LANES};
 
     /// As the portable `blend`, for `W` = 8 or 16.
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         frame: &Frame<'_, W>,
         kc: usize,
-        slots: Slots<'_, K>,
-        b: &mut [Lanes; W],
+        slots: Slots<'_, K, LANES>,
+        b: &mut [[f32; LANES]; W],
     ) {
         const { assert!(W == 8 || W == 16) };
         let Slots { js, ws, ps } = slots;
@@ -234,7 +352,8 @@ mod avx2 {
             for l in 0..LANES {
                 let j = usize::from(js[l][k]);
                 let w = _mm256_set1_ps(ws[l][k]);
-                let sw = if signed > 0 { _mm256_mul_ps(w, _mm256_set1_ps(*frame.signs.get_unchecked(ps[l][k] as usize))) } else { w };
+                // Slot 0 is the heaviest joint itself, whose sign is always +1.
+                let sw = if signed > 0 && k > 0 { _mm256_mul_ps(w, _mm256_set1_ps(*frame.signs.get_unchecked(ps[l][k] as usize))) } else { w };
                 let p = frame.params.get_unchecked(j).as_ptr();
                 for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
                     let wv = if signed >= 8 * (blk + 1) {
@@ -284,6 +403,147 @@ mod avx2 {
             _mm256_permute2f128_ps::<0x31>(s1, s5),
             _mm256_permute2f128_ps::<0x31>(s2, s6),
             _mm256_permute2f128_ps::<0x31>(s3, s7),
+        ]
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    //! The blend step with AVX-512 for 16 vertices: vertex `l` in the low half of a 512-bit
+    //! register and vertex `l + 8` in the high half, so one fused multiply-add per influence
+    //! serves two vertices; then the AVX2 8×8 transpose done in both halves at once, and a
+    //! two-source permute that puts each component's 16 lanes in vertex order.
+
+    use core::arch::x86_64::*;
+
+    use super::{Blend, Frame, Slots, LANES};
+
+    /// As the portable `blend`, for 16 vertices and `W` = 8 or 16.
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512dq")]
+    pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
+        frame: &Frame<'_, W>,
+        kc: usize,
+        slots: Slots<'_, K, { 2 * LANES }>,
+        b: &mut [[f32; 2 * LANES]; W],
+    ) {
+        const { assert!(W == 8 || W == 16) };
+        let Slots { js, ws, ps } = slots;
+        let signed = B::SIGNED;
+        let mut rows = [[_mm512_setzero_ps(); LANES]; 2];
+        // The lanes of each block of eight parameters that take the signed weight, in both halves.
+        let mask = |blk: usize| {
+            let first = (signed as i32 - 8 * blk as i32).clamp(0, 8) as u32;
+            let half = ((1u32 << first) - 1) as u16;
+            half | (half << 8)
+        };
+        let masks = [mask(0), mask(1)];
+        let pair = |lo: f32, hi: f32| _mm512_insertf32x8::<1>(_mm512_set1_ps(lo), _mm256_set1_ps(hi));
+        for k in 0..kc.min(K) {
+            for l in 0..LANES {
+                let (a, z) = (l, l + LANES);
+                let w = pair(ws[a][k], ws[z][k]);
+                // Slot 0 is the heaviest joint itself, whose sign is always +1.
+                let sw = if signed > 0 && k > 0 {
+                    let s = pair(*frame.signs.get_unchecked(ps[a][k] as usize), *frame.signs.get_unchecked(ps[z][k] as usize));
+                    _mm512_mul_ps(w, s)
+                } else {
+                    w
+                };
+                let pa = frame.params.get_unchecked(usize::from(js[a][k])).as_ptr();
+                let pz = frame.params.get_unchecked(usize::from(js[z][k])).as_ptr();
+                for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
+                    let wv = if signed >= 8 * (blk + 1) {
+                        sw
+                    } else if signed <= 8 * blk {
+                        w
+                    } else {
+                        _mm512_mask_blend_ps(masks[blk], w, sw)
+                    };
+                    let p = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(_mm256_loadu_ps(pa.add(8 * blk))), _mm256_loadu_ps(pz.add(8 * blk)));
+                    r[l] = _mm512_fmadd_ps(wv, p, r[l]);
+                }
+            }
+        }
+        for (blk, r) in rows.iter().enumerate().take(W / 8) {
+            let t = transpose(r);
+            for (c, v) in t.iter().enumerate() {
+                _mm512_storeu_ps(b[8 * blk + c].as_mut_ptr(), *v);
+            }
+        }
+    }
+
+    /// The permutes that interleave 16 lanes of x, y and z into 48 floats `x₀ y₀ z₀ x₁ …`:
+    /// per output register `k`, first x and y into place (`XY`), then z (`Z`).
+    const XY: [[i32; 16]; 3] = interleave(false);
+    const Z: [[i32; 16]; 3] = interleave(true);
+
+    const fn interleave(z: bool) -> [[i32; 16]; 3] {
+        let mut idx = [[0; 16]; 3];
+        let mut k = 0;
+        while k < 3 {
+            let mut j = 0;
+            while j < 16 {
+                let (v, c) = (((16 * k + j) / 3) as i32, (16 * k + j) % 3);
+                idx[k][j] = match (z, c) {
+                    (false, 0) => v,
+                    (false, 1) => 16 + v,
+                    (false, _) => 0,
+                    (true, 2) => 16 + v,
+                    (true, _) => j as i32,
+                };
+                j += 1;
+            }
+            k += 1;
+        }
+        idx
+    }
+
+    /// Writes 16 vertices' x, y, z lanes as 48 interleaved floats at `dst` (the `[f32; 3]`
+    /// per vertex of the outputs): six two-source permutes and three stores instead of 48
+    /// single-float stores.
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512dq")]
+    pub(super) unsafe fn store_interleaved<const L: usize>(lanes: &[[f32; L]; 3], dst: *mut f32) {
+        debug_assert_eq!(L, 16, "16 lanes");
+        let [x, y, z] = [0, 1, 2].map(|c| _mm512_loadu_ps(lanes[c].as_ptr()));
+        for k in 0..3 {
+            let xy = _mm512_permutex2var_ps(x, _mm512_loadu_si512(XY[k].as_ptr().cast()), y);
+            _mm512_storeu_ps(dst.add(16 * k), _mm512_permutex2var_ps(xy, _mm512_loadu_si512(Z[k].as_ptr().cast()), z));
+        }
+    }
+
+    /// Row `l` holds vertices `l` and `l + 8` (components 0..8 in each half); output `c` holds
+    /// component `c` of vertices 0..16 in order. The unpacks and shuffles work within 128-bit
+    /// lanes, as in the AVX2 transpose; the last step picks 128-bit lanes from two sources.
+    #[inline(always)]
+    unsafe fn transpose(r: &[__m512; 8]) -> [__m512; 8] {
+        let t0 = _mm512_unpacklo_ps(r[0], r[1]);
+        let t1 = _mm512_unpackhi_ps(r[0], r[1]);
+        let t2 = _mm512_unpacklo_ps(r[2], r[3]);
+        let t3 = _mm512_unpackhi_ps(r[2], r[3]);
+        let t4 = _mm512_unpacklo_ps(r[4], r[5]);
+        let t5 = _mm512_unpackhi_ps(r[4], r[5]);
+        let t6 = _mm512_unpacklo_ps(r[6], r[7]);
+        let t7 = _mm512_unpackhi_ps(r[6], r[7]);
+        let s0 = _mm512_shuffle_ps::<0x44>(t0, t2);
+        let s1 = _mm512_shuffle_ps::<0xEE>(t0, t2);
+        let s2 = _mm512_shuffle_ps::<0x44>(t1, t3);
+        let s3 = _mm512_shuffle_ps::<0xEE>(t1, t3);
+        let s4 = _mm512_shuffle_ps::<0x44>(t4, t6);
+        let s5 = _mm512_shuffle_ps::<0xEE>(t4, t6);
+        let s6 = _mm512_shuffle_ps::<0x44>(t5, t7);
+        let s7 = _mm512_shuffle_ps::<0xEE>(t5, t7);
+        // 128-bit lanes 0 and 2 (components 0–3 of vertices 0–3 and 8–11) with the other's.
+        let low = _mm512_setr_epi32(0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27);
+        let high = _mm512_setr_epi32(4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31);
+        [
+            _mm512_permutex2var_ps(s0, low, s4),
+            _mm512_permutex2var_ps(s1, low, s5),
+            _mm512_permutex2var_ps(s2, low, s6),
+            _mm512_permutex2var_ps(s3, low, s7),
+            _mm512_permutex2var_ps(s0, high, s4),
+            _mm512_permutex2var_ps(s1, high, s5),
+            _mm512_permutex2var_ps(s2, high, s6),
+            _mm512_permutex2var_ps(s3, high, s7),
         ]
     }
 }

@@ -5,8 +5,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{inv_len, Blend, Chunk, Lanes};
-use super::skinned_mesh::LANES;
+use super::kernel::{inv_len, Blend, Chunk};
 
 /// Blend parameters: the rows of the 3×4 matrix `[R | t]`, padded to two blocks of eight.
 pub(crate) const W: usize = 16;
@@ -25,14 +24,18 @@ impl Blend<W> for Lb {
     /// Positions by the blended matrix; normals by its cofactor matrix (the inverse transpose
     /// up to the determinant), whose rows are cross products of the other two rows.
     #[inline(always)]
-    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
-        for l in 0..LANES {
+    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+        for l in 0..L {
             let r = [[b[0][l], b[1][l], b[2][l]], [b[4][l], b[5][l], b[6][l]], [b[8][l], b[9][l], b[10][l]]];
             let t = [b[3][l], b[7][l], b[11][l]];
-            let (p, n) = ([rest.p[0][l], rest.p[1][l], rest.p[2][l]], [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+            let p = [rest.p[0][l], rest.p[1][l], rest.p[2][l]];
             for i in 0..3 {
                 out.p[i][l] = r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2] + t[i];
             }
+            if !NORMALS {
+                continue;
+            }
+            let n = [rest.n[0][l], rest.n[1][l], rest.n[2][l]];
             let cross = |a: [f32; 3], b: [f32; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
             let cof = [cross(r[1], r[2]), cross(r[2], r[0]), cross(r[0], r[1])];
             let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

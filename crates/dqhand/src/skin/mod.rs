@@ -9,8 +9,8 @@ mod method_set;
 mod quaternion_blend;
 mod skinned_mesh;
 
-pub use deformer::{skinning_transforms, Deformed, Deformer};
-pub use kernel::simd_available;
+pub use deformer::{skinning_transforms, Deformed, Deformer, MIN_VERTICES_PER_THREAD};
+pub use kernel::{simd_available, Kernel};
 pub use method::Method;
 pub use method_set::MethodSet;
 pub use skinned_mesh::{MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};

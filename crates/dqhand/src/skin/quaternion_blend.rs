@@ -6,8 +6,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{recip, rotate, Blend, Chunk, Lanes};
-use super::skinned_mesh::LANES;
+use super::kernel::{recip, rotate, Blend, Chunk};
 
 /// Blend parameters: the rotation `(x, y, z, w)`, then the translation and a zero.
 pub(crate) const W: usize = 8;
@@ -25,15 +24,19 @@ impl Blend<W> for Qb {
     const SIGNED: usize = 4;
 
     #[inline(always)]
-    fn finish(b: &[Lanes; W], rest: &Chunk, out: &mut Chunk) {
-        for l in 0..LANES {
+    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+        for l in 0..L {
             let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
             let inv_sq = recip(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
             let p = rotate(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
-            let n = rotate(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + b[4 + i][l];
-                out.n[i][l] = n[i];
+            }
+            if NORMALS {
+                let n = rotate(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+                for i in 0..3 {
+                    out.n[i][l] = n[i];
+                }
             }
         }
     }
