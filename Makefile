@@ -10,7 +10,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench fuzz clean recordings
+.PHONY: demo test build viewer assets chromium figures bench bench-peers fuzz clean recordings
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -98,6 +98,33 @@ bench: build
 	./target/release/dqhand bench
 	./target/release/dqhand bench --stream 3
 
+# dqhand beside its peers on one frame of the built-in hand (bench/peers): libigl's dqs and
+# lbs_matrix, a NumPy LB and DQB, three.js's CPU skinning; one table, also in
+# bench/peers/results.md. Each peer has its own environment there, made here: a venv from
+# requirements.txt (libigl 2.5.1's wheels need Python 3.10-3.12: PYTHON=python3.12 to pick
+# one) and node_modules from package-lock.json.
+PYTHON ?= python3
+PEERS := bench/peers
+PEERS_VENV := $(PEERS)/.venv/installed
+PEERS_DEPS := $(PEERS)/node_modules/.package-lock.json
+
+bench-peers: build $(PEERS_VENV) $(PEERS_DEPS)
+	./target/release/dqhand export-skinning --out out/peers
+	node $(PEERS)/three.mjs out/peers
+	$(PEERS)/.venv/bin/python $(PEERS)/peers.py out/peers --out $(PEERS)/results.md
+
+$(PEERS_VENV): $(PEERS)/requirements.txt
+	@$(PYTHON) -c 'import sys; sys.exit(not (3, 10) <= sys.version_info[:2] <= (3, 12))' || \
+	  { echo "make: bench-peers needs Python 3.10 to 3.12 for libigl 2.5.1 (PYTHON=python3.12 make bench-peers)" >&2; exit 1; }
+	rm -rf $(PEERS)/.venv
+	$(PYTHON) -m venv $(PEERS)/.venv
+	$(PEERS)/.venv/bin/pip install --quiet --disable-pip-version-check -r $<
+	touch $@
+
+$(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
+	cd $(PEERS) && $(NPM) ci --no-audit --no-fund
+	touch $@
+
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules viewer/node_modules viewer/dist $(RECORDINGS)
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules

@@ -68,11 +68,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let best = Kernel::best();
     let kernels: Vec<Kernel> = Kernel::ALL.into_iter().filter(|k| k.available()).collect();
     let mut variants = Vec::new();
+    // One pool per thread count, shared by its variants, as an application would keep one.
+    let pools: Vec<(usize, Arc<rayon::ThreadPool>)> =
+        threads.iter().map(|&t| Ok((t, Arc::new(rayon::ThreadPoolBuilder::new().num_threads(t).build()?)))).collect::<anyhow::Result<_>>()?;
     let mut add = |method, kernel, threads: usize, normals| {
         let mut deformer = Deformer::new(method, mesh).with_kernel(kernel);
-        if threads > 1 {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-            deformer = deformer.with_pool(Arc::new(pool));
+        if let Some((_, pool)) = pools.iter().find(|(t, _)| *t == threads) {
+            deformer = deformer.with_pool(Arc::clone(pool));
         }
         let out = if normals { Deformed::new(mesh) } else { Deformed::positions_only(mesh) };
         variants.push(Variant { method, kernel, threads, normals, deformer, out, samples: Vec::with_capacity(args.frames) });

@@ -16,6 +16,7 @@ mod info;
 mod listen;
 mod live;
 mod metrics;
+mod peers;
 mod recording;
 mod replay;
 mod server;
@@ -43,6 +44,9 @@ enum Command {
     Skin(skin::Args),
     /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
     Bench(bench::Args),
+    /// Write one posed frame of the built-in hand (rest mesh, weights, skinning matrices) with
+    /// dqhand's LB and DQB output and timing, for other implementations to compare (make bench-peers).
+    ExportSkinning(peers::Args),
     /// The live viewer: a local server for the browser page that poses the hand and compares
     /// LB, QB and DQB (with --out: write the gesture library as meshes instead).
     Demo(demo::Args),
@@ -77,6 +81,7 @@ fn main() {
         Command::Hand(a) => hand::run(&a),
         Command::Skin(a) => skin::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::ExportSkinning(a) => peers::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Metrics(a) => metrics::run(&a),
         Command::Replay(a) => replay::run(&a),

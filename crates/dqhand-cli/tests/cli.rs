@@ -70,7 +70,7 @@ const BUILTIN_VERTICES: usize = 8668;
 #[test]
 fn help_works_for_every_command() {
     let top = run_ok(&["--help"]);
-    for sub in ["info", "hand", "skin", "bench", "demo", "metrics", "replay", "calibrate", "synthesize", "listen", "gesture-bench", "grasp", "grasp-bench"] {
+    for sub in ["info", "hand", "skin", "bench", "demo", "metrics", "replay", "calibrate", "synthesize", "listen", "gesture-bench", "grasp", "grasp-bench", "export-skinning"] {
         assert!(top.contains(sub), "top-level help does not list {sub}:\n{top}");
         let help = run_ok(&[sub, "--help"]);
         assert!(help.contains("Usage"), "`dqhand {sub} --help`:\n{help}");

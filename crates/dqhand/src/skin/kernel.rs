@@ -127,12 +127,6 @@ pub(crate) fn deform<const W: usize, B: Blend<W>>(
     }
 }
 
-/// Whether the AVX2 + FMA kernel runs on this CPU.
-#[must_use]
-pub fn simd_available() -> bool {
-    Kernel::Avx2.available()
-}
-
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn deform_avx2<const W: usize, B: Blend<W>>(mesh: &SkinnedMesh, frame: &Frame<'_, W>, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
@@ -175,6 +169,8 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
     let mut c = 0;
     #[cfg(target_arch = "x86_64")]
     if ISA == AVX512 {
+        // Blocks of the slot-major weights start at even chunks (the threads' spans are even).
+        assert!(first % 2 == 0, "an AVX-512 run starts at a block");
         let mut b = [[0.0f32; 2 * LANES]; W];
         let (mut rest, mut out) = (Chunk::new(), Chunk::new());
         while c + 2 <= count {
@@ -182,7 +178,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
             let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
             // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature
             // detection; lookups are in bounds (above).
-            unsafe { avx512::blend::<W, K, B>(frame, usize::from(kc), Slots::of(mesh, chunk * LANES), &mut b) };
+            unsafe { avx512::blend::<W, K, B>(frame, mesh, chunk / 2, usize::from(kc), &mut b) };
             run::<W, B, { 2 * LANES }, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
             c += 2;
         }
@@ -330,8 +326,9 @@ mod avx2 {
 
     use super::{Blend, Frame, Slots, LANES};
 
-    /// As the portable `blend`, for `W` = 8 or 16.
-    #[target_feature(enable = "avx2,fma")]
+    /// As the portable `blend`, for `W` = 8 or 16; inlined into `deform_avx2` (or
+    /// `deform_avx512`), whose features it uses.
+    #[inline(always)]
     pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         frame: &Frame<'_, W>,
         kc: usize,
@@ -416,18 +413,26 @@ mod avx512 {
 
     use core::arch::x86_64::*;
 
-    use super::{Blend, Frame, Slots, LANES};
+    use super::{Blend, Frame, SkinnedMesh, LANES};
 
-    /// As the portable `blend`, for 16 vertices and `W` = 8 or 16.
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512dq")]
+    /// As the portable `blend`, for the 16 vertices of block `block` and `W` = 8 or 16.
+    /// A slot's 16 weights (and signs) come in one load (and one gather) from the mesh's
+    /// slot-major block arrays; each register pair of vertices then takes its two weights by
+    /// a permute.
+    /// Inlined into `deform_avx512`, whose features it uses (a call per block would spill
+    /// the accumulators).
+    #[inline(always)]
     pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         frame: &Frame<'_, W>,
+        mesh: &SkinnedMesh,
+        block: usize,
         kc: usize,
-        slots: Slots<'_, K, { 2 * LANES }>,
         b: &mut [[f32; 2 * LANES]; W],
     ) {
         const { assert!(W == 8 || W == 16) };
-        let Slots { js, ws, ps } = slots;
+        let js: &[[u16; K]; 2 * LANES] = mesh.joints.as_chunks::<K>().0[block * 2 * LANES..][..2 * LANES].try_into().unwrap();
+        let slot = |k: usize| (block * K + k) * 2 * LANES;
+        let (weights, signs) = (mesh.block_weights.as_ptr(), mesh.block_signs.as_ptr());
         let signed = B::SIGNED;
         let mut rows = [[_mm512_setzero_ps(); LANES]; 2];
         // The lanes of each block of eight parameters that take the signed weight, in both halves.
@@ -437,20 +442,21 @@ mod avx512 {
             half | (half << 8)
         };
         let masks = [mask(0), mask(1)];
-        let pair = |lo: f32, hi: f32| _mm512_insertf32x8::<1>(_mm512_set1_ps(lo), _mm256_set1_ps(hi));
         for k in 0..kc.min(K) {
+            let w16 = _mm512_loadu_ps(weights.add(slot(k)));
+            // Slot 0 is the heaviest joint itself, whose sign is always +1.
+            let sw16 = if signed > 0 && k > 0 {
+                let index = _mm512_loadu_si512(signs.add(slot(k)).cast());
+                _mm512_mul_ps(w16, _mm512_i32gather_ps::<4>(index, frame.signs.as_ptr()))
+            } else {
+                w16
+            };
             for l in 0..LANES {
-                let (a, z) = (l, l + LANES);
-                let w = pair(ws[a][k], ws[z][k]);
-                // Slot 0 is the heaviest joint itself, whose sign is always +1.
-                let sw = if signed > 0 && k > 0 {
-                    let s = pair(*frame.signs.get_unchecked(ps[a][k] as usize), *frame.signs.get_unchecked(ps[z][k] as usize));
-                    _mm512_mul_ps(w, s)
-                } else {
-                    w
-                };
-                let pa = frame.params.get_unchecked(usize::from(js[a][k])).as_ptr();
-                let pz = frame.params.get_unchecked(usize::from(js[z][k])).as_ptr();
+                let spread = _mm512_loadu_si512(PAIRS[l].as_ptr().cast());
+                let w = _mm512_permutexvar_ps(spread, w16);
+                let sw = if signed > 0 && k > 0 { _mm512_permutexvar_ps(spread, sw16) } else { w };
+                let pa = frame.params.get_unchecked(usize::from(js[l][k])).as_ptr();
+                let pz = frame.params.get_unchecked(usize::from(js[l + LANES][k])).as_ptr();
                 for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
                     let wv = if signed >= 8 * (blk + 1) {
                         sw
@@ -471,6 +477,22 @@ mod avx512 {
             }
         }
     }
+
+    /// Per register row `l`: lane indices that spread vertex `l`'s value over the low half
+    /// and vertex `l + 8`'s over the high half.
+    const PAIRS: [[i32; 16]; LANES] = {
+        let mut idx = [[0; 16]; LANES];
+        let mut l = 0;
+        while l < LANES {
+            let mut j = 0;
+            while j < 16 {
+                idx[l][j] = (l + if j < 8 { 0 } else { LANES }) as i32;
+                j += 1;
+            }
+            l += 1;
+        }
+        idx
+    };
 
     /// The permutes that interleave 16 lanes of x, y and z into 48 floats `x₀ y₀ z₀ x₁ …`:
     /// per output register `k`, first x and y into place (`XY`), then z (`Z`).
@@ -501,7 +523,7 @@ mod avx512 {
     /// Writes 16 vertices' x, y, z lanes as 48 interleaved floats at `dst` (the `[f32; 3]`
     /// per vertex of the outputs): six two-source permutes and three stores instead of 48
     /// single-float stores.
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512dq")]
+    #[inline(always)]
     pub(super) unsafe fn store_interleaved<const L: usize>(lanes: &[[f32; L]; 3], dst: *mut f32) {
         debug_assert_eq!(L, 16, "16 lanes");
         let [x, y, z] = [0, 1, 2].map(|c| _mm512_loadu_ps(lanes[c].as_ptr()));

@@ -10,7 +10,7 @@ mod quaternion_blend;
 mod skinned_mesh;
 
 pub use deformer::{skinning_transforms, Deformed, Deformer, MIN_VERTICES_PER_THREAD};
-pub use kernel::{simd_available, Kernel};
+pub use kernel::Kernel;
 pub use method::Method;
 pub use method_set::MethodSet;
 pub use skinned_mesh::{MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};

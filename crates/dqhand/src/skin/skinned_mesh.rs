@@ -6,6 +6,8 @@ use crate::{Error, Result};
 
 /// Vertices are processed in chunks of this many; arrays are padded to a multiple of it.
 pub const LANES: usize = 8;
+/// Vertices per block of the slot-major weights: two chunks, one AVX-512 step.
+pub(crate) const BLOCK: usize = 2 * LANES;
 
 /// Most influences a vertex may have (glTF's JOINTS_0 and JOINTS_1).
 pub const MAX_INFLUENCES: usize = 8;
@@ -66,6 +68,11 @@ pub struct SkinnedMesh {
     /// Per chunk of [`LANES`] vertices, the most non-zero influences of any of its vertices:
     /// the blend loop stops there (weights are sorted, so the rest are zero).
     pub(crate) chunk_influences: Vec<u8>,
+    /// The weights and sign indices again, per block of [`BLOCK`] vertices slot-major
+    /// (`[block][slot][vertex]`, full blocks only): one load gives a slot of the whole block
+    /// (the AVX-512 blend).
+    pub(crate) block_weights: Vec<f32>,
+    pub(crate) block_signs: Vec<u32>,
     max_influences: usize,
     uvs: Vec<[f32; 2]>,
     indices: Vec<u32>,
@@ -183,7 +190,7 @@ impl SkinnedMesh {
 
         let mut pair_index = std::collections::HashMap::new();
         let mut pairs = Vec::new();
-        let slot_pairs = joints
+        let slot_pairs: Vec<u32> = joints
             .chunks_exact(k)
             .flat_map(|js| js.iter().map(move |&j| (js[0], j)))
             .map(|(h, j)| {
@@ -196,6 +203,14 @@ impl SkinnedMesh {
                 })
             })
             .collect();
+        let blocks = padded / BLOCK;
+        let (mut block_weights, mut block_signs) = (vec![0f32; blocks * k * BLOCK], vec![0u32; blocks * k * BLOCK]);
+        for v in 0..blocks * BLOCK {
+            for s in 0..k {
+                let at = ((v / BLOCK) * k + s) * BLOCK + v % BLOCK;
+                (block_weights[at], block_signs[at]) = (weights[v * k + s], slot_pairs[v * k + s]);
+            }
+        }
         let chunk_influences = slots
             .chunks(LANES)
             .map(|c| c.iter().map(Vec::len).max().unwrap_or(1) as u8)
@@ -242,6 +257,8 @@ impl SkinnedMesh {
             pairs,
             slot_pairs,
             chunk_influences,
+            block_weights,
+            block_signs,
             max_influences,
             uvs: data.uvs,
             indices: data.indices,
