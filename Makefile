@@ -10,7 +10,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers fuzz clean recordings
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -97,6 +97,11 @@ fuzz: assets
 bench: build
 	./target/release/dqhand bench
 	./target/release/dqhand bench --stream 3
+
+# The viewer server under load and abuse (1, 10, 64 viewers; malformed flood; slowloris; a
+# slow reader), measured; `make test` runs a short version that asserts behaviour only.
+loadtest: build
+	./target/release/dqhand loadtest
 
 # dqhand beside its peers on one frame of the built-in hand (bench/peers): libigl's dqs and
 # lbs_matrix, a NumPy LB and DQB, three.js's CPU skinning; one table, also in

@@ -15,6 +15,7 @@ mod hand;
 mod info;
 mod listen;
 mod live;
+mod loadtest;
 mod metrics;
 mod peers;
 mod recording;
@@ -44,6 +45,9 @@ enum Command {
     Skin(skin::Args),
     /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
     Bench(bench::Args),
+    /// The viewer server under load and abuse, measured: 1, 10 and 64 viewers, a malformed
+    /// flood, slowloris, a slow reader.
+    Loadtest(loadtest::Args),
     /// Write one posed frame of the built-in hand (rest mesh, weights, skinning matrices) with
     /// dqhand's LB and DQB output and timing, for other implementations to compare (make bench-peers).
     ExportSkinning(peers::Args),
@@ -81,6 +85,7 @@ fn main() {
         Command::Hand(a) => hand::run(&a),
         Command::Skin(a) => skin::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Loadtest(a) => loadtest::run(&a),
         Command::ExportSkinning(a) => peers::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Metrics(a) => metrics::run(&a),
