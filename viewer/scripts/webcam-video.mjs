@@ -3,18 +3,22 @@
 // a webcam (--use-file-for-fake-video-capture), with a labels file saying which gesture each
 // stretch of frames shows.
 //
-//   node scripts/webcam-video.mjs OUT_DIR    → OUT_DIR/hand.y4m, OUT_DIR/hand.labels.json
+//   node scripts/webcam-video.mjs OUT_DIR           → OUT_DIR/hand.y4m, OUT_DIR/hand.labels.json
+//   node scripts/webcam-video.mjs OUT_DIR --left    → OUT_DIR/hand-left.*: the frames mirrored,
+//                                                      a left hand before the camera
 //
 // The frames are the page's canvas read back at SIZE, converted to 4:2:0 (BT.601, full range,
 // as `C420jpeg` says), at FPS. The hand is the built-in one in the page's front view (fingers
-// up, palm to the camera), as a user's right hand before a webcam.
+// up, palm to the camera), as a user's right hand before a webcam; mirrored, their left.
 
 import { mkdirSync, openSync, writeSync, closeSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { launchBrowser, startServer, waitState, settle } from './harness.mjs';
 
+const left = process.argv.includes('--left');
 /** The gestures shown, in order, each held for HOLD_FRAMES after a move of MOVE_FRAMES. */
-const GESTURES = ['open_palm', 'fist', 'victory', 'open_palm', 'point', 'fist'];
+const GESTURES = left ? ['open_palm', 'fist', 'point'] : ['open_palm', 'fist', 'victory', 'open_palm', 'point', 'fist'];
+const NAME = left ? 'hand-left' : 'hand';
 const SIZE = [320, 240];
 const FPS = 10;
 const HOLD_FRAMES = 30;
@@ -23,12 +27,12 @@ const MOVE_FRAMES = 3;
 const MOVE_S = 0.5;
 
 const out = process.argv[2];
-if (!out) throw new Error('usage: node scripts/webcam-video.mjs OUT_DIR');
+if (!out || out.startsWith('--')) throw new Error('usage: node scripts/webcam-video.mjs OUT_DIR [--left]');
 mkdirSync(out, { recursive: true });
 
 const server = await startServer();
 const browser = await launchBrowser();
-const file = path.join(out, 'hand.y4m');
+const file = path.join(out, `${NAME}.y4m`);
 const fd = openSync(file, 'w');
 try {
   const page = await browser.newPage({ viewport: { width: SIZE[0], height: SIZE[1] } });
@@ -41,7 +45,7 @@ try {
   let frame = 0;
   const capture = async () => {
     await settle(page, 2);
-    const rgba = Buffer.from(await page.evaluate(readCanvas, SIZE), 'base64');
+    const rgba = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
     writeSync(fd, 'FRAME\n');
     writeSync(fd, toI420(rgba, SIZE[0], SIZE[1]));
     frame++;
@@ -58,7 +62,7 @@ try {
     const from = frame;
     await capture();
     // The hand is still: the rest of the hold repeats the frame.
-    const still = Buffer.from(await page.evaluate(readCanvas, SIZE), 'base64');
+    const still = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
     for (let k = 1; k < HOLD_FRAMES; k++) {
       writeSync(fd, 'FRAME\n');
       writeSync(fd, toI420(still, SIZE[0], SIZE[1]));
@@ -66,7 +70,7 @@ try {
     }
     labels.push({ gesture: name, from_s: from / FPS, to_s: frame / FPS });
   }
-  writeFileSync(path.join(out, 'hand.labels.json'), JSON.stringify({ fps: FPS, size: SIZE, frames: frame, side: 'right', gestures: labels }, null, 1));
+  writeFileSync(path.join(out, `${NAME}.labels.json`), JSON.stringify({ fps: FPS, size: SIZE, frames: frame, side: left ? 'left' : 'right', gestures: labels }, null, 1));
   console.log(`${file}: ${frame} frames of ${SIZE.join('×')} at ${FPS} fps, ${GESTURES.join(', ')}`);
 } finally {
   closeSync(fd);
@@ -74,10 +78,11 @@ try {
   await server.stop();
 }
 
-/** In the page: the canvas scaled to `size`, as base64 RGBA. */
-function readCanvas([w, h]) {
+/** In the page: the canvas scaled to `size`, mirrored left to right if asked, as base64 RGBA. */
+function readCanvas([w, h, mirror]) {
   const c = document.getElementById('view');
   const g = Object.assign(document.createElement('canvas'), { width: w, height: h }).getContext('2d');
+  if (mirror) g.setTransform(-1, 0, 0, 1, w, 0);
   g.drawImage(c, 0, 0, w, h);
   const bytes = g.getImageData(0, 0, w, h).data;
   let s = '';

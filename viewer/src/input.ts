@@ -43,6 +43,8 @@ export class InputPanel {
   gesture: string | null = null;
   /** The tracked hand's side (null before a record). */
   side: Side | null = null;
+  /** Whether our hand shows the tracked one mirrored (a hand of the other side). */
+  mirrored = false;
   accepted = 0;
   rejected = 0;
   readonly log = new InputLog();
@@ -70,14 +72,14 @@ export class InputPanel {
 
   /** Forgets the previous session's state (its counters and times restart with the new one). */
   reset(): void {
-    Object.assign(this, { tracking: 'waiting', gesture: null, side: null, accepted: 0, rejected: 0 });
+    Object.assign(this, { tracking: 'waiting', gesture: null, side: null, mirrored: false, accepted: 0, rejected: 0 });
     this.setHeld(null);
     this.log.clear();
     this.render();
   }
 
   update(message: InputMessage): void {
-    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, side: message.side, accepted: message.accepted, rejected: message.rejected });
+    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, side: message.side, mirrored: message.mirrored, accepted: message.accepted, rejected: message.rejected });
     this.log.add(message);
     this.render();
   }
@@ -95,9 +97,9 @@ export class InputPanel {
   }
 
   /** The test hook's view: null without an input. */
-  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: Side | null; accepted: number; rejected: number; log: string[] } | null {
+  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: Side | null; mirrored: boolean; accepted: number; rejected: number; log: string[] } | null {
     if (!this.source) return null;
-    const { tracking, gesture, side, accepted, rejected } = this;
-    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, accepted, rejected, log: [...this.log.lines] };
+    const { tracking, gesture, side, mirrored, accepted, rejected } = this;
+    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, mirrored, accepted, rejected, log: [...this.log.lines] };
   }
 }
