@@ -73,12 +73,13 @@ figures: build viewer chromium
 # Coverage-guided fuzzing of every parser (nightly toolchain + cargo-fuzz), FUZZ_SECONDS each:
 # the stream's frame and topology readers, viewer commands on a live session, pose files, glTF
 # import, scene object meshes (glTF), recordings (JSON records, glove CSV), scene files, the
-# JSON settings (input configurations, glove tables and calibrations, gesture definitions).
+# JSON settings (input configurations, glove tables and calibrations, gesture definitions),
+# and the server's HTTP request heads and WebSocket frames (its own reading code, compiled in).
 # Seeds: fuzz/seeds, the wire-format golden vectors, the WebXR generic hand. Without a
-# sanitizer: the library is safe Rust apart from the AVX2 kernel (checked against a reference
-# by the tests), and AddressSanitizer makes building the hand the targets pose too slow.
+# sanitizer: the library is safe Rust apart from the AVX2 and AVX-512 kernels (checked against
+# a reference by the tests), and AddressSanitizer makes building the hand the targets pose too slow.
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := frame command pose_file gltf object_mesh json_record glove_csv scene settings
+FUZZ_TARGETS := frame command pose_file gltf object_mesh json_record glove_csv scene settings http_head websocket
 
 fuzz: assets
 	command -v cargo-fuzz >/dev/null || $(CARGO) install cargo-fuzz --locked
@@ -90,6 +91,8 @@ fuzz: assets
 	cp fuzz/seeds/glove_csv/* fuzz/corpus/glove_csv/
 	cp fuzz/seeds/scene/* fuzz/corpus/scene/
 	cp fuzz/seeds/settings/* fuzz/corpus/settings/
+	cp fuzz/seeds/http_head/* fuzz/corpus/http_head/
+	cp fuzz/seeds/websocket/* fuzz/corpus/websocket/
 	cp $(WEBXR_HAND) fuzz/corpus/gltf/
 	cp $(WEBXR_HAND) fuzz/corpus/object_mesh/
 	for t in $(FUZZ_TARGETS); do $(CARGO) +nightly fuzz run --sanitizer none $$t fuzz/corpus/$$t -- -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=4096 || exit 1; done

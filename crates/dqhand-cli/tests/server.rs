@@ -681,9 +681,9 @@ fn a_refusal_reaches_a_client_still_sending() {
     assert!(response.starts_with("HTTP/1.1 431"), "{read:?}: {response:?}");
 }
 
-/// Issue 15 (found fuzzing the request head): the 8 KiB bound holds however a head arrives.
-/// Read 1 KiB at a time, a head of 8193 to 9215 bytes was taken when the reads did not end at
-/// 8 KiB exactly (here 100 bytes, then the rest); a head of 8 KiB itself is served.
+/// Issue 15 (found writing the request-head fuzz target): the 8 KiB bound holds however a
+/// head arrives. Read 1 KiB at a time, a head of 8193 to 9215 bytes was taken when the reads
+/// did not end at 8 KiB exactly (here 100 bytes, then the rest); a head of 8 KiB is served.
 #[test]
 fn a_head_over_8_kib_is_refused_however_it_arrives() {
     let server = start("head-bound", &[]);

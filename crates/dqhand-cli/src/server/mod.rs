@@ -4,6 +4,7 @@
 
 mod assets;
 mod input_socket;
+mod messages;
 mod request;
 mod socket;
 

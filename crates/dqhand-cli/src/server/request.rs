@@ -52,27 +52,36 @@ impl Request {
                 return Err(refuse(400, "connection closed before the request was complete"));
             }
             buf.extend_from_slice(&chunk[..n]);
-            let mut headers = [httparse::EMPTY_HEADER; MAX_HEADERS];
-            let mut parsed = httparse::Request::new(&mut headers);
-            match parsed.parse(&buf) {
-                Ok(httparse::Status::Complete(len)) => {
-                    let target = parsed.path.unwrap_or("/");
-                    let raw = target.split(['?', '#']).next().unwrap_or("/");
-                    let path = percent_encoding::percent_decode_str(raw)
-                        .decode_utf8()
-                        .map_err(|_| refuse(400, "the path is not UTF-8 once percent-decoded"))?
-                        .into_owned();
-                    let headers = parsed
-                        .headers
-                        .iter()
-                        .map(|h| (h.name.to_ascii_lowercase(), String::from_utf8_lossy(h.value).into_owned()))
-                        .collect();
-                    return Ok(Self { method: parsed.method.unwrap_or("").into(), path, headers, rest: buf[len..].to_vec() });
-                }
-                Ok(httparse::Status::Partial) if buf.len() < MAX_HEAD_BYTES => {}
-                Ok(httparse::Status::Partial) => return Err(refuse(431, "request head larger than 8 KiB")),
-                Err(e) => return Err(refuse(400, format!("malformed request: {e}"))),
+            if let Some(request) = Self::parse(&buf)? {
+                return Ok(request);
             }
+        }
+    }
+
+    /// Parses a request head from the bytes received so far: `None` while it is incomplete
+    /// and within [`MAX_HEAD_BYTES`]; over it, 431 whether complete or not (the bound does not
+    /// depend on how the head arrived). Over bytes alone, so the `http_head` fuzz target runs it.
+    pub fn parse(buf: &[u8]) -> Result<Option<Self>, Refusal> {
+        let mut headers = [httparse::EMPTY_HEADER; MAX_HEADERS];
+        let mut parsed = httparse::Request::new(&mut headers);
+        match parsed.parse(buf) {
+            Ok(httparse::Status::Complete(len)) if len <= MAX_HEAD_BYTES => {
+                let target = parsed.path.unwrap_or("/");
+                let raw = target.split(['?', '#']).next().unwrap_or("/");
+                let path = percent_encoding::percent_decode_str(raw)
+                    .decode_utf8()
+                    .map_err(|_| refuse(400, "the path is not UTF-8 once percent-decoded"))?
+                    .into_owned();
+                let headers = parsed
+                    .headers
+                    .iter()
+                    .map(|h| (h.name.to_ascii_lowercase(), String::from_utf8_lossy(h.value).into_owned()))
+                    .collect();
+                Ok(Some(Self { method: parsed.method.unwrap_or("").into(), path, headers, rest: buf[len..].to_vec() }))
+            }
+            Ok(httparse::Status::Partial) if buf.len() < MAX_HEAD_BYTES => Ok(None),
+            Ok(_) => Err(refuse(431, "request head larger than 8 KiB")),
+            Err(e) => Err(refuse(400, format!("malformed request: {e}"))),
         }
     }
 

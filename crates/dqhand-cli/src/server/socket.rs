@@ -9,19 +9,14 @@ use std::time::{Duration, Instant};
 use dqhand::stream::{Applied, Command, LiveInput, Session};
 use tungstenite::protocol::frame::coding::CloseCode;
 use tungstenite::protocol::CloseFrame;
-use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 
+use super::messages::{server_socket, Incoming, MAX_COMMAND_BYTES};
 use super::request::{linger, Request};
 use super::Shared;
 
 /// The path of the stream.
 pub const PATH: &str = "/stream";
-/// Largest command accepted from a page; larger ones are answered with an error.
-pub const MAX_COMMAND_BYTES: usize = 4 * 1024;
-/// Largest WebSocket message read at all; beyond it the connection is closed (after an
-/// error message), since the rest of the message would have to be read to go on.
-const MAX_WIRE_BYTES: usize = 64 * 1024;
 /// Frames sent but not yet acknowledged, at most.
 const WINDOW: u32 = 3;
 /// A send that cannot complete in this time (the client stopped reading) ends the connection,
@@ -39,8 +34,7 @@ pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> 
         "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
     );
     stream.write_all(response.as_bytes())?;
-    let config = WebSocketConfig::default().max_message_size(Some(MAX_WIRE_BYTES)).max_frame_size(Some(MAX_WIRE_BYTES));
-    Ok(WebSocket::from_partially_read(stream, request.rest, Role::Server, Some(config)))
+    Ok(server_socket(stream, request.rest))
 }
 
 /// Completes the handshake and streams until the client leaves.
@@ -85,30 +79,21 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
             if read.is_ok() {
                 (heard, pinged) = (Instant::now(), false);
             }
-            match read {
-                Ok(Message::Text(text)) => {
-                    if text.len() > MAX_COMMAND_BYTES {
-                        send_error(&mut ws, &format!("message of {} bytes refused (at most {MAX_COMMAND_BYTES})", text.len())).map_err(io)?;
-                        continue;
+            match read.map(Incoming::of) {
+                Ok(Incoming::Command(Command::Ack { seq })) => acked = seq.wrapping_add(1),
+                Ok(Incoming::Command(command)) => match session.apply(&command) {
+                    Ok(Applied::Frame) => {}
+                    Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
+                    Ok(Applied::Record(on)) => {
+                        if let Err(e) = record(shared, on) {
+                            send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
+                        }
                     }
-                    match Command::parse(&text) {
-                        Ok(Command::Ack { seq }) => acked = seq.wrapping_add(1),
-                        Ok(command) => match session.apply(&command) {
-                            Ok(Applied::Frame) => {}
-                            Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
-                            Ok(Applied::Record(on)) => {
-                                if let Err(e) = record(shared, on) {
-                                    send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
-                                }
-                            }
-                            Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
-                        },
-                        Err(e) => send_error(&mut ws, &e).map_err(io)?,
-                    }
-                }
-                Ok(Message::Binary(_)) => send_error(&mut ws, "binary messages are not commands; send JSON text").map_err(io)?,
-                Ok(Message::Close(_)) => return Ok(()),
-                Ok(_) => {}
+                    Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
+                },
+                Ok(Incoming::Refused(e)) => send_error(&mut ws, &e).map_err(io)?,
+                Ok(Incoming::Close) => return Ok(()),
+                Ok(Incoming::Nothing) => {}
                 Err(e) => {
                     if let Some(end) = read_failure(&mut ws, e) {
                         return end;
