@@ -101,12 +101,12 @@ function runs(samples: Sample[]): { gesture: string; seconds: number }[] {
 }
 
 /**
- * A move between two gestures may pass through another (point to fist closes the thumb onto
- * the curling index: a pinch, 0.8 s here, the filters and MediaPipe's 5 frames a second
- * stretching the video's 0.3 s move): runs up to this long (s) are moves, not gestures shown.
- * Each gesture is shown for 3 s.
+ * A move between two gestures may pass through another (closing the hand brings the thumb
+ * onto the curling index: a pinch, 0.8–1.1 s here, the filters and MediaPipe's few frames a
+ * second on a loaded machine stretching the video's 0.3 s move): runs up to this long (s) are
+ * moves, not gestures shown. Each gesture is shown for 3 s.
  */
-const PASSING_S = 1.0;
+const PASSING_S = 1.5;
 
 describe('the Camera button on a video of our own hand', () => {
   test('MediaPipe finds the right hand, the engine recognises the rendered gestures, and the angles follow', async () => {
