@@ -341,7 +341,9 @@ describe('the viewer page with a recorded input', () => {
     const s = await p.evaluate(() => (window as unknown as { dqhand: { state(): { input: { accepted: number; log: string[] }; errors: string[] } } }).dqhand.state());
     expect(s.input.accepted).toBeGreaterThan(0);
     expect(s.input.log[0]).toMatch(/^\d+\.\d\d {2}/);
-    expect(await p.locator('#input-log li').count()).toBe(s.input.log.length);
+    // The panel's list and the state, read together (an event may arrive between two reads).
+    const [items, lines] = await p.evaluate(() => [document.querySelectorAll('#input-log li').length, (window as unknown as { dqhand: { state(): { input: { log: string[] } } } }).dqhand.state().input.log.length]);
+    expect(items).toBe(lines);
     // The joint sliders show the pose the input drives (once it holds a bent pose, to the degree).
     await waitState(
       p,
