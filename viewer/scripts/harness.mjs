@@ -61,6 +61,17 @@ export function launchBrowser(args = []) {
   });
 }
 
+/**
+ * A page of the tests' size (or `viewport`) in `browser` that logs its errors.
+ * @param {import('playwright-core').Browser} browser
+ * @param {{ width: number, height: number }} [viewport]
+ */
+export async function newPage(browser, viewport = { width: 900, height: 520 }) {
+  const p = await browser.newPage({ viewport });
+  p.on('pageerror', (e) => console.error('page error:', e.message));
+  return p;
+}
+
 /** Waits until the page's state satisfies `predicate` (a function source over `s`). */
 export async function waitState(page, predicate, timeout = 60_000) {
   await page.waitForFunction(`(() => { const s = window.dqhand && window.dqhand.state(); return !!s && (${predicate}); })()`, null, { timeout, polling: 100 });

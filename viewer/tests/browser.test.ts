@@ -6,7 +6,7 @@ import { spawnSync } from 'node:child_process';
 import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, onTestFinished, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
-import { canvasStats, countColour, dqhandBin, launchBrowser, root, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, dqhandBin, launchBrowser, newPage, root, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 let server: Server;
@@ -58,17 +58,11 @@ async function restartServer(whileDown = async () => {}) {
   await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
 }
 
-/** A page of the tests' size that logs its errors. */
-async function newPage(): Promise<Page> {
-  const p = await browser.newPage({ viewport: { width: 900, height: 520 } });
-  p.on('pageerror', (e) => console.error('page error:', e.message));
-  return p;
-}
 
 beforeAll(async () => {
   server = await startServer();
   browser = await launchBrowser();
-  page = await newPage();
+  page = await newPage(browser);
   await page.goto(server.url);
   await waitState(page, 's.connected && s.framesReceived > 3 && s.visible.length === 1');
 });
@@ -239,7 +233,7 @@ describe('the Input panel, on input messages put into the real stream', () => {
   const inputState = () => p.evaluate(() => (window as unknown as { dqhand: { state(): State } }).dqhand.state());
 
   beforeAll(async () => {
-    p = await newPage();
+    p = await newPage(browser);
     // The engine's messages pass through, its hello announcing an input.
     await p.routeWebSocket(/\/stream$/, (ws) => {
       const engine = ws.connectToServer();
@@ -314,7 +308,7 @@ describe('the viewer page with a recorded input', () => {
     supportsInput = /--input\b/.test(`${help.stdout}${help.stderr}`);
     if (!supportsInput) return;
     inputServer = await startServer({ args: ['--input', RECORDING] });
-    inputPage = await newPage();
+    inputPage = await newPage(browser);
     await inputPage.goto(inputServer.url);
   });
 
@@ -363,7 +357,7 @@ describe('the viewer page with a scene', () => {
   beforeAll(async () => {
     // No --input: the bundled grasp recording plays (make recordings writes it).
     sceneServer = await startServer({ args: ['--scene', 'grasp'] });
-    p = await newPage();
+    p = await newPage(browser);
     await p.goto(sceneServer.url);
   });
 

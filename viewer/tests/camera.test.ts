@@ -11,7 +11,7 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import { dqhandBin, launchBrowser, root, startServer, waitState } from '../scripts/harness.mjs';
+import { dqhandBin, launchBrowser, newPage, root, startServer, waitState } from '../scripts/harness.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 interface Labels {
@@ -50,10 +50,24 @@ let server: Server;
 let browser: Browser;
 let page: Page;
 
+/** Renders the test's video into `dir` (`--left`: mirrored) and reads its labels. */
+function renderVideo(...flags: string[]): Labels {
+  const video = spawnSync('node', [path.join(root, 'viewer/scripts/webcam-video.mjs'), dir, ...flags], { encoding: 'utf8', env: { ...process.env, DQHAND_BIN: dqhandBin() } });
+  if (video.status !== 0) throw new Error(`webcam-video.mjs ${flags.join(' ')} failed: ${video.stderr}`);
+  return JSON.parse(readFileSync(path.join(dir, flags.includes('--left') ? 'hand-left.labels.json' : 'hand.labels.json'), 'utf8'));
+}
+
+/** A browser whose camera plays `video` (in `dir`), and a page of it on the server, connected. */
+async function cameraPage(video: string): Promise<{ browser: Browser; page: Page }> {
+  const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
+  const p = await newPage(b, { width: 1100, height: 700 });
+  await p.goto(server.url);
+  await waitState(p, 's.connected && s.frame !== null');
+  return { browser: b, page: p };
+}
+
 beforeAll(async () => {
-  const video = spawnSync('node', [path.join(root, 'viewer/scripts/webcam-video.mjs'), dir], { encoding: 'utf8', env: { ...process.env, DQHAND_BIN: dqhandBin() } });
-  if (video.status !== 0) throw new Error(`webcam-video.mjs failed: ${video.stderr}`);
-  labels = JSON.parse(readFileSync(path.join(dir, 'hand.labels.json'), 'utf8'));
+  labels = renderVideo();
   const out = path.join(dir, 'poses');
   const written = spawnSync(dqhandBin(), ['demo', '--out', out], { encoding: 'utf8' });
   if (written.status !== 0) throw new Error(`dqhand demo --out failed: ${written.stderr}`);
@@ -62,10 +76,7 @@ beforeAll(async () => {
   }
   writeFileSync(path.join(dir, 'config.json'), JSON.stringify(CONFIG));
   server = await startServer({ args: ['--config', path.join(dir, 'config.json'), '--recordings', path.join(dir, 'recordings')] });
-  browser = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, 'hand.y4m')}`]);
-  page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-  await page.goto(server.url);
-  await waitState(page, 's.connected && s.frame !== null');
+  ({ browser, page } = await cameraPage('hand.y4m'));
 });
 
 afterAll(async () => {
@@ -220,13 +231,8 @@ describe('the Camera button on a video of our own hand, mirrored: a left hand', 
   let leftPage: Page;
 
   beforeAll(async () => {
-    const video = spawnSync('node', [path.join(root, 'viewer/scripts/webcam-video.mjs'), dir, '--left'], { encoding: 'utf8', env: { ...process.env, DQHAND_BIN: dqhandBin() } });
-    if (video.status !== 0) throw new Error(`webcam-video.mjs --left failed: ${video.stderr}`);
-    leftLabels = JSON.parse(readFileSync(path.join(dir, 'hand-left.labels.json'), 'utf8'));
-    leftBrowser = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, 'hand-left.y4m')}`]);
-    leftPage = await leftBrowser.newPage({ viewport: { width: 1100, height: 700 } });
-    await leftPage.goto(server.url);
-    await waitState(leftPage, 's.connected && s.frame !== null');
+    leftLabels = renderVideo('--left');
+    ({ browser: leftBrowser, page: leftPage } = await cameraPage('hand-left.y4m'));
   });
 
   afterAll(async () => {

@@ -8,7 +8,7 @@ import { createRequire } from 'node:module';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
 import type { XRDevice } from 'iwer';
-import { canvasStats, launchBrowser, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, launchBrowser, newPage, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 /** IWER's UMD build: defines `window.IWER`. */
 const IWER_BUNDLE = createRequire(import.meta.url).resolve('iwer/build/iwer.min.js');
@@ -46,17 +46,11 @@ const canvasPlace = () => page.evaluate(() => {
   return { width: c.width, height: c.height, parent: c.parentElement?.id };
 });
 
-/** A page of the tests' size that logs its errors. */
-async function newPage(): Promise<Page> {
-  const p = await browser.newPage({ viewport: { width: 900, height: 520 } });
-  p.on('pageerror', (e) => console.error('page error:', e.message));
-  return p;
-}
 
 beforeAll(async () => {
   server = await startServer();
   browser = await launchBrowser();
-  page = await newPage();
+  page = await newPage(browser);
   await page.addInitScript({ path: IWER_BUNDLE });
   await page.addInitScript(() => {
     const w = window as unknown as Emulated;
@@ -84,7 +78,7 @@ describe('the WebXR input, with an emulated headset tracking hands', () => {
     await waitState(page, 's.xr.supported.vr && s.xr.supported.ar');
     expect(await page.locator('#enter-vr').isVisible()).toBe(true);
     expect(await page.locator('#enter-ar').isVisible()).toBe(true);
-    const plain = await newPage();
+    const plain = await newPage(browser);
     try {
       await plain.goto(server.url);
       await waitState(plain, 's.connected');

@@ -62,7 +62,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let fps = measure(&viewers, period);
         let cpu_share = (server.cpu_ns() - cpu) as f64 / period.as_nanos() as f64;
         let page = get(a, "/")?;
-        rows.push(json!({ "viewers": n, "fps_median": quantile(&fps, 0.5), "fps_min": quantile(&fps, 0.0), "server_cpu": cpu_share, "server_rss_mib": server.rss_mib(), "page_status": page.0 }));
+        rows.push(json!({ "viewers": n, "fps_median": quantile(&fps, 0.5), "fps_min": quantile(&fps, 0.0), "server_cpu": cpu_share, "server_rss_mib": server.rss_mib(), "page_status": page }));
         stop(viewers);
     }
     report.insert("viewers".into(), rows.into());
@@ -87,7 +87,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let page = get(a, "/")?;
     report.insert(
         "malformed_flood".into(),
-        json!({ "sent": bad, "errors_answered": answered.load(Ordering::Relaxed), "watcher_fps": watcher_fps, "page_status_after": page.0 }),
+        json!({ "sent": bad, "errors_answered": answered.load(Ordering::Relaxed), "watcher_fps": watcher_fps, "page_status_after": page }),
     );
     drop(flood);
     stop(vec![watcher]);
@@ -109,7 +109,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let dripping = drippers.join().unwrap_or(0);
     report.insert(
         "slowloris".into(),
-        json!({ "sockets": dripping, "page_status": page.0, "page_ms": page_ms, "new_viewer_first_frame_ms": viewer_ms, "streaming_fps": fps[0] }),
+        json!({ "sockets": dripping, "page_status": page, "page_ms": page_ms, "new_viewer_first_frame_ms": viewer_ms, "streaming_fps": fps[0] }),
     );
     stop(vec![streaming, newcomer]);
 
@@ -343,14 +343,12 @@ fn closed_by_peer(stream: &mut TcpStream) -> bool {
     }
 }
 
-/// A plain GET: the status and how it went.
-fn get(a: SocketAddr, path: &str) -> anyhow::Result<(u16, String)> {
+/// A plain GET: the response's status.
+fn get(a: SocketAddr, path: &str) -> anyhow::Result<u16> {
     let mut s = TcpStream::connect(a)?;
     s.set_read_timeout(Some(Duration::from_secs(10)))?;
     s.write_all(format!("GET {path} HTTP/1.1\r\nHost: {a}\r\nConnection: close\r\n\r\n").as_bytes())?;
     let mut response = Vec::new();
     let _ = s.read_to_end(&mut response);
-    let text = String::from_utf8_lossy(&response).into_owned();
-    let status = text.split_whitespace().nth(1).and_then(|c| c.parse().ok()).unwrap_or(0);
-    Ok((status, text))
+    Ok(String::from_utf8_lossy(&response).split_whitespace().nth(1).and_then(|c| c.parse().ok()).unwrap_or(0))
 }

@@ -237,20 +237,20 @@ fn run<const W: usize, B: Blend<W>, const L: usize, const NORMALS: bool, const I
     }
 }
 
-/// The influence slots of `L` vertices: joints, weights and sign indices per vertex.
+/// The influence slots of one chunk: joints, weights and sign indices per vertex.
 #[derive(Clone, Copy)]
-pub(crate) struct Slots<'a, const K: usize, const L: usize> {
-    js: &'a [[u16; K]; L],
-    ws: &'a [[f32; K]; L],
-    ps: &'a [[u32; K]; L],
+pub(crate) struct Slots<'a, const K: usize> {
+    js: &'a [[u16; K]; LANES],
+    ws: &'a [[f32; K]; LANES],
+    ps: &'a [[u32; K]; LANES],
 }
 
-impl<'a, const K: usize, const L: usize> Slots<'a, K, L> {
-    /// The slots of mesh vertices `base..base + L`.
+impl<'a, const K: usize> Slots<'a, K> {
+    /// The slots of mesh vertices `base..base + LANES`.
     #[inline(always)]
     fn of(mesh: &'a SkinnedMesh, base: usize) -> Self {
         let (js, ws, ps) = (mesh.joints.as_chunks::<K>().0, mesh.weights.as_chunks::<K>().0, mesh.slot_pairs.as_chunks::<K>().0);
-        Self { js: js[base..base + L].try_into().unwrap(), ws: ws[base..base + L].try_into().unwrap(), ps: ps[base..base + L].try_into().unwrap() }
+        Self { js: js[base..base + LANES].try_into().unwrap(), ws: ws[base..base + LANES].try_into().unwrap(), ps: ps[base..base + LANES].try_into().unwrap() }
     }
 }
 
@@ -261,7 +261,7 @@ impl<'a, const K: usize, const L: usize> Slots<'a, K, L> {
 /// Per vertex the influences are summed as whole contiguous parameter rows, then the chunk
 /// is transposed to one array per component.
 #[inline(always)]
-fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K, LANES>, b: &mut [[f32; LANES]; W]) {
+fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K>, b: &mut [[f32; LANES]; W]) {
     #[cfg(target_arch = "x86_64")]
     if ISA != PORTABLE {
         // SAFETY: `ISA` is AVX2 or AVX512 only inside `deform_avx2` or `deform_avx512`,
@@ -332,7 +332,7 @@ mod avx2 {
     pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         frame: &Frame<'_, W>,
         kc: usize,
-        slots: Slots<'_, K, LANES>,
+        slots: Slots<'_, K>,
         b: &mut [[f32; LANES]; W],
     ) {
         const { assert!(W == 8 || W == 16) };
