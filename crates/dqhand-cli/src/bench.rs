@@ -13,7 +13,7 @@ use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::Sequence;
 use dqhand::kinematics::{JointModel, Pose, Transform};
 use dqhand::model::Model;
-use dqhand::skin::{Deformed, Deformer, Kernel, Method};
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method};
 use glam::Quat;
 use serde_json::json;
 
@@ -50,6 +50,15 @@ struct Variant {
     samples: Vec<f64>,
 }
 
+impl Variant {
+    /// Deforms one frame and returns the µs it took.
+    fn time(&mut self, mesh: &dqhand::skin::SkinnedMesh, skinning: &[glam::Affine3A]) -> f64 {
+        let t = Instant::now();
+        self.deformer.deform(mesh, skinning, &mut self.out);
+        t.elapsed().as_secs_f64() * 1e6
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.frames > 0, "--frames must be at least 1");
     let model = args.mesh.load()?;
@@ -68,13 +77,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let best = Kernel::best();
     let kernels: Vec<Kernel> = Kernel::ALL.into_iter().filter(|k| k.available()).collect();
     let mut variants = Vec::new();
-    // One pool per thread count, shared by its variants, as an application would keep one.
-    let pools: Vec<(usize, Arc<rayon::ThreadPool>)> =
-        threads.iter().map(|&t| Ok((t, Arc::new(rayon::ThreadPoolBuilder::new().num_threads(t).build()?)))).collect::<anyhow::Result<_>>()?;
+    // One crew per thread count, shared by its variants, as an application would keep one.
+    let crews: Vec<(usize, Arc<Crew>)> = threads.iter().map(|&t| Ok((t, Arc::new(Crew::new(t, Crew::SPIN)?)))).collect::<anyhow::Result<_>>()?;
     let mut add = |method, kernel, threads: usize, normals| {
         let mut deformer = Deformer::new(method, mesh).with_kernel(kernel);
-        if let Some((_, pool)) = pools.iter().find(|(t, _)| *t == threads) {
-            deformer = deformer.with_pool(Arc::clone(pool));
+        if let Some((_, crew)) = crews.iter().find(|(t, _)| *t == threads) {
+            deformer = deformer.with_crew(Arc::clone(crew));
         }
         let out = if normals { Deformed::new(mesh) } else { Deformed::positions_only(mesh) };
         variants.push(Variant { method, kernel, threads, normals, deformer, out, samples: Vec::with_capacity(args.frames) });
@@ -92,11 +100,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     let mut animation = Animation::new(model.clone());
-    // Warm-up: caches, branch predictors, CPU frequency, the pools' threads.
+    // Warm-up: caches, branch predictors, CPU frequency, the crews' threads.
     for f in 0..100 {
         animation.pose(f);
         for v in &mut variants {
-            v.deformer.deform(mesh, animation.engine.skinning(), &mut v.out);
+            v.time(mesh, animation.engine.skinning());
         }
     }
     // Interleaved frame by frame, the order rotating: machine noise hits every variant alike.
@@ -105,9 +113,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         animation.pose(f);
         for k in 0..n {
             let v = &mut variants[(f + k) % n];
-            let t = Instant::now();
-            v.deformer.deform(mesh, animation.engine.skinning(), &mut v.out);
-            v.samples.push(t.elapsed().as_secs_f64() * 1e6);
+            let us = v.time(mesh, animation.engine.skinning());
+            v.samples.push(us);
             std::hint::black_box(v.out.positions());
         }
     }

@@ -8,8 +8,9 @@ use dqhand::geometry::vertex_normals;
 use dqhand::kinematics::{JointModel, Limits, PoseTarget};
 use dqhand::math::DualQuat;
 use std::sync::Arc;
+use std::time::Duration;
 
-use dqhand::skin::{Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, MIN_VERTICES_PER_THREAD};
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, MIN_VERTICES_PER_THREAD};
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 use proptest::prelude::*;
 use support::{rotation, vec3};
@@ -221,14 +222,16 @@ fn dqb_and_lb_normals_follow_a_smoothly_bent_surface() {
 }
 
 /// On the built-in hand (the reference tests use small random meshes): every kernel agrees
-/// with the portable one; a deformation split across threads, and a batch of poses, give
-/// exactly what one thread gives.
+/// with the portable one; a deformation split across a crew's threads (helpers parked or
+/// spinning), and a batch of poses, give exactly what one thread gives.
 #[test]
 fn kernels_threads_and_batches_agree_on_the_hand() {
     let (model, pinch) = posed_hand("pinch");
     let (_, fist) = posed_hand("fist");
     let mesh = &model.mesh;
-    let pool = Arc::new(rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap());
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+    // Helpers that park at once (woken per frame) and helpers that spin between frames.
+    let crews = [Duration::ZERO, Crew::SPIN].map(|spin| Arc::new(Crew::new(3, spin).unwrap()));
     assert!(mesh.vertex_count() >= 3 * MIN_VERTICES_PER_THREAD, "the hand is split three ways");
     for method in Method::ALL {
         let mut portable = Deformed::new(mesh);
@@ -238,15 +241,23 @@ fn kernels_threads_and_batches_agree_on_the_hand() {
             for (a, b) in single.positions().iter().zip(portable.positions()).chain(single.normals().iter().zip(portable.normals())) {
                 assert_close!(*a, *b, 1e-5);
             }
-            let split = deform_with(Deformer::new(method, mesh).with_kernel(kernel).with_pool(Arc::clone(&pool)), mesh, &pinch);
-            assert_eq!(split, single, "{method} on {kernel:?}: three threads");
-            let mut only = Deformed::positions_only(mesh);
-            Deformer::new(method, mesh).with_kernel(kernel).with_pool(Arc::clone(&pool)).deform(mesh, &pinch, &mut only);
-            assert_eq!(only.positions(), single.positions(), "{method} on {kernel:?}: positions only, three threads");
+            let fisted = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &fist);
+            for crew in &crews {
+                let mut split = Deformer::new(method, mesh).with_kernel(kernel).with_crew(Arc::clone(crew));
+                let mut out = Deformed::new(mesh);
+                // Two poses in turn: a piece left undone would keep the other pose.
+                for i in 0..20 {
+                    let (pose, expected) = if i % 2 == 0 { (&pinch, &single) } else { (&fist, &fisted) };
+                    split.deform(mesh, pose, &mut out);
+                    assert_eq!(&out, expected, "{method} on {kernel:?}: three threads, {crew:?}, frame {i}");
+                }
+                let mut only = Deformed::positions_only(mesh);
+                split.deform(mesh, &pinch, &mut only);
+                assert_eq!(only.positions(), single.positions(), "{method} on {kernel:?}: positions only, three threads");
+            }
             let poses: Vec<Affine3A> = [&pinch, &fist, &pinch].into_iter().flatten().copied().collect();
             let mut batch = vec![Deformed::new(mesh); 3];
             Deformer::new(method, mesh).with_kernel(kernel).deform_batch(&pool, mesh, &poses, &mut batch);
-            let fisted = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &fist);
             assert_eq!(batch, vec![single.clone(), fisted, single.clone()], "{method} on {kernel:?}: a batch");
         }
     }

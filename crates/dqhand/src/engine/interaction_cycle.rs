@@ -8,7 +8,7 @@ use glam::Affine3A;
 
 use crate::kinematics::{forward_kinematics, HandRig, JointModel, Limits, Pose, PoseTarget, Skeleton, Transform};
 use crate::model::Model;
-use crate::skin::{skinning_transforms, Deformed, Deformer, Kernel, Method, MethodSet};
+use crate::skin::{skinning_transforms, Crew, Deformed, Deformer, Kernel, Method, MethodSet};
 use crate::Result;
 
 /// The virtual hand's engine: a model, its kinematics and its skin, with every per-frame
@@ -111,9 +111,9 @@ impl Engine {
         self.deformers = self.deformers.clone().map(|d| d.with_kernel(kernel));
     }
 
-    /// Splits each deformation across `pool`'s threads (large meshes; see [`Deformer::with_pool`]).
-    pub fn use_pool(&mut self, pool: &Arc<rayon::ThreadPool>) {
-        self.deformers = self.deformers.clone().map(|d| d.with_pool(Arc::clone(pool)));
+    /// Splits each deformation across `crew`'s threads (see [`Deformer::with_crew`]).
+    pub fn use_crew(&mut self, crew: &Arc<Crew>) {
+        self.deformers = self.deformers.clone().map(|d| d.with_crew(Arc::clone(crew)));
     }
 
     /// The model.

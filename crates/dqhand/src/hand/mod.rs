@@ -127,7 +127,7 @@ pub fn build(params: &HandParams) -> Result<Model> {
         .iter()
         .map(|p| [0.5 + radial.x * p[0] / (1.2 * b), -p[2] / (1.1 * l)])
         .collect();
-    let data = MeshData {
+    let mut data = MeshData {
         positions: surface.positions,
         normals: surface.normals,
         uvs,
@@ -138,6 +138,7 @@ pub fn build(params: &HandParams) -> Result<Model> {
         parts: Vec::new(),
         inverse_bind: anatomy.frames.iter().map(Affine3A::inverse).collect(),
     };
+    data.sort_by_influence_count();
     let (mesh, warnings) = SkinnedMesh::new(data)?;
     Ok(Model {
         description: format!("anatomical {} hand, length {l} m, breadth {b} m, {vertices} vertices", side.name()),

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::crew::Crew;
 use super::kernel::{self, Frame, Kernel};
 use super::skinned_mesh::{SkinnedMesh, LANES};
 use super::Method;
@@ -52,7 +53,7 @@ impl Deformed {
 pub const MIN_VERTICES_PER_THREAD: usize = 2048;
 
 /// A skinning method with its per-frame scratch: bone parameters and the sign table; the
-/// kernel it runs and, optionally, a thread pool it splits each deformation across.
+/// kernel it runs and, optionally, a crew of threads it splits each deformation across.
 #[derive(Clone, Debug)]
 pub struct Deformer {
     method: Method,
@@ -60,7 +61,7 @@ pub struct Deformer {
     quat: Vec<[f32; dqb::W]>,
     signs: Vec<f32>,
     kernel: Kernel,
-    pool: Option<Arc<rayon::ThreadPool>>,
+    crew: Option<Arc<Crew>>,
 }
 
 impl Deformer {
@@ -70,7 +71,7 @@ impl Deformer {
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
         let joints = mesh.inverse_bind().len();
         let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
-        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], kernel: Kernel::best(), pool: None }
+        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], kernel: Kernel::best(), crew: None }
     }
 
     /// The same deformer on `kernel` (one this CPU does not run falls back to the best it
@@ -80,12 +81,12 @@ impl Deformer {
         Self { kernel, ..self }
     }
 
-    /// The same deformer splitting each deformation across `pool`'s threads (made once and
-    /// kept: no thread is started per frame), for meshes of at least
+    /// The same deformer splitting each deformation across `crew`'s threads (started once:
+    /// no thread is started per frame), the calling thread included, for meshes of at least
     /// [`MIN_VERTICES_PER_THREAD`] vertices per thread.
     #[must_use]
-    pub fn with_pool(self, pool: Arc<rayon::ThreadPool>) -> Self {
-        Self { pool: Some(pool), ..self }
+    pub fn with_crew(self, crew: Arc<Crew>) -> Self {
+        Self { crew: Some(crew), ..self }
     }
 
     /// The method.
@@ -106,7 +107,7 @@ impl Deformer {
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
     /// and translation, or dual quaternion), and for the quaternion methods one sign per pair
     /// of joints that share a vertex, aligning the other joint's rotation to the hemisphere
-    /// of the heaviest one. Steps 2–6: every vertex is blended, split across the pool's
+    /// of the heaviest one. Steps 2–6: every vertex is blended, split across the crew's
     /// threads if there is one. Allocates nothing.
     ///
     /// * `skinning` — #joints transforms `world · inverse_bind`, from [`skinning_transforms`].
@@ -137,23 +138,43 @@ impl Deformer {
                 }
             }
         }
-        let threads = self.pool.as_ref().map_or(1, |p| p.current_num_threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);
-        let (positions, normals) = (&mut out.positions[..], &mut out.normals[..]);
-        match &self.pool {
-            Some(pool) if threads > 1 => {
-                // Whole chunks per thread, an even number so the AVX-512 loop keeps its pairs.
-                let span = (positions.len() / LANES).div_ceil(threads).next_multiple_of(2) * LANES;
-                let this = &*self;
-                pool.install(|| {
-                    if normals.is_empty() {
-                        positions.par_chunks_mut(span).enumerate().for_each(|(i, p)| this.run(mesh, i * span / LANES, p, &mut []));
-                    } else {
-                        positions.par_chunks_mut(span).zip(normals.par_chunks_mut(span)).enumerate().for_each(|(i, (p, n))| this.run(mesh, i * span / LANES, p, n));
-                    }
-                });
-            }
-            _ => self.run(mesh, 0, positions, normals),
+        let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);
+        match &self.crew {
+            Some(crew) if threads > 1 => self.split(crew, threads, mesh, out),
+            _ => self.run(mesh, 0, &mut out.positions, &mut out.normals),
         }
+    }
+
+    /// The vertex loop split into pieces claimed by `crew`'s threads: whole chunks per piece,
+    /// an even number so the AVX-512 loop keeps its blocks, four pieces per thread so a
+    /// helper that joins late still takes its share.
+    fn split(&self, crew: &Crew, threads: usize, mesh: &SkinnedMesh, out: &mut Deformed) {
+        /// The output buffers, written piece by piece from several threads.
+        struct Outputs {
+            positions: *mut [f32; 3],
+            normals: *mut [f32; 3],
+            len: usize,
+            with_normals: bool,
+        }
+        // SAFETY: the threads write disjoint pieces (below).
+        unsafe impl Sync for Outputs {}
+        let len = out.positions.len();
+        let span = (len / LANES).div_ceil(4 * threads).next_multiple_of(2) * LANES;
+        let o = Outputs { positions: out.positions.as_mut_ptr(), normals: out.normals.as_mut_ptr(), len, with_normals: !out.normals.is_empty() };
+        let o = &o; // The whole struct, not its (non-Sync) fields, is captured.
+        crew.run(len.div_ceil(span), &|i| {
+            let (start, end) = (i * span, ((i + 1) * span).min(o.len));
+            // SAFETY: the crew runs each piece once, pieces are disjoint ranges within the
+            // buffers (normals as long as positions, or unused), and `out` is borrowed
+            // mutably until `run` returns, after every piece.
+            let (p, n) = unsafe {
+                (
+                    core::slice::from_raw_parts_mut(o.positions.add(start), end - start),
+                    if o.with_normals { core::slice::from_raw_parts_mut(o.normals.add(start), end - start) } else { &mut [] },
+                )
+            };
+            self.run(mesh, start / LANES, p, n);
+        });
     }
 
     /// The vertex loop over the chunks from `first` that `positions` holds.
@@ -176,7 +197,7 @@ impl Deformer {
     pub fn deform_batch(&self, pool: &rayon::ThreadPool, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut [Deformed]) {
         let joints = mesh.inverse_bind().len();
         assert_eq!(skinning.len(), joints * out.len(), "one pose's transforms per output");
-        let single = Self { pool: None, ..self.clone() };
+        let single = Self { crew: None, ..self.clone() };
         pool.install(|| {
             out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
         });

@@ -10,7 +10,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{recip, rotate, Blend, Chunk};
+use super::kernel::{cross, dot, mad, recip, rotate, Blend, Chunk};
 use crate::math::DualQuat;
 
 /// Blend parameters: real part `(x, y, z, w)`, then dual part.
@@ -25,27 +25,25 @@ pub(crate) struct Dqb;
 
 impl Blend<W> for Dqb {
     const SIGNED: usize = W;
+    const USED: usize = W;
 
     #[inline(always)]
-    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+    fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
         for l in 0..L {
-            let (x, y, z, a0) = (b[0][l], b[1][l], b[2][l], b[3][l]);
-            let (ex, ey, ez, ae) = (b[4][l], b[5][l], b[6][l], b[7][l]);
+            let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
+            let (d0, a0) = ([q[0], q[1], q[2]], q[3]);
+            let (de, ae) = ([b[4][l], b[5][l], b[6][l]], b[7][l]);
             // Eq. (5) is quadratic in b̂, so dividing once by ‖b₀‖² normalises it exactly.
-            let inv_sq = recip(x * x + y * y + z * z + a0 * a0);
+            let inv_sq = recip(dot::<ISA, 4>(q, q));
             let k = 2.0 * inv_sq;
             // Eq. (5): translation 2(a₀ d_ε − a_ε d₀ + d₀ × d_ε).
-            let t = [
-                k * (a0 * ex - ae * x + (y * ez - z * ey)),
-                k * (a0 * ey - ae * y + (z * ex - x * ez)),
-                k * (a0 * ez - ae * z + (x * ey - y * ex)),
-            ];
-            let p = rotate([x, y, z, a0], inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let c = cross::<ISA>(d0, de);
+            let p = rotate::<ISA>(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
             for i in 0..3 {
-                out.p[i][l] = p[i] + t[i];
+                out.p[i][l] = mad::<ISA>(k, mad::<ISA>(a0, de[i], mad::<ISA>(-ae, d0[i], c[i])), p[i]);
             }
             if NORMALS {
-                let n = rotate([x, y, z, a0], inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+                let n = rotate::<ISA>(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
                 for i in 0..3 {
                     out.n[i][l] = n[i];
                 }

@@ -11,7 +11,7 @@
 //! (two of the mesh's 8-vertex chunks), two vertices per 512-bit register in the blend and
 //! 16 lanes per register in the finish.
 
-use super::skinned_mesh::{SkinnedMesh, LANES};
+use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
 
 /// Which compiled vertex loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -65,7 +65,7 @@ impl Kernel {
 }
 
 /// The instruction set a loop is compiled for (a const parameter: one copy per set).
-const PORTABLE: u8 = 0;
+pub(crate) const PORTABLE: u8 = 0;
 const AVX2: u8 = 1;
 const AVX512: u8 = 2;
 
@@ -90,9 +90,13 @@ pub(crate) trait Blend<const W: usize> {
     /// is; DQB aligns the whole dual quaternion (8), whose dual part changes sign with the
     /// real part; LB aligns nothing (0).
     const SIGNED: usize;
+    /// How many leading parameters `finish` reads (the rest is padding the AVX-512 blend
+    /// skips): LB 12, QB 7, DQB 8.
+    const USED: usize;
     /// Finishes a chunk of `L` vertices from the blended parameters `b[component][lane]`:
-    /// positions, and normals when `NORMALS` (else `out.n` is left alone).
-    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>);
+    /// positions, and normals when `NORMALS` (else `out.n` is left alone); products summed
+    /// by [`mad`] for instruction set `ISA`.
+    fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>);
 }
 
 /// Per-frame inputs of the vertex loop.
@@ -169,19 +173,13 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
     let mut c = 0;
     #[cfg(target_arch = "x86_64")]
     if ISA == AVX512 {
-        // Blocks of the slot-major weights start at even chunks (the threads' spans are even).
-        assert!(first % 2 == 0, "an AVX-512 run starts at a block");
-        let mut b = [[0.0f32; 2 * LANES]; W];
-        let (mut rest, mut out) = (Chunk::new(), Chunk::new());
-        while c + 2 <= count {
-            let chunk = first + c;
-            let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
-            // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature
-            // detection; lookups are in bounds (above).
-            unsafe { avx512::blend::<W, K, B>(frame, mesh, chunk / 2, usize::from(kc), &mut b) };
-            run::<W, B, { 2 * LANES }, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
-            c += 2;
-        }
+        // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature detection.
+        c = unsafe {
+            match avx512::Table::new(frame.params) {
+                Some(table) => blocks::<W, K, B, NORMALS>(&table, mesh, first, positions, normals),
+                None => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, first, positions, normals),
+            }
+        };
     }
     let mut b = [[0.0f32; LANES]; W];
     let (mut rest, mut out) = (Chunk::new(), Chunk::new());
@@ -192,6 +190,34 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
         run::<W, B, LANES, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 1;
     }
+}
+
+/// The AVX-512 part of `chunks`: as many whole blocks of [`BLOCK`] vertices as the outputs
+/// hold, from chunk `first`; returns the chunks done.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: bool>(
+    lookup: &impl avx512::Lookup<W>,
+    mesh: &SkinnedMesh,
+    first: usize,
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+) -> usize {
+    // Blocks of the slot-major arrays start at even chunks (the threads' spans are even).
+    assert!(first % 2 == 0, "an AVX-512 run starts at a block");
+    let count = positions.len() / LANES;
+    let mut b = [[0.0f32; BLOCK]; W];
+    let (mut rest, mut out) = (Chunk::new(), Chunk::new());
+    let mut c = 0;
+    while c + 2 <= count {
+        let chunk = first + c;
+        let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
+        // SAFETY: joint indices are below the parameter rows (asserted in `chunks`).
+        avx512::blend::<W, K, B>(lookup, mesh, chunk / 2, usize::from(kc), &mut b);
+        run::<W, B, BLOCK, NORMALS, AVX512>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        c += 2;
+    }
+    c
 }
 
 /// Finishes `L` vertices from mesh vertex `base` and writes them at `at` of the outputs.
@@ -214,7 +240,7 @@ fn run<const W: usize, B: Blend<W>, const L: usize, const NORMALS: bool, const I
             rest.n[c] = lanes(&mesh.nrm[c]);
         }
     }
-    B::finish::<L, NORMALS>(b, rest, out);
+    B::finish::<L, NORMALS, ISA>(b, rest, out);
     #[cfg(target_arch = "x86_64")]
     if ISA == AVX512 && L == 2 * LANES {
         // SAFETY: `ISA` is AVX512 only inside `deform_avx512`; each output holds `at + L`
@@ -290,19 +316,37 @@ fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Fra
     }
 }
 
+/// `a·b + c` in one fused instruction on the SIMD kernels (both have FMA: one rounding, half
+/// the instructions of the finish's sums of products); plain on the portable one, where a
+/// fused multiply-add without the instruction would be a library call per lane.
+#[inline(always)]
+pub(crate) fn mad<const ISA: u8>(a: f32, b: f32, c: f32) -> f32 {
+    if ISA == PORTABLE { a * b + c } else { a.mul_add(b, c) }
+}
+
+/// `a · b`, by [`mad`].
+#[inline(always)]
+pub(crate) fn dot<const ISA: u8, const N: usize>(a: [f32; N], b: [f32; N]) -> f32 {
+    (1..N).fold(a[0] * b[0], |s, i| mad::<ISA>(a[i], b[i], s))
+}
+
+/// `a × b`, by [`mad`].
+#[inline(always)]
+pub(crate) fn cross<const ISA: u8>(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [mad::<ISA>(a[1], b[2], -a[2] * b[1]), mad::<ISA>(a[2], b[0], -a[0] * b[2]), mad::<ISA>(a[0], b[1], -a[1] * b[0])]
+}
+
 /// Rotates `v` by the quaternion `q = (x, y, z, w)` of squared norm `1 / inv_sq`, lane-wise:
 /// `v + 2 d × (d × v + w v) / ‖q‖²` — the rotation part of paper eq. (5) and all of eq. (6)
 /// for the normalised `q / ‖q‖`, without a square root.
 #[inline(always)]
-pub(crate) fn rotate(q: [f32; 4], inv_sq: f32, v: [f32; 3]) -> [f32; 3] {
-    let [x, y, z, w] = q;
-    let c1 = [y * v[2] - z * v[1] + w * v[0], z * v[0] - x * v[2] + w * v[1], x * v[1] - y * v[0] + w * v[2]];
+pub(crate) fn rotate<const ISA: u8>(q: [f32; 4], inv_sq: f32, v: [f32; 3]) -> [f32; 3] {
+    let d = [q[0], q[1], q[2]];
+    let c = cross::<ISA>(d, v);
+    let c1 = [0, 1, 2].map(|i| mad::<ISA>(q[3], v[i], c[i]));
+    let c2 = cross::<ISA>(d, c1);
     let k = 2.0 * inv_sq;
-    [
-        v[0] + k * (y * c1[2] - z * c1[1]),
-        v[1] + k * (z * c1[0] - x * c1[2]),
-        v[2] + k * (x * c1[1] - y * c1[0]),
-    ]
+    [0, 1, 2].map(|i| mad::<ISA>(k, c2[i], v[i]))
 }
 
 /// `1 / x` with a floor that keeps a degenerate (all-cancelling) blend finite.
@@ -406,93 +450,126 @@ mod avx2 {
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    //! The blend step with AVX-512 for 16 vertices: vertex `l` in the low half of a 512-bit
-    //! register and vertex `l + 8` in the high half, so one fused multiply-add per influence
-    //! serves two vertices; then the AVX2 8×8 transpose done in both halves at once, and a
-    //! two-source permute that puts each component's 16 lanes in vertex order.
+    //! The blend step with AVX-512, one vertex per lane from the start: per influence slot
+    //! the block's 16 joint indices and weights come in one load each, each parameter
+    //! component of the 16 joints is looked up at once — from two registers by a two-source
+    //! permute when the skin has at most 32 joints (a hand has 16 to 26), else by a gather —
+    //! and one fused multiply-add per component blends it. The sum is already one register
+    //! per component, as the finish wants it: no transpose.
 
     use core::arch::x86_64::*;
 
-    use super::{Blend, Frame, SkinnedMesh, LANES};
+    use super::{Blend, SkinnedMesh, BLOCK};
 
-    /// As the portable `blend`, for the 16 vertices of block `block` and `W` = 8 or 16.
-    /// A slot's 16 weights (and signs) come in one load (and one gather) from the mesh's
-    /// slot-major block arrays; each register pair of vertices then takes its two weights by
-    /// a permute.
-    /// Inlined into `deform_avx512`, whose features it uses (a call per block would spill
-    /// the accumulators).
-    #[inline(always)]
-    pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
-        frame: &Frame<'_, W>,
-        mesh: &SkinnedMesh,
-        block: usize,
-        kc: usize,
-        b: &mut [[f32; 2 * LANES]; W],
-    ) {
-        const { assert!(W == 8 || W == 16) };
-        let js: &[[u16; K]; 2 * LANES] = mesh.joints.as_chunks::<K>().0[block * 2 * LANES..][..2 * LANES].try_into().unwrap();
-        let slot = |k: usize| (block * K + k) * 2 * LANES;
-        let (weights, signs) = (mesh.block_weights.as_ptr(), mesh.block_signs.as_ptr());
-        let signed = B::SIGNED;
-        let mut rows = [[_mm512_setzero_ps(); LANES]; 2];
-        // The lanes of each block of eight parameters that take the signed weight, in both halves.
-        let mask = |blk: usize| {
-            let first = (signed as i32 - 8 * blk as i32).clamp(0, 8) as u32;
-            let half = ((1u32 << first) - 1) as u16;
-            half | (half << 8)
-        };
-        let masks = [mask(0), mask(1)];
-        for k in 0..kc.min(K) {
-            let w16 = _mm512_loadu_ps(weights.add(slot(k)));
-            // Slot 0 is the heaviest joint itself, whose sign is always +1.
-            let sw16 = if signed > 0 && k > 0 {
-                let index = _mm512_loadu_si512(signs.add(slot(k)).cast());
-                _mm512_mul_ps(w16, _mm512_i32gather_ps::<4>(index, frame.signs.as_ptr()))
-            } else {
-                w16
-            };
-            for l in 0..LANES {
-                let spread = _mm512_loadu_si512(PAIRS[l].as_ptr().cast());
-                let w = _mm512_permutexvar_ps(spread, w16);
-                let sw = if signed > 0 && k > 0 { _mm512_permutexvar_ps(spread, sw16) } else { w };
-                let pa = frame.params.get_unchecked(usize::from(js[l][k])).as_ptr();
-                let pz = frame.params.get_unchecked(usize::from(js[l + LANES][k])).as_ptr();
-                for (blk, r) in rows.iter_mut().enumerate().take(W / 8) {
-                    let wv = if signed >= 8 * (blk + 1) {
-                        sw
-                    } else if signed <= 8 * blk {
-                        w
-                    } else {
-                        _mm512_mask_blend_ps(masks[blk], w, sw)
-                    };
-                    let p = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(_mm256_loadu_ps(pa.add(8 * blk))), _mm256_loadu_ps(pz.add(8 * blk)));
-                    r[l] = _mm512_fmadd_ps(wv, p, r[l]);
+    /// Joints a [`Table`] holds: the 32 lanes of a two-source permute.
+    const TABLE_JOINTS: usize = 32;
+
+    /// How the blend finds a component of the 16 lanes' joints' parameters.
+    pub(super) trait Lookup<const W: usize> {
+        /// Per-slot work on the lanes' joint indices, done once for all components.
+        unsafe fn offsets(&self, joints: __m512i) -> __m512i;
+        /// Component `c` of the parameters at `offsets`.
+        unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512;
+    }
+
+    /// The per-frame parameters component-major in two registers' worth per component,
+    /// `rows[c][j]` = parameter `c` of joint `j`: one two-source permute looks a component up
+    /// for 16 lanes, from registers or L1. For skins of at most [`TABLE_JOINTS`] joints.
+    pub(super) struct Table<const W: usize> {
+        rows: [[f32; TABLE_JOINTS]; W],
+    }
+
+    impl<const W: usize> Table<W> {
+        /// The table of `params`, if there are at most [`TABLE_JOINTS`] joints.
+        pub(super) fn new(params: &[[f32; W]]) -> Option<Self> {
+            if params.len() > TABLE_JOINTS {
+                return None;
+            }
+            let mut rows = [[0.0; TABLE_JOINTS]; W];
+            for (j, p) in params.iter().enumerate() {
+                for (c, row) in rows.iter_mut().enumerate() {
+                    row[j] = p[c];
                 }
             }
-        }
-        for (blk, r) in rows.iter().enumerate().take(W / 8) {
-            let t = transpose(r);
-            for (c, v) in t.iter().enumerate() {
-                _mm512_storeu_ps(b[8 * blk + c].as_mut_ptr(), *v);
-            }
+            Some(Self { rows })
         }
     }
 
-    /// Per register row `l`: lane indices that spread vertex `l`'s value over the low half
-    /// and vertex `l + 8`'s over the high half.
-    const PAIRS: [[i32; 16]; LANES] = {
-        let mut idx = [[0; 16]; LANES];
-        let mut l = 0;
-        while l < LANES {
-            let mut j = 0;
-            while j < 16 {
-                idx[l][j] = (l + if j < 8 { 0 } else { LANES }) as i32;
-                j += 1;
-            }
-            l += 1;
+    impl<const W: usize> Lookup<W> for Table<W> {
+        #[inline(always)]
+        unsafe fn offsets(&self, joints: __m512i) -> __m512i {
+            joints
         }
-        idx
-    };
+
+        #[inline(always)]
+        unsafe fn get(&self, joints: __m512i, c: usize) -> __m512 {
+            let row = self.rows[c].as_ptr();
+            _mm512_permutex2var_ps(_mm512_loadu_ps(row), joints, _mm512_loadu_ps(row.add(16)))
+        }
+    }
+
+    /// Any number of joints: each component gathered from the parameter rows.
+    pub(super) struct Gather<'a, const W: usize>(pub &'a [[f32; W]]);
+
+    impl<const W: usize> Lookup<W> for Gather<'_, W> {
+        #[inline(always)]
+        unsafe fn offsets(&self, joints: __m512i) -> __m512i {
+            _mm512_mullo_epi32(joints, _mm512_set1_epi32(W as i32))
+        }
+
+        #[inline(always)]
+        unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512 {
+            _mm512_i32gather_ps::<4>(_mm512_add_epi32(offsets, _mm512_set1_epi32(c as i32)), self.0.as_ptr().cast())
+        }
+    }
+
+    /// As the portable `blend`, for the 16 vertices of block `block`. The sign of each
+    /// influence is found in the lanes, from the dot product of its rotation with the
+    /// heaviest influence's: the rule of the frame's pair signs, without their table.
+    /// Inlined into `deform_avx512`, whose features it uses.
+    #[inline(always)]
+    pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
+        lookup: &impl Lookup<W>,
+        mesh: &SkinnedMesh,
+        block: usize,
+        kc: usize,
+        b: &mut [[f32; BLOCK]; W],
+    ) {
+        let slot = |k: usize| (block * K + k) * BLOCK;
+        let zero = _mm512_setzero_ps();
+        let mut acc = [zero; W];
+        let mut heaviest = [zero; 4];
+        for k in 0..kc.min(K) {
+            let joints = _mm512_cvtepu16_epi32(_mm256_loadu_si256(mesh.block_joints.as_ptr().add(slot(k)).cast()));
+            let w = _mm512_loadu_ps(mesh.block_weights.as_ptr().add(slot(k)));
+            let offsets = lookup.offsets(joints);
+            // Plain loops, not closures: a closure would not inherit the function's features,
+            // and its intrinsics would become calls.
+            let mut v = [zero; W];
+            for (c, v) in v.iter_mut().enumerate().take(B::USED) {
+                *v = lookup.get(offsets, c);
+            }
+            let sw = if B::SIGNED == 0 {
+                w
+            } else if k == 0 {
+                // Slot 0 is the heaviest joint itself, whose sign is always +1.
+                heaviest = [v[0], v[1], v[2], v[3]];
+                w
+            } else {
+                let mut dot = zero;
+                for c in 0..4 {
+                    dot = _mm512_fmadd_ps(heaviest[c], v[c], dot);
+                }
+                _mm512_mask_sub_ps(w, _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dot, zero), zero, w)
+            };
+            for c in 0..B::USED {
+                acc[c] = _mm512_fmadd_ps(if c < B::SIGNED { sw } else { w }, v[c], acc[c]);
+            }
+        }
+        for c in 0..B::USED {
+            _mm512_storeu_ps(b[c].as_mut_ptr(), acc[c]);
+        }
+    }
 
     /// The permutes that interleave 16 lanes of x, y and z into 48 floats `x₀ y₀ z₀ x₁ …`:
     /// per output register `k`, first x and y into place (`XY`), then z (`Z`).
@@ -531,41 +608,5 @@ mod avx512 {
             let xy = _mm512_permutex2var_ps(x, _mm512_loadu_si512(XY[k].as_ptr().cast()), y);
             _mm512_storeu_ps(dst.add(16 * k), _mm512_permutex2var_ps(xy, _mm512_loadu_si512(Z[k].as_ptr().cast()), z));
         }
-    }
-
-    /// Row `l` holds vertices `l` and `l + 8` (components 0..8 in each half); output `c` holds
-    /// component `c` of vertices 0..16 in order. The unpacks and shuffles work within 128-bit
-    /// lanes, as in the AVX2 transpose; the last step picks 128-bit lanes from two sources.
-    #[inline(always)]
-    unsafe fn transpose(r: &[__m512; 8]) -> [__m512; 8] {
-        let t0 = _mm512_unpacklo_ps(r[0], r[1]);
-        let t1 = _mm512_unpackhi_ps(r[0], r[1]);
-        let t2 = _mm512_unpacklo_ps(r[2], r[3]);
-        let t3 = _mm512_unpackhi_ps(r[2], r[3]);
-        let t4 = _mm512_unpacklo_ps(r[4], r[5]);
-        let t5 = _mm512_unpackhi_ps(r[4], r[5]);
-        let t6 = _mm512_unpacklo_ps(r[6], r[7]);
-        let t7 = _mm512_unpackhi_ps(r[6], r[7]);
-        let s0 = _mm512_shuffle_ps::<0x44>(t0, t2);
-        let s1 = _mm512_shuffle_ps::<0xEE>(t0, t2);
-        let s2 = _mm512_shuffle_ps::<0x44>(t1, t3);
-        let s3 = _mm512_shuffle_ps::<0xEE>(t1, t3);
-        let s4 = _mm512_shuffle_ps::<0x44>(t4, t6);
-        let s5 = _mm512_shuffle_ps::<0xEE>(t4, t6);
-        let s6 = _mm512_shuffle_ps::<0x44>(t5, t7);
-        let s7 = _mm512_shuffle_ps::<0xEE>(t5, t7);
-        // 128-bit lanes 0 and 2 (components 0–3 of vertices 0–3 and 8–11) with the other's.
-        let low = _mm512_setr_epi32(0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27);
-        let high = _mm512_setr_epi32(4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31);
-        [
-            _mm512_permutex2var_ps(s0, low, s4),
-            _mm512_permutex2var_ps(s1, low, s5),
-            _mm512_permutex2var_ps(s2, low, s6),
-            _mm512_permutex2var_ps(s3, low, s7),
-            _mm512_permutex2var_ps(s0, high, s4),
-            _mm512_permutex2var_ps(s1, high, s5),
-            _mm512_permutex2var_ps(s2, high, s6),
-            _mm512_permutex2var_ps(s3, high, s7),
-        ]
     }
 }

@@ -5,7 +5,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{inv_len, Blend, Chunk};
+use super::kernel::{cross, dot, inv_len, Blend, Chunk};
 
 /// Blend parameters: the rows of the 3×4 matrix `[R | t]`, padded to two blocks of eight.
 pub(crate) const W: usize = 16;
@@ -20,28 +20,27 @@ pub(crate) struct Lb;
 
 impl Blend<W> for Lb {
     const SIGNED: usize = 0;
+    const USED: usize = 12;
 
     /// Positions by the blended matrix; normals by its cofactor matrix (the inverse transpose
     /// up to the determinant), whose rows are cross products of the other two rows.
     #[inline(always)]
-    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+    fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
         for l in 0..L {
             let r = [[b[0][l], b[1][l], b[2][l]], [b[4][l], b[5][l], b[6][l]], [b[8][l], b[9][l], b[10][l]]];
             let t = [b[3][l], b[7][l], b[11][l]];
             let p = [rest.p[0][l], rest.p[1][l], rest.p[2][l]];
             for i in 0..3 {
-                out.p[i][l] = r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2] + t[i];
+                out.p[i][l] = dot::<ISA, 4>([r[i][0], r[i][1], r[i][2], t[i]], [p[0], p[1], p[2], 1.0]);
             }
             if !NORMALS {
                 continue;
             }
             let n = [rest.n[0][l], rest.n[1][l], rest.n[2][l]];
-            let cross = |a: [f32; 3], b: [f32; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-            let cof = [cross(r[1], r[2]), cross(r[2], r[0]), cross(r[0], r[1])];
-            let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            let m = [dot(cof[0], n), dot(cof[1], n), dot(cof[2], n)];
+            let cof = [cross::<ISA>(r[1], r[2]), cross::<ISA>(r[2], r[0]), cross::<ISA>(r[0], r[1])];
+            let m = cof.map(|c| dot::<ISA, 3>(c, n));
             // A mirroring blend (negative determinant) would turn the normal inside out.
-            let s = inv_len(dot(m, m)).copysign(dot(r[0], cof[0]));
+            let s = inv_len(dot::<ISA, 3>(m, m)).copysign(dot::<ISA, 3>(r[0], cof[0]));
             for i in 0..3 {
                 out.n[i][l] = m[i] * s;
             }

@@ -1,5 +1,6 @@
 //! Skin layer (paper 4.1, 4.4): the skinned mesh and the LB, QB and DQB deformers.
 
+mod crew;
 mod deformer;
 mod dual_quaternion_blend;
 mod kernel;
@@ -9,6 +10,7 @@ mod method_set;
 mod quaternion_blend;
 mod skinned_mesh;
 
+pub use crew::Crew;
 pub use deformer::{skinning_transforms, Deformed, Deformer, MIN_VERTICES_PER_THREAD};
 pub use kernel::Kernel;
 pub use method::Method;

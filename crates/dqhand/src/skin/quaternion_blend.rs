@@ -6,7 +6,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{recip, rotate, Blend, Chunk};
+use super::kernel::{dot, recip, rotate, Blend, Chunk};
 
 /// Blend parameters: the rotation `(x, y, z, w)`, then the translation and a zero.
 pub(crate) const W: usize = 8;
@@ -22,18 +22,19 @@ pub(crate) struct Qb;
 
 impl Blend<W> for Qb {
     const SIGNED: usize = 4;
+    const USED: usize = 7;
 
     #[inline(always)]
-    fn finish<const L: usize, const NORMALS: bool>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+    fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
         for l in 0..L {
             let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
-            let inv_sq = recip(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-            let p = rotate(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
+            let inv_sq = recip(dot::<ISA, 4>(q, q));
+            let p = rotate::<ISA>(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + b[4 + i][l];
             }
             if NORMALS {
-                let n = rotate(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+                let n = rotate::<ISA>(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
                 for i in 0..3 {
                     out.n[i][l] = n[i];
                 }
