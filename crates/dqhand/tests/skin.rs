@@ -340,3 +340,53 @@ fn zero_length_normals_are_replaced_by_face_normals() {
     assert!(warnings[0].contains("1 zero-length normals"), "{warnings:?}");
     assert_eq!(mesh.normal(0), Vec3::Z);
 }
+
+/// Grouping vertices by influence count moves whole vertices (position, normal, texture
+/// coordinate, influences) within their part and renumbers the triangles to match.
+#[test]
+fn sorting_by_influence_count_keeps_every_vertex_and_triangle() {
+    let n = 40;
+    let counts = |v: usize| 1 + (v * 7 + v / 3) % 4;
+    let mut data = MeshData {
+        positions: (0..n).map(|v| [v as f32, (v * v) as f32, 1.0]).collect(),
+        normals: (0..n).map(|v| Vec3::new(1.0, v as f32, 0.5).normalize().to_array()).collect(),
+        uvs: (0..n).map(|v| [v as f32 / 40.0, 0.5]).collect(),
+        stride: 4,
+        indices: (0..n as u32 - 2).flat_map(|i| [i, i + 1, i + 2]).collect(),
+        parts: vec![
+            dqhand::skin::Part { name: "a".into(), vertices: 0..15, indices: 0..30 },
+            dqhand::skin::Part { name: "b".into(), vertices: 15..n, indices: 30..(n - 2) * 3 },
+        ],
+        inverse_bind: vec![Affine3A::IDENTITY; 5],
+        ..MeshData::default()
+    };
+    for v in 0..n {
+        for s in 0..4 {
+            data.joints.push(((v + s) % 5) as u32);
+            data.weights.push(if s < counts(v) { 1.0 + s as f32 } else { 0.0 });
+        }
+    }
+    let before = data.clone();
+    data.sort_by_influence_count();
+    let vertex = |d: &MeshData, v: usize| (d.positions[v], d.normals[v], d.uvs[v], d.joints[v * 4..][..4].to_vec(), d.weights[v * 4..][..4].to_vec());
+    for part in &data.parts {
+        let mut old: Vec<_> = part.vertices.clone().map(|v| format!("{:?}", vertex(&before, v))).collect();
+        let mut new: Vec<_> = part.vertices.clone().map(|v| format!("{:?}", vertex(&data, v))).collect();
+        old.sort();
+        new.sort();
+        assert_eq!(old, new, "part {}: the same vertices", part.name);
+        let count = |v: usize| data.weights[v * 4..][..4].iter().filter(|&&w| w > 0.0).count();
+        assert!(part.vertices.clone().zip(part.vertices.clone().skip(1)).all(|(a, b)| count(a) <= count(b)), "part {}: grouped", part.name);
+    }
+    let corners = |d: &MeshData| d.indices.chunks(3).map(|t| t.iter().map(|&i| d.positions[i as usize]).collect::<Vec<_>>()).collect::<Vec<_>>();
+    assert_eq!(corners(&data), corners(&before), "every triangle joins the same points");
+    assert!(SkinnedMesh::new(data).is_ok());
+}
+
+#[test]
+fn the_built_in_hand_is_grouped_by_influence_count() {
+    let model = build(&HandParams::default()).unwrap();
+    let mesh = &model.mesh;
+    let counts: Vec<usize> = (0..mesh.vertex_count()).map(|v| mesh.influences(v).count()).collect();
+    assert!(counts.windows(2).all(|w| w[0] <= w[1]));
+}

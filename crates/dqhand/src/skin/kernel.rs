@@ -7,9 +7,9 @@
 //! positions are asked for, normal) — plain lane loops that the compiler vectorises.
 //!
 //! The same code is compiled for three instruction sets and one is chosen at run time
-//! ([`Kernel`]): portable; AVX2 + FMA, chunks of 8 vertices; AVX-512, chunks of 16 vertices
-//! (two of the mesh's 8-vertex chunks), two vertices per 512-bit register in the blend and
-//! 16 lanes per register in the finish.
+//! ([`Kernel`]): portable; AVX2 + FMA, chunks of 8 vertices; AVX-512, blocks of 16 vertices
+//! (two of the mesh's 8-vertex chunks) blended one vertex per lane from the start, with no
+//! transpose (module `avx512`), and finished 16 lanes per register.
 
 use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
 
