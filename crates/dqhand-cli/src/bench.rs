@@ -3,7 +3,8 @@
 //! The three methods are timed interleaved, frame by frame, in one run (the order rotating
 //! each frame), so that machine noise hits them alike; the report is the median per frame
 //! and the ratios of medians. Each frame the engine's kinematics stage poses the hand
-//! untimed; what is timed is its skin stage (`Engine::skin`), per-bone conversion included.
+//! untimed; what is timed is one variant's `Deformer::deform` on the engine's skinning
+//! transforms, per-bone conversion included.
 
 use std::time::Instant;
 

@@ -65,7 +65,7 @@ impl Kernel {
 }
 
 /// The instruction set a loop is compiled for (a const parameter: one copy per set).
-pub(crate) const PORTABLE: u8 = 0;
+const PORTABLE: u8 = 0;
 const AVX2: u8 = 1;
 const AVX512: u8 = 2;
 
