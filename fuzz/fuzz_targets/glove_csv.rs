@@ -13,7 +13,7 @@ static TABLE: LazyLock<MappingTable> = LazyLock::new(|| MappingTable::builtin("5
 
 fuzz_target!(|bytes: &[u8]| {
     let Ok(mut reader) = GloveCsvReader::new(bytes, &TABLE, Side::Right) else { return };
-    let mut record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
     while let Some(read) = reader.next_record(&mut record) {
         if read.is_err() {
             continue;
@@ -25,7 +25,7 @@ fuzz_target!(|bytes: &[u8]| {
         }
         // The other default side: the written row must say its hand.
         let mut back_reader = GloveCsvReader::new(&written[..], &TABLE, Side::Left).unwrap();
-        let mut back = Record { time: -1.0, side: Side::Left, hand: None, tracker: None };
+        let mut back = Record { time: -1.0, side: Side::Left, hand: None, tracker: None, arrival: None };
         let text = String::from_utf8_lossy(&written);
         match back_reader.next_record(&mut back) {
             Some(Ok(())) => assert_eq!(back, record, "written as {text}"),

@@ -16,7 +16,7 @@ static SENSORS: LazyLock<Vec<String>> =
 
 fuzz_target!(|bytes: &[u8]| {
     let mut reader = JsonRecordReader::new(bytes, Side::Right, SENSORS.clone());
-    let mut record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
     while let Ok(Some(read)) = reader.next_record(&mut record) {
         if read.is_err() {
             continue;
@@ -25,7 +25,7 @@ fuzz_target!(|bytes: &[u8]| {
         write_record(&mut line, &record, &SENSORS).unwrap();
         let text = std::str::from_utf8(&line).unwrap();
         // The other default side: the written line must say its hand.
-        let mut back = Record { time: -1.0, side: Side::Left, hand: None, tracker: None };
+        let mut back = Record { time: -1.0, side: Side::Left, hand: None, tracker: None, arrival: None };
         if let Err(r) = parse_record(text.trim_end(), Side::Left, &SENSORS, &mut back) {
             panic!("{record:?} written as {text} is refused: {}", r.message);
         }

@@ -26,7 +26,7 @@ pub struct Args {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let table = args.common.table()?;
     let mut reader = RecordingReader::open(&args.input, args.format, &args.common)?;
-    let mut record = Record { time: 0.0, side: args.common.hand, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: args.common.hand, hand: None, tracker: None, arrival: None };
     let (mut samples, mut rejected) = (Vec::new(), dqhand::input::Rejections::default());
     while let Some(read) = reader.next(&mut record)? {
         match (read, &record.hand) {

@@ -130,7 +130,7 @@ impl SourceRun {
         let mut reader = RecordingReader::open(path, Some(self.source.format), input)?;
         let mapper = input.mapper(JointModel::Full)?;
         let mut gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, Some(mapper), input.config()?, Some(GestureSet::builtin()))?;
-        let mut record = Record { time: 0.0, side: input.hand, hand: None, tracker: None };
+        let mut record = Record { time: 0.0, side: input.hand, hand: None, tracker: None, arrival: None };
         let mut events = Vec::new();
         let start = Instant::now();
         while let Some(read) = reader.next(&mut record)? {
@@ -139,7 +139,6 @@ impl SourceRun {
                 gesture_loop.reject(rejection);
                 continue;
             }
-            gesture_loop.advance(record.time);
             let t0 = Instant::now();
             let pushed = gesture_loop.push(&record, None);
             self.push_us.push(t0.elapsed().as_secs_f64() * 1e6);

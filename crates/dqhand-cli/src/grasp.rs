@@ -63,7 +63,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
     let names: Vec<String> = manip.rendered().skeleton().names().map(str::to_owned).collect();
-    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None, arrival: None };
     let mut pending: Option<Record> = None;
     let (mut frame, mut refused) = (0u64, 0u64);
     let mut clock: Option<f64> = None;

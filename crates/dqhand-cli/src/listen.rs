@@ -72,7 +72,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Ok((n, _)) => match live.decode(&buf[..n], &mut record) {
                 // A refusal by the loop is counted there.
                 Ok(()) => {
-                    if let Ok(events) = gesture_loop.push(&record, Some(start.elapsed().as_secs_f64())) {
+                    record.arrival = Some(start.elapsed().as_secs_f64()); // recorded: a replay takes it as it arrived
+                    if let Ok(events) = gesture_loop.push(&record, record.arrival) {
                         let mut out = stdout.lock();
                         for event in events {
                             serde_json::to_writer(&mut out, &event)?;

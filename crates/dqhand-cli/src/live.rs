@@ -49,7 +49,7 @@ impl LiveRecords {
 
     /// A blank record to decode into.
     pub fn blank(&self) -> Record {
-        Record { time: 0.0, side: self.side, hand: None, tracker: None }
+        Record { time: 0.0, side: self.side, hand: None, tracker: None, arrival: None }
     }
 
     /// Decodes one datagram or message into `out`.

@@ -50,7 +50,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let stdout = std::io::stdout();
     let mut events_out = std::io::BufWriter::new(stdout.lock());
-    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None };
+    let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None, arrival: None };
     let (mut records, mut times_us, mut sizes) = (0u64, Vec::new(), Vec::new());
     let start = Instant::now();
     loop {
@@ -61,8 +61,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             gesture_loop.reject(rejection);
             continue;
         }
-        gesture_loop.advance(record.time);
-        match gesture_loop.push(&record, None) {
+        match gesture_loop.push(&record, record.arrival) {
             Ok(events) => {
                 for event in events {
                     serde_json::to_writer(&mut events_out, &event)?;

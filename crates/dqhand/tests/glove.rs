@@ -33,7 +33,7 @@ fn angle(angles_deg: &[f32], model: JointModel, dof: &str) -> f32 {
 }
 
 fn empty_record() -> Record {
-    Record { time: -1.0, side: Side::Right, hand: None, tracker: None }
+    Record { time: -1.0, side: Side::Right, hand: None, tracker: None, arrival: None }
 }
 
 // ---- tables ----
@@ -575,6 +575,7 @@ fn records(tracker: bool, hand: bool) -> Vec<Record> {
                 position: Vec3::new(noise.next(1.0), noise.next(1.0), noise.next(1.0)),
                 orientation: Quat::from_axis_angle(Vec3::new(noise.next(1.0), 1.0, noise.next(1.0)).normalize(), noise.next(3.0)),
             }),
+            arrival: None,
         })
         .collect()
 }

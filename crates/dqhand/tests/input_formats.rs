@@ -14,7 +14,7 @@ use proptest::prelude::*;
 const NO_GLOVE: [&str; 0] = [];
 
 fn empty() -> Record {
-    Record { time: 0.0, side: Side::Right, hand: None, tracker: None }
+    Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None }
 }
 
 fn joints_json(names: &[&str], skip: Option<usize>) -> String {
@@ -81,6 +81,9 @@ fn landmarks_glove_and_tracker() {
     assert_eq!(g.values(), &[7.0, 8.0, 9.0]);
     parse_record(r#"{"t": 4, "tracker": {"p": [0, 1, 0], "q": [0, 0.7071068, 0, 0.7071068]}}"#, Side::Right, &sensors, &mut r).unwrap();
     assert!(r.hand.is_none() && r.tracker.is_some(), "a tracker-only record");
+    assert_eq!(r.arrival, None);
+    parse_record(r#"{"t": 4, "tracker": {"p": [0, 1, 0], "q": [0, 0, 0, 1]}, "arrival": 12.5}"#, Side::Right, &sensors, &mut r).unwrap();
+    assert_eq!(r.arrival, Some(12.5), "a live recording's arrival time");
 }
 
 /// Each bad record is refused with its kind and a message naming the problem.
@@ -92,6 +95,8 @@ fn bad_records_are_refused_by_kind() {
         ("not json", RejectKind::Malformed, "malformed"),
         (r#"{"t": 1, "landmarks": [[0,0,0]], "extra": 1}"#, RejectKind::Malformed, "malformed"),
         (r#"{"t": -1, "tracker": {"p": [0,0,0], "q": [0,0,0,1]}}"#, RejectKind::OutOfRange, "negative"),
+        (r#"{"t": 1, "arrival": -0.5, "tracker": {"p": [0,0,0], "q": [0,0,0,1]}}"#, RejectKind::OutOfRange, "arrival: -0.5 is negative"),
+        (r#"{"t": 1, "arrival": "now", "tracker": {"p": [0,0,0], "q": [0,0,0,1]}}"#, RejectKind::Malformed, "malformed"),
         (r#"{"t": 1, "hand": "both", "tracker": {"p": [0,0,0], "q": [0,0,0,1]}}"#, RejectKind::UnknownName, "both"),
         (r#"{"t": 1, "joints": {"wrist": {"p": [0,0,0]}, "thumb-nail": {"p": [0,0,0]}}}"#, RejectKind::UnknownName, "thumb-nail"),
         (r#"{"t": 1, "joints": {"wrist": {"p": [0,0,0]}}}"#, RejectKind::Malformed, "thumb-metacarpal is missing"),
@@ -151,7 +156,7 @@ fn written_records_read_back() {
     let mut lines = Vec::new();
     for line in [
         joints_json(&webxr::JOINT_NAMES, None),
-        r#"{"t": 3, "hand": "right", "glove": [1.5, 4095], "tracker": {"p": [1, 2, 3], "q": [0, 0, 0, 1]}}"#.to_owned(),
+        r#"{"t": 3, "hand": "right", "glove": [1.5, 4095], "tracker": {"p": [1, 2, 3], "q": [0, 0, 0, 1]}, "arrival": 3.0416666666666665}"#.to_owned(),
     ] {
         parse_record(&line, Side::Right, &sensors, &mut r).unwrap();
         let mut out = Vec::new();

@@ -29,7 +29,7 @@ fn joints_record(time: f64, pose: &Pose) -> Record {
         let p: Vec3 = world[rig.skeleton().find(name).unwrap()].translation.into();
         set.set(i, TrackedJoint { position: p, orientation: None, radius: 0.0 });
     }
-    Record { time, side: Side::Right, hand: Some(HandData::Joints(set)), tracker: None }
+    Record { time, side: Side::Right, hand: Some(HandData::Joints(set)), tracker: None, arrival: None }
 }
 
 fn unfiltered() -> InputConfig {
@@ -59,12 +59,15 @@ fn out_of_order_flood_and_late_records_are_refused_and_counted() {
     // Live: the clock offset is the fastest delivery; 0.3 s slower than that is late.
     p.push(&joints_record(2.0, &fist), Some(102.01)).unwrap();
     p.push(&joints_record(2.1, &fist), Some(102.10)).unwrap();
+    p.push(&joints_record(2.15, &fist), Some(102.33)).unwrap(); // 0.18 s slow: taken
+    // (Within the grace time of the last arrival: later, the hand is lost and a late record
+    // starts a new stream.)
     assert_eq!(p.push(&joints_record(2.2, &point), Some(102.55)).unwrap_err().kind, RejectKind::Late);
-    p.push(&joints_record(2.3, &point), Some(102.31)).unwrap();
+    p.push(&joints_record(2.5, &point), Some(102.56)).unwrap();
     let r = p.rejections();
     assert_eq!((r.count(RejectKind::OutOfOrder), r.count(RejectKind::Flood), r.count(RejectKind::Late), r.total()), (2, 1, 1, 4));
     assert_eq!(r.summary().count(), 3, "one line per kind");
-    assert_eq!(p.accepted(), 4);
+    assert_eq!(p.accepted(), 5);
 }
 
 #[test]
@@ -195,7 +198,7 @@ fn glove_and_tracker_records_pose_the_hand() {
     let mut p = InputPipeline::new(&rig(), Some(mapper.clone()), config).unwrap();
     let fist_raw = GloveSample::new(&[4095.0; 14]);
     let tracker = RigidPose { position: Vec3::new(0.1, 1.0, -0.2), orientation: Quat::from_rotation_y(0.5) };
-    p.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: Some(tracker) }, None).unwrap();
+    p.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: Some(tracker), arrival: None }, None).unwrap();
     let mut expected = vec![0.0; JointModel::Full.dof_count()];
     mapper.map(&fist_raw, &mut expected).unwrap();
     assert_eq!(p.pose().angles, expected);
@@ -204,12 +207,12 @@ fn glove_and_tracker_records_pose_the_hand() {
     assert!(p.pose().angles[index_pip] > 1.0, "a fist curls the index");
     // A raw value outside 0–4095 is refused and the pose kept.
     let bad = GloveSample::new(&[5000.0; 14]);
-    let e = p.push(&Record { time: 0.1, side: Side::Right, hand: Some(HandData::Glove(bad)), tracker: None }, None).unwrap_err();
+    let e = p.push(&Record { time: 0.1, side: Side::Right, hand: Some(HandData::Glove(bad)), tracker: None, arrival: None }, None).unwrap_err();
     assert_eq!(e.kind, RejectKind::OutOfRange);
     assert_eq!(p.pose().angles, expected);
     // A glove record without a configured glove is refused.
     let mut bare = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
-    assert!(bare.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: None }, None).is_err());
+    assert!(bare.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: None, arrival: None }, None).is_err());
     // A glove for another joint model is a configuration error.
     let paper = GloveMapper::new(&table, &calibration, JointModel::Paper).unwrap();
     assert!(InputPipeline::new(&rig(), Some(paper), unfiltered()).is_err());
@@ -247,4 +250,49 @@ fn live_streams_jump_restart_and_go_lost_by_the_arrival_clock() {
     assert!(max_diff_deg(p.pose(), &open) < 0.5, "the new stream drives the hand");
     // While tracking, a second sender's clock is refused (out of order), not mixed in.
     assert_eq!(p.push(&joints_record(0.1, &fist), Some(300.7)).unwrap_err().kind, RejectKind::OutOfOrder);
+}
+
+/// A live stream stalls: records captured 1/30 s apart arrive in a burst after a 2 s stall,
+/// so the live input marks the hand lost, lets it relax, and blends back. Written as a live
+/// recording (each record with its arrival) and read back, the records replay to exactly the
+/// poses shown live, whenever the live input advanced between them; without the arrival
+/// times the capture clock sees no stall and the poses differ.
+#[test]
+fn a_live_recording_replays_to_the_poses_shown_live() {
+    use dqhand::input::json_record::{parse_record, write_record};
+    let config = InputConfig::default();
+    let poses = ["fist", "open_palm", "point"].map(|g| gesture(g).unwrap().pose(JointModel::Full));
+    let capture = |i: usize| i as f64 / 30.0;
+    let arrival = |i: usize| capture(i) + 0.05 + if (40..60).contains(&i) { 2.0 - (i - 40) as f64 / 30.0 } else if i >= 60 { 1.4 } else { 0.0 };
+    let mut live = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+    let (mut shown, mut file, mut tick, mut lost) = (Vec::new(), Vec::new(), 0.0, false);
+    for i in 0..120 {
+        let record = Record { arrival: Some(arrival(i)), ..joints_record(capture(i), &poses[i / 25 % 3]) };
+        // The server's frames advance the hand at 120 Hz between records.
+        while tick < arrival(i) {
+            live.advance(tick);
+            lost |= live.tracking() == Tracking::Lost;
+            tick += 1.0 / 120.0;
+        }
+        if live.push(&record, record.arrival).is_ok() {
+            shown.push(live.pose().clone());
+            write_record(&mut file, &record, &[] as &[&str]).unwrap();
+        }
+    }
+    assert!(lost, "the stall lost the hand");
+    assert!(shown.len() >= 100, "{} records taken", shown.len());
+    let replay = |with_arrival: bool| {
+        let mut p = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+        let mut out = Vec::new();
+        for line in std::str::from_utf8(&file).unwrap().lines() {
+            let mut record = Record { time: 0.0, side: Side::Left, hand: None, tracker: None, arrival: None };
+            parse_record(line, Side::Right, &[] as &[&str], &mut record).unwrap();
+            assert!(record.arrival.is_some(), "{line}");
+            p.push(&record, if with_arrival { record.arrival } else { None }).unwrap();
+            out.push(p.pose().clone());
+        }
+        out
+    };
+    assert_eq!(replay(true), shown, "replayed with its arrival times");
+    assert_ne!(replay(false), shown, "on the capture clock alone the stall is not seen");
 }

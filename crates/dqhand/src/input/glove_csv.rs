@@ -218,6 +218,7 @@ impl Header {
             side,
             hand: Some(HandData::Glove(GloveSample::new(&values[..self.sensor_names.len()]))),
             tracker,
+            arrival: None,
         };
         Ok(())
     }

@@ -16,6 +16,9 @@
 //! * `landmarks`: 21 positions in MediaPipe's order (m);
 //! * `glove`: raw sensor values keyed by the glove's sensor names, or an array in its order;
 //! * `tracker`: the wrist tracker's pose, `p` and `q`;
+//! * `arrival`: written by live recordings, when the live input took the record (seconds on
+//!   its clock), so a replay judges lateness and loss of tracking as it did
+//!   ([`Record::arrival`]);
 //! * at most one of `joints`, `landmarks`, `glove`; glTF axes (+Y up).
 //!
 //! Parsing checks syntax and names; it borrows the line's strings (no copies) and writes into
@@ -56,6 +59,8 @@ struct Line<'a> {
     glove: Option<Entries<'a, f32, MAX_GLOVE_SENSORS>>,
     #[serde(default)]
     tracker: Option<PoseJson>,
+    #[serde(default)]
+    arrival: Option<f64>,
 }
 
 #[derive(Clone, Copy, Default, Deserialize)]
@@ -188,12 +193,8 @@ pub fn parse_record<S: AsRef<str>>(line: &str, default_side: Side, glove_sensors
         let what = if e.is_eof() { "truncated record" } else { "malformed record" };
         Rejection::new(RejectKind::Malformed, format!("{what}: {e}"))
     })?;
-    if !parsed.t.is_finite() {
-        return Err(Rejection::new(RejectKind::NonFinite, format!("t: {} is not a finite time", parsed.t)));
-    }
-    if parsed.t < 0.0 {
-        return Err(Rejection::new(RejectKind::OutOfRange, format!("t: {} is negative", parsed.t)));
-    }
+    let time = seconds("t", parsed.t)?;
+    let arrival = parsed.arrival.map(|a| seconds("arrival", a)).transpose()?;
     let side = match parsed.hand.as_ref().map(|h| h.0.as_ref()) {
         None => default_side,
         Some("left") => Side::Left,
@@ -224,7 +225,7 @@ pub fn parse_record<S: AsRef<str>>(line: &str, default_side: Side, glove_sensors
     if hand.is_none() && tracker.is_none() {
         return Err(Rejection::new(RejectKind::Malformed, "a record needs joints, landmarks, glove or tracker"));
     }
-    *out = Record { time: parsed.t, side, hand, tracker };
+    *out = Record { time, side, hand, tracker, arrival };
     Ok(())
 }
 
@@ -299,6 +300,17 @@ fn glove_sample<S: AsRef<str>>(glove: &Entries<f32, MAX_GLOVE_SENSORS>, sensors:
     Ok(GloveSample::new(&values[..sensors.len()]))
 }
 
+/// A time field: finite and not negative.
+fn seconds(field: &str, t: f64) -> Result<f64, Rejection> {
+    if !t.is_finite() {
+        return Err(Rejection::new(RejectKind::NonFinite, format!("{field}: {t} is not a finite time")));
+    }
+    if t < 0.0 {
+        return Err(Rejection::new(RejectKind::OutOfRange, format!("{field}: {t} is negative")));
+    }
+    Ok(t)
+}
+
 fn position(p: [f32; 3], label: impl Fn() -> String) -> Result<Vec3, Rejection> {
     let v = Vec3::from(p);
     if !v.is_finite() {
@@ -361,6 +373,9 @@ pub fn write_record<S: AsRef<str>>(out: &mut impl Write, record: &Record, glove_
     }
     if let Some(t) = record.tracker {
         object.insert("tracker".into(), json!({ "p": t.position.to_array(), "q": t.orientation.to_array() }));
+    }
+    if let Some(a) = record.arrival {
+        object.insert("arrival".into(), json!(a));
     }
     serde_json::to_writer(&mut *out, &Value::Object(object))?;
     out.write_all(b"\n")

@@ -207,11 +207,14 @@ impl InputPipeline {
     }
 
     /// Takes one record: from a file with `arrival` `None`, live with its local arrival time
-    /// (seconds, any origin, monotonic).
+    /// (seconds, any origin, monotonic). The hand is first brought up to that time as by
+    /// [`Self::advance`], so the pose it blends back from after a loss does not depend on
+    /// when the caller last advanced it: a replay gives the poses the live input gave.
     ///
     /// # Errors
     /// The record's refusal (also counted in [`Self::rejections`]); the shown pose is kept.
     pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
+        self.advance(arrival.unwrap_or(record.time));
         let result = self.take(record, arrival);
         if let Err(r) = &result {
             self.rejections.add(r.clone());

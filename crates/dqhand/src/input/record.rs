@@ -149,4 +149,9 @@ pub struct Record {
     pub hand: Option<HandData>,
     /// The wrist tracker's pose (the sensor's, before the mounting offset), when present.
     pub tracker: Option<RigidPose>,
+    /// When a live input took it, seconds on that input's arrival clock. A live recording
+    /// writes it so that a replay judges lateness and "tracking lost" on the clock the live
+    /// input judged them on, and so gives the same poses and events; `None` for records from
+    /// a source (a live input sets its own, whatever the sender wrote).
+    pub arrival: Option<f64>,
 }

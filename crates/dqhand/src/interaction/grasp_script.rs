@@ -274,7 +274,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         engine.pose(&pose);
         let world: &[Affine3A] = engine.world();
         let positions = joints.read(world);
-        script.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None });
+        script.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None, arrival: None });
         script.truth.push(pose);
     }
     Ok(script)

@@ -272,7 +272,7 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
             let (_, orientation, position) = (wrist * offset.inverse()).to_scale_rotation_translation();
             RigidPose { position, orientation: orientation.normalize() }
         });
-        records.push(Record { time: t, side: hand.side, hand: Some(record_hand), tracker });
+        records.push(Record { time: t, side: hand.side, hand: Some(record_hand), tracker, arrival: None });
         truth.push(pose.clone());
     }
     Ok(Synthetic { hand, records, truth, labels, idle: (idle_start, end) })

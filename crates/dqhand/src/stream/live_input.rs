@@ -242,15 +242,18 @@ impl LiveInput {
         }
     }
 
-    /// Takes one record arriving now (and steps a scene's loop); `taken` sees it once the loop
-    /// has taken it, in the order records are taken (under the input's lock: recording it
-    /// there keeps a recording in that order when several sources send at once).
+    /// Takes one record arriving now (and steps a scene's loop); `taken` sees it, its
+    /// [`Record::arrival`] set to now, once the loop has taken it, in the order records are
+    /// taken (under the input's lock: recording it there keeps a recording in that order when
+    /// several sources send at once, and a replay of it takes each record as it arrived).
     ///
     /// # Errors
     /// The record's refusal (counted, and reported to the viewers in the totals).
     pub fn push(&self, record: &Record, taken: impl FnOnce(&Record)) -> Result<(), Rejection> {
-        let arrival = self.clock();
         let mut guard = self.lock();
+        // Read under the lock, so that the records taken have increasing arrival times.
+        let arrival = self.clock();
+        let record = &Record { arrival: Some(arrival), ..*record };
         let State { driver, posed, log, logged } = &mut *guard;
         let mut add = |entry| {
             if log.len() == LOG_CAPACITY {
@@ -312,8 +315,8 @@ impl LiveInput {
     /// time (steps a scene's loop when a step is due), gives `session` the newest pose and the
     /// gesture commands since its last update, and says what to send.
     pub fn update(&self, session: &mut Session, view: &mut InputView) -> InputUpdate {
-        let arrival = self.clock();
         let mut guard = self.lock();
+        let arrival = self.clock();
         let state = &mut *guard;
         match &mut state.driver {
             Driver::Gestures(g) => {
