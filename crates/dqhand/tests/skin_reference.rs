@@ -25,9 +25,11 @@ struct Case {
     flips: Vec<bool>,
 }
 
-/// Joints of most cases; the AVX-512 kernel looks parameters up from registers up to 32
-/// joints and gathers them past that, so one test uses [`MANY_JOINTS`].
+/// Joints of most cases. The AVX-512 kernel looks parameters and pair signs up from two
+/// registers per table up to 32 joints, and gathers past that: one test fills both
+/// registers ([`TABLE_JOINTS`]), one uses [`MANY_JOINTS`].
 const JOINTS: usize = 6;
+const TABLE_JOINTS: usize = 32;
 const MANY_JOINTS: usize = 40;
 
 fn case(max_influences: usize) -> impl Strategy<Value = Case> {
@@ -130,8 +132,13 @@ fn rotate(q: [f64; 4], v: DVec3) -> DVec3 {
     DVec3::new(r[0], r[1], r[2])
 }
 
-/// The reference position and normal of vertex `v` under `method`.
-fn reference(c: &Case, v: usize, method: Method) -> (DVec3, DVec3) {
+/// The reference position and normal of vertex `v` under `method`, and the condition number
+/// of the normal's transform (LB's blended matrix, near singular where LB collapses: a
+/// float computation of its inverse loses that many times more; 1 for the rotations of QB
+/// and DQB). `None` where QB's or DQB's hemisphere sign is undecided: an influence's rotation
+/// is 180° from the heaviest one's, their quaternions' dot product within rounding of 0,
+/// and either sign is as right (the blends differ completely).
+fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> {
     let total: f64 = c.influences[v].iter().map(|i| f64::from(i.1)).sum();
     let inf: Vec<(usize, f64)> = c.influences[v].iter().map(|&(j, w)| (j as usize, f64::from(w) / total)).collect();
     let p = Vec3::from(c.positions[v]).as_dvec3();
@@ -146,7 +153,8 @@ fn reference(c: &Case, v: usize, method: Method) -> (DVec3, DVec3) {
                 r += DMat3::from_cols(m.matrix3.x_axis.as_dvec3(), m.matrix3.y_axis.as_dvec3(), m.matrix3.z_axis.as_dvec3()) * w;
                 t += m.translation.as_dvec3() * w;
             }
-            (r * p + t, (r.inverse().transpose() * n).normalize())
+            let frobenius = |m: DMat3| (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt();
+            Some((r * p + t, (r.inverse().transpose() * n).normalize(), frobenius(r) * frobenius(r.inverse())))
         }
         Method::Qb | Method::Dqb => {
             let bones: Vec<(usize, f64, [f64; 4], DVec3)> = inf
@@ -157,7 +165,11 @@ fn reference(c: &Case, v: usize, method: Method) -> (DVec3, DVec3) {
                 })
                 .collect();
             let heaviest = bones.iter().fold(&bones[0], |a, b| if b.1 > a.1 { b } else { a }).2;
-            let sign = |q: [f64; 4]| if q.iter().zip(&heaviest).map(|(a, b)| a * b).sum::<f64>() < 0.0 { -1.0 } else { 1.0 };
+            let dot = |q: [f64; 4]| q.iter().zip(&heaviest).map(|(a, b)| a * b).sum::<f64>();
+            if bones.iter().any(|b| dot(b.2).abs() < 1e-5) {
+                return None;
+            }
+            let sign = |q: [f64; 4]| if dot(q) < 0.0 { -1.0 } else { 1.0 };
             if method == Method::Qb {
                 // q = normalise(Σ wᵢ sᵢ qᵢ), t = Σ wᵢ tᵢ, v' = q v q* + t.
                 let mut q = [0.0; 4];
@@ -169,7 +181,7 @@ fn reference(c: &Case, v: usize, method: Method) -> (DVec3, DVec3) {
                 }
                 let len = q.iter().map(|x| x * x).sum::<f64>().sqrt();
                 let q = q.map(|x| x / len);
-                (rotate(q, p) + t, rotate(q, n))
+                Some((rotate(q, p) + t, rotate(q, n), 1.0))
             } else {
                 // b̂ = Σ wᵢ sᵢ q̂ᵢ with q̂ = q + ε ½ t q; b̂ / ‖b₀‖;
                 // v' = b₀ v b₀* + 2 vec(b_ε b₀*) (paper eq. 3–6).
@@ -185,7 +197,7 @@ fn reference(c: &Case, v: usize, method: Method) -> (DVec3, DVec3) {
                 let len = real.iter().map(|x| x * x).sum::<f64>().sqrt();
                 let (real, dual) = (real.map(|x| x / len), dual.map(|x| x / len));
                 let t = mul(dual, conj(real)).map(|x| 2.0 * x);
-                (rotate(real, p) + DVec3::new(t[0], t[1], t[2]), rotate(real, n))
+                Some((rotate(real, p) + DVec3::new(t[0], t[1], t[2]), rotate(real, n), 1.0))
             }
         }
     }
@@ -202,10 +214,12 @@ fn check(c: &Case, stride: usize) -> Result<(), TestCaseError> {
             deformer.deform(&mesh, &c.skinning, &mut only);
             prop_assert!(only.normals().is_empty());
             for v in 0..c.positions.len() {
-                let (p, n) = reference(c, v, method);
+                let Some((p, n, condition)) = reference(c, v, method) else { continue };
                 let (gp, gn) = (Vec3::from(out.positions()[v]).as_dvec3(), Vec3::from(out.normals()[v]).as_dvec3());
                 prop_assert!(gp.distance(p) < 2e-4, "{method} on {kernel:?}, vertex {v}: position {gp} but the reference gives {p}");
-                prop_assert!(gn.distance(n) < 2e-4, "{method} on {kernel:?}, vertex {v}: normal {gn} but the reference gives {n}");
+                // Rounding of f32 (~1e-7) grows with the condition number (3 for a rotation).
+                let normal_tolerance = 2e-4_f64.max(1e-6 * condition);
+                prop_assert!(gn.distance(n) < normal_tolerance, "{method} on {kernel:?}, vertex {v}: normal {gn} but the reference gives {n} (condition {condition:.0})");
                 let op = Vec3::from(only.positions()[v]).as_dvec3();
                 prop_assert!(op.distance(p) < 2e-4, "{method} on {kernel:?}, positions only, vertex {v}: {op} but the reference gives {p}");
             }
@@ -225,6 +239,11 @@ proptest! {
     #[test]
     fn the_kernels_match_the_reference_with_up_to_eight_influences(c in case(8)) {
         check(&c, 8)?;
+    }
+
+    #[test]
+    fn the_kernels_match_the_reference_with_a_full_register_table(c in case_of(TABLE_JOINTS, 4)) {
+        check(&c, 4)?;
     }
 
     #[test]
@@ -253,6 +272,7 @@ fn qb_translation_is_not_flipped_with_the_rotation() {
     let mut out = Deformed::new(&mesh);
     Deformer::new(Method::Qb, &mesh).deform(&mesh, &c.skinning, &mut out);
     assert_close!(out.positions()[0], [0.5, 0.0, 0.5], 1e-5);
-    let (p, _) = reference(&c, 0, Method::Qb);
+    let (p, _, _) = reference(&c, 0, Method::Qb).expect("signs decided");
     assert_close!(out.positions()[0], p.as_vec3().to_array(), 1e-5);
 }
+

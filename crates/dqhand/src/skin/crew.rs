@@ -4,30 +4,49 @@
 //! to wake (rayon's workers sleep microseconds after their queues empty, and a wake costs
 //! tens of µs in a VM). So the crew's helpers spin for a while after each job, waiting for
 //! the next (OpenMP's active wait policy), and only then park; and the caller never waits
-//! for a helper to wake: it claims pieces of the job itself, from the same counter as the
-//! helpers, and a helper that wakes late finds nothing left. Allocates nothing per job.
+//! for a helper to wake: it claims pieces of the job itself, and a helper that wakes late
+//! finds nothing left. Each thread has a home range of the pieces, which it claims first and
+//! the others only once theirs are done, so a thread deforms the same vertices frame after
+//! frame, from its own cache, when all are awake. Allocates nothing per job.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering::*};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// One job: `pieces` calls of `f`, each index claimed once from `next`.
+/// The next piece of one thread's home range, counted from its start; a cache line of its
+/// own, so that claims in one range do not slow claims in another.
+#[repr(align(128))]
+struct Cursor(AtomicUsize);
+
+/// One job: `pieces` calls of `f`, each index claimed once through its range's cursor.
 struct Job<'a> {
     f: &'a (dyn Fn(usize) + Sync),
     pieces: usize,
-    next: AtomicUsize,
+    /// One per thread, at zero when the job is offered.
+    cursors: &'a [Cursor],
 }
 
 impl Job<'_> {
-    /// Claims and runs pieces until none is left.
-    fn work(&self) {
-        loop {
-            let i = self.next.fetch_add(1, Relaxed);
-            if i >= self.pieces {
-                return;
+    /// Thread `r`'s home range of the pieces.
+    fn range(&self, r: usize) -> Range<usize> {
+        let n = self.cursors.len();
+        r * self.pieces / n..(r + 1) * self.pieces / n
+    }
+
+    /// Claims and runs pieces, from thread `home`'s range on, until none is left.
+    fn work(&self, home: usize) {
+        let n = self.cursors.len();
+        for r in (home..n).chain(0..home) {
+            let range = self.range(r);
+            loop {
+                let i = range.start + self.cursors[r].0.fetch_add(1, Relaxed);
+                if i >= range.end {
+                    break;
+                }
+                (self.f)(i);
             }
-            (self.f)(i);
         }
     }
 }
@@ -51,6 +70,8 @@ struct Shared {
     /// Set if a piece panicked on a helper.
     poisoned: AtomicBool,
     spin: Duration,
+    /// The job's cursors, one per thread (the caller's first), reset by each caller.
+    cursors: Box<[Cursor]>,
 }
 
 /// A crew of `threads − 1` helper threads, started once; see the module docs.
@@ -87,11 +108,12 @@ impl Crew {
             stop: AtomicBool::new(false),
             poisoned: AtomicBool::new(false),
             spin,
+            cursors: (0..threads.max(1)).map(|_| Cursor(AtomicUsize::new(0))).collect(),
         });
         let helpers = (1..threads.max(1))
             .map(|i| {
                 let shared = Arc::clone(&shared);
-                std::thread::Builder::new().name(format!("dqhand-crew-{i}")).spawn(move || helper(&shared))
+                std::thread::Builder::new().name(format!("dqhand-crew-{i}")).spawn(move || helper(i, &shared))
             })
             .collect::<std::io::Result<_>>()?;
         Ok(Self { shared, helpers })
@@ -110,11 +132,16 @@ impl Crew {
     /// If a piece panicked on a helper (a piece that panics on the caller unwinds as usual,
     /// after the helpers are done with the job).
     pub fn run(&self, pieces: usize, f: &(dyn Fn(usize) + Sync)) {
-        let job = Job { f, pieces, next: AtomicUsize::new(0) };
         let s = &*self.shared;
         if self.helpers.is_empty() || s.busy.swap(true, Acquire) {
-            return job.work();
+            return (0..pieces).for_each(f);
         }
+        // No helper touches the cursors between jobs (see `Withdraw`); the job's offer below
+        // publishes the reset.
+        for c in &s.cursors {
+            c.0.store(0, Relaxed);
+        }
+        let job = Job { f, pieces, cursors: &s.cursors };
         s.poisoned.store(false, Relaxed);
         // Withdraws the job and waits out the helpers on every way out, unwinding included:
         // after this no helper touches the job.
@@ -137,7 +164,7 @@ impl Crew {
             let _guard = s.lock.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
             s.wake.notify_all();
         }
-        job.work();
+        job.work(0);
         drop(withdraw);
         assert!(!s.poisoned.load(Acquire), "a crew thread panicked");
     }
@@ -156,8 +183,9 @@ impl Drop for Crew {
     }
 }
 
-/// A helper's life: take part in each job on offer once, spin `spin` after it, then park.
-fn helper(s: &Shared) {
+/// Helper `home`'s life: take part in each job on offer once, spin `spin` after it, then
+/// park.
+fn helper(home: usize, s: &Shared) {
     let (mut seen, mut last) = (0, Instant::now());
     let offered = |seen: usize| s.epoch.load(SeqCst) != seen && !s.job.load(SeqCst).is_null();
     while !s.stop.load(Relaxed) {
@@ -187,7 +215,7 @@ fn helper(s: &Shared) {
             // still waiting in `Withdraw` and the job is alive.
             let job = unsafe { &*job };
             // A panicking piece is the caller's to report; the helper stays for the next job.
-            if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work())).is_err() {
+            if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work(home))).is_err() {
                 s.poisoned.store(true, Release);
             }
         }
@@ -223,6 +251,19 @@ mod tests {
             each_piece_once(&crew, 3, 1000);
         }
         each_piece_once(&Crew::new(1, Crew::SPIN).unwrap(), 5, 9);
+    }
+
+    /// A thread claims its own range first, then the others' in turn, each piece once.
+    #[test]
+    fn a_thread_starts_at_its_home_range_and_then_takes_the_others() {
+        let cursors: Vec<Cursor> = (0..3).map(|_| Cursor(AtomicUsize::new(0))).collect();
+        let order = Mutex::new(Vec::new());
+        let job = Job { f: &|i| order.lock().unwrap().push(i), pieces: 10, cursors: &cursors };
+        assert_eq!([0, 1, 2].map(|r| job.range(r)), [0..3, 3..6, 6..10]);
+        job.work(1);
+        assert_eq!(*order.lock().unwrap(), [3, 4, 5, 6, 7, 8, 9, 0, 1, 2]);
+        job.work(0);
+        assert_eq!(order.lock().unwrap().len(), 10, "nothing left for a second thread");
     }
 
     #[test]

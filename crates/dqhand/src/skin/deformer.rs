@@ -7,7 +7,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::crew::Crew;
-use super::kernel::{self, Frame, Kernel};
+use super::kernel::{self, Frame, FrameTable, Kernel};
 use super::skinned_mesh::{SkinnedMesh, LANES};
 use super::Method;
 use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
@@ -52,14 +52,17 @@ impl Deformed {
 /// of waking and joining; the built-in hand's 8,668 vertices take ~10 µs on one core).
 pub const MIN_VERTICES_PER_THREAD: usize = 2048;
 
-/// A skinning method with its per-frame scratch: bone parameters and the sign table; the
-/// kernel it runs and, optionally, a crew of threads it splits each deformation across.
+/// A skinning method with its per-frame scratch: bone parameters, the sign table and the
+/// AVX-512 loop's lookup table of both; the kernel it runs and, optionally, a crew of threads
+/// it splits each deformation across.
 #[derive(Clone, Debug)]
 pub struct Deformer {
     method: Method,
     lb: Vec<[f32; lb::W]>,
     quat: Vec<[f32; dqb::W]>,
     signs: Vec<f32>,
+    lb_table: FrameTable<{ lb::W }>,
+    quat_table: FrameTable<{ dqb::W }>,
     kernel: Kernel,
     crew: Option<Arc<Crew>>,
 }
@@ -71,7 +74,16 @@ impl Deformer {
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
         let joints = mesh.inverse_bind().len();
         let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
-        Self { method, lb: vec![[0.0; lb::W]; lbn], quat: vec![[0.0; dqb::W]; qn], signs: vec![1.0; sn], kernel: Kernel::best(), crew: None }
+        Self {
+            method,
+            lb: vec![[0.0; lb::W]; lbn],
+            quat: vec![[0.0; dqb::W]; qn],
+            signs: vec![1.0; sn],
+            lb_table: if lbn > 0 { FrameTable::new(lbn) } else { FrameTable::default() },
+            quat_table: if qn > 0 { FrameTable::new(qn) } else { FrameTable::default() },
+            kernel: Kernel::best(),
+            crew: None,
+        }
     }
 
     /// The same deformer on `kernel` (one this CPU does not run falls back to the best it
@@ -123,6 +135,7 @@ impl Deformer {
                 for (d, m) in self.lb.iter_mut().zip(skinning) {
                     *d = lb::params(m);
                 }
+                self.lb_table.update(&self.lb, &[], &[]);
             }
             Method::Qb | Method::Dqb => {
                 assert_eq!(self.quat.len(), skinning.len(), "deformer made for another joint count");
@@ -136,6 +149,7 @@ impl Deformer {
                     let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
                     *sign = if dot < 0.0 { -1.0 } else { 1.0 };
                 }
+                self.quat_table.update(&self.quat, &mesh.pairs, &self.signs);
             }
         }
         let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);
@@ -181,9 +195,9 @@ impl Deformer {
     fn run(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         let kernel = self.kernel;
         match self.method {
-            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], kernel }, first, positions, normals),
-            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, kernel }, first, positions, normals),
-            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, kernel }, first, positions, normals),
+            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], table: &self.lb_table, kernel }, first, positions, normals),
+            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel }, first, positions, normals),
+            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel }, first, positions, normals),
         }
     }
 

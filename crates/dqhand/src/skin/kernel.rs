@@ -69,8 +69,15 @@ const PORTABLE: u8 = 0;
 const AVX2: u8 = 1;
 const AVX512: u8 = 2;
 
+/// Stack data the vector loops load and store whole registers of, aligned to a cache line:
+/// an unaligned 64-byte access straddles two lines, and where the stack happened to fall
+/// that cost a fifth of the frame (DQB positions only, 7.2 or 9.4 µs by the caller's depth).
+#[repr(C, align(64))]
+pub(crate) struct Aligned<T>(pub T);
+
 /// Rest or deformed geometry of one chunk of `L` vertices: positions then normals, x/y/z
 /// lanes each.
+#[repr(C, align(64))]
 pub(crate) struct Chunk<const L: usize> {
     pub p: [[f32; L]; 3],
     pub n: [[f32; L]; 3],
@@ -105,8 +112,46 @@ pub(crate) struct Frame<'a, const W: usize> {
     pub params: &'a [[f32; W]],
     /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused when `SIGNED` is 0).
     pub signs: &'a [f32],
+    /// `params` and `signs` as the AVX-512 loop looks them up, updated for this frame.
+    pub table: &'a FrameTable<W>,
     /// The loop to run (one this CPU does not run falls back to the best it does).
     pub kernel: Kernel,
+}
+
+/// The AVX-512 loop's lookup table of a frame's parameters and pair signs (module `avx512`),
+/// kept by the deformer and updated once per frame, not once per piece of a split frame.
+/// Empty where the CPU has no AVX-512 or the skin has more joints than it holds: that loop
+/// then gathers.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FrameTable<const W: usize> {
+    #[cfg(target_arch = "x86_64")]
+    table: Option<Box<avx512::Table<W>>>,
+}
+
+impl<const W: usize> FrameTable<W> {
+    /// A table for a skin of `joints` joints (empty if it would not be used).
+    pub(crate) fn new(joints: usize) -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            Self { table: (joints <= avx512::TABLE_JOINTS && Kernel::Avx512.available()).then(Box::default) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = joints;
+            Self {}
+        }
+    }
+
+    /// Takes this frame's `params` and the `signs` of `pairs` (as in [`Frame`]; none for
+    /// LB). Allocates nothing.
+    pub(crate) fn update(&mut self, params: &[[f32; W]], pairs: &[(u16, u16)], signs: &[f32]) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(table) = &mut self.table {
+            table.update(params, pairs, signs);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = (params, pairs, signs);
+    }
 }
 
 /// Deforms the vertices of `mesh`'s chunks from `first` on (of [`LANES`] vertices), as many
@@ -175,19 +220,19 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
     if ISA == AVX512 {
         // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature detection.
         c = unsafe {
-            match avx512::Table::new(frame.params) {
-                Some(table) => blocks::<W, K, B, NORMALS>(&table, mesh, first, positions, normals),
+            match frame.table.table.as_deref() {
+                Some(table) => blocks::<W, K, B, NORMALS>(table, mesh, first, positions, normals),
                 None => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, first, positions, normals),
             }
         };
     }
-    let mut b = [[0.0f32; LANES]; W];
+    let mut b = Aligned([[0.0f32; LANES]; W]);
     let (mut rest, mut out) = (Chunk::new(), Chunk::new());
     while c < count {
         let chunk = first + c;
         let kc = usize::from(mesh.chunk_influences[chunk]);
-        blend::<W, K, B, ISA>(frame, kc, Slots::of(mesh, chunk * LANES), &mut b);
-        run::<W, B, LANES, NORMALS, ISA>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        blend::<W, K, B, ISA>(frame, kc, Slots::of(mesh, chunk * LANES), &mut b.0);
+        run::<W, B, LANES, NORMALS, ISA>(mesh, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 1;
     }
 }
@@ -206,15 +251,15 @@ unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: boo
     // Blocks of the slot-major arrays start at even chunks (the threads' spans are even).
     assert!(first % 2 == 0, "an AVX-512 run starts at a block");
     let count = positions.len() / LANES;
-    let mut b = [[0.0f32; BLOCK]; W];
+    let mut b = Aligned([[0.0f32; BLOCK]; W]);
     let (mut rest, mut out) = (Chunk::new(), Chunk::new());
     let mut c = 0;
     while c + 2 <= count {
         let chunk = first + c;
         let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
         // SAFETY: joint indices are below the parameter rows (asserted in `chunks`).
-        avx512::blend::<W, K, B>(lookup, mesh, chunk / 2, usize::from(kc), &mut b);
-        run::<W, B, BLOCK, NORMALS, AVX512>(mesh, &b, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        avx512::blend::<W, K, B>(lookup, mesh, chunk / 2, usize::from(kc), &mut b.0);
+        run::<W, B, BLOCK, NORMALS, AVX512>(mesh, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 2;
     }
     c
@@ -462,7 +507,7 @@ mod avx512 {
     use super::{Blend, SkinnedMesh, BLOCK};
 
     /// Joints a [`Table`] holds: the 32 lanes of a two-source permute.
-    const TABLE_JOINTS: usize = 32;
+    pub(super) const TABLE_JOINTS: usize = 32;
 
     /// How the blend finds a component of the 16 lanes' joints' parameters.
     pub(super) trait Lookup<const W: usize> {
@@ -470,28 +515,50 @@ mod avx512 {
         unsafe fn offsets(&self, joints: __m512i) -> __m512i;
         /// Component `c` of the parameters at `offsets`.
         unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512;
+        /// The lanes whose influence must be negated to share its heaviest influence's
+        /// hemisphere (a negative dot product of their rotations): `heaviest` and `joints`
+        /// are the two joints' indices, `h` and `v` their rotations.
+        unsafe fn opposite(&self, heaviest: __m512i, joints: __m512i, h: &[__m512; 4], v: &[__m512; 4]) -> __mmask16;
     }
 
     /// The per-frame parameters component-major in two registers' worth per component,
     /// `rows[c][j]` = parameter `c` of joint `j`: one two-source permute looks a component up
     /// for 16 lanes, from registers or L1. For skins of at most [`TABLE_JOINTS`] joints.
+    #[derive(Clone, Debug)]
+    #[repr(C, align(64))]
     pub(super) struct Table<const W: usize> {
         rows: [[f32; TABLE_JOINTS]; W],
+        /// The frame's pair signs as bits: bit `j` of `opposite[h]` is set when joint `j`
+        /// is negated beside heaviest joint `h`. A permute and a shift find 16 lanes' signs,
+        /// instead of a four-term dot product on the multiply-add ports.
+        opposite: [u32; TABLE_JOINTS],
+    }
+
+    impl<const W: usize> Default for Table<W> {
+        fn default() -> Self {
+            Self { rows: [[0.0; TABLE_JOINTS]; W], opposite: [0; TABLE_JOINTS] }
+        }
     }
 
     impl<const W: usize> Table<W> {
-        /// The table of `params`, if there are at most [`TABLE_JOINTS`] joints.
-        pub(super) fn new(params: &[[f32; W]]) -> Option<Self> {
-            if params.len() > TABLE_JOINTS {
-                return None;
-            }
-            let mut rows = [[0.0; TABLE_JOINTS]; W];
+        /// Takes `params` and the `signs` of `pairs` (as in [`super::Frame`]; none for LB).
+        ///
+        /// # Panics
+        /// If there are more than [`TABLE_JOINTS`] joints.
+        pub(super) fn update(&mut self, params: &[[f32; W]], pairs: &[(u16, u16)], signs: &[f32]) {
+            assert!(params.len() <= TABLE_JOINTS, "a table holds {TABLE_JOINTS} joints");
             for (j, p) in params.iter().enumerate() {
-                for (c, row) in rows.iter_mut().enumerate() {
+                for (c, row) in self.rows.iter_mut().enumerate() {
                     row[j] = p[c];
                 }
             }
-            Some(Self { rows })
+            self.opposite = [0; TABLE_JOINTS];
+            // Sign 0 is the heaviest joint's own (+1); pair joints are below the joint count.
+            for (&(h, j), &sign) in pairs.iter().zip(signs.get(1..).unwrap_or_default()) {
+                if sign < 0.0 {
+                    self.opposite[usize::from(h)] |= 1 << j;
+                }
+            }
         }
     }
 
@@ -505,6 +572,16 @@ mod avx512 {
         unsafe fn get(&self, joints: __m512i, c: usize) -> __m512 {
             let row = self.rows[c].as_ptr();
             _mm512_permutex2var_ps(_mm512_loadu_ps(row), joints, _mm512_loadu_ps(row.add(16)))
+        }
+
+        #[inline(always)]
+        unsafe fn opposite(&self, heaviest: __m512i, joints: __m512i, _: &[__m512; 4], _: &[__m512; 4]) -> __mmask16 {
+            let rows = self.opposite.as_ptr();
+            let bits = _mm512_permutex2var_epi32(_mm512_loadu_si512(rows.cast()), heaviest, _mm512_loadu_si512(rows.add(16).cast()));
+            // Joints are below 32 here; saying so spares the shift the compiler's checks
+            // for counts of 32 or more (four instructions).
+            let j = _mm512_and_si512(joints, _mm512_set1_epi32(TABLE_JOINTS as i32 - 1));
+            _mm512_test_epi32_mask(bits, _mm512_sllv_epi32(_mm512_set1_epi32(1), j))
         }
     }
 
@@ -521,12 +598,21 @@ mod avx512 {
         unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512 {
             _mm512_i32gather_ps::<4>(_mm512_add_epi32(offsets, _mm512_set1_epi32(c as i32)), self.0.as_ptr().cast())
         }
+
+        /// From the rotations themselves: the rule of the frame's pair signs, without a table.
+        #[inline(always)]
+        unsafe fn opposite(&self, _: __m512i, _: __m512i, h: &[__m512; 4], v: &[__m512; 4]) -> __mmask16 {
+            let mut dot = _mm512_setzero_ps();
+            for c in 0..4 {
+                dot = _mm512_fmadd_ps(h[c], v[c], dot);
+            }
+            _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dot, _mm512_setzero_ps())
+        }
     }
 
-    /// As the portable `blend`, for the 16 vertices of block `block`. The sign of each
-    /// influence is found in the lanes, from the dot product of its rotation with the
-    /// heaviest influence's: the rule of the frame's pair signs, without their table.
-    /// Inlined into `deform_avx512`, whose features it uses.
+    /// As the portable `blend`, for the 16 vertices of block `block`, each influence signed
+    /// to its heaviest one's hemisphere by [`Lookup::opposite`]. Inlined into
+    /// `deform_avx512`, whose features it uses.
     #[inline(always)]
     pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
         lookup: &impl Lookup<W>,
@@ -538,7 +624,7 @@ mod avx512 {
         let slot = |k: usize| (block * K + k) * BLOCK;
         let zero = _mm512_setzero_ps();
         let mut acc = [zero; W];
-        let mut heaviest = [zero; 4];
+        let (mut heaviest, mut heaviest_joints) = ([zero; 4], _mm512_setzero_si512());
         for k in 0..kc.min(K) {
             let joints = _mm512_cvtepu16_epi32(_mm256_loadu_si256(mesh.block_joints.as_ptr().add(slot(k)).cast()));
             let w = _mm512_loadu_ps(mesh.block_weights.as_ptr().add(slot(k)));
@@ -553,14 +639,11 @@ mod avx512 {
                 w
             } else if k == 0 {
                 // Slot 0 is the heaviest joint itself, whose sign is always +1.
-                heaviest = [v[0], v[1], v[2], v[3]];
+                (heaviest, heaviest_joints) = ([v[0], v[1], v[2], v[3]], joints);
                 w
             } else {
-                let mut dot = zero;
-                for c in 0..4 {
-                    dot = _mm512_fmadd_ps(heaviest[c], v[c], dot);
-                }
-                _mm512_mask_sub_ps(w, _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dot, zero), zero, w)
+                let opposite = lookup.opposite(heaviest_joints, joints, &heaviest, &[v[0], v[1], v[2], v[3]]);
+                _mm512_mask_sub_ps(w, opposite, zero, w)
             };
             for c in 0..B::USED {
                 acc[c] = _mm512_fmadd_ps(if c < B::SIGNED { sw } else { w }, v[c], acc[c]);
