@@ -119,20 +119,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             std::hint::black_box(v.out.positions());
         }
     }
-    let median = |v: &mut Variant| percentile(&mut v.samples, 0.5);
     let rows: Vec<serde_json::Value> = variants
         .iter_mut()
         .map(|v| {
-            let (med, p10, p90) = (median(v), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
+            let (med, p10, p90) = (percentile(&mut v.samples, 0.5), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
             json!({ "method": v.method.as_str(), "kernel": v.kernel.name(), "threads": v.threads, "normals": v.normals, "us_per_frame": med, "p10_us": p10, "p90_us": p90, "fps": 1e6 / med })
         })
         .collect();
-    let us = |method: Method, kernel: Kernel, threads: usize, normals: bool| {
+    let row = |method: Method, kernel: Kernel, threads: usize, normals: bool| {
         rows.iter()
             .find(|r| r["method"] == method.as_str() && r["kernel"] == kernel.name() && r["threads"] == threads && r["normals"] == normals)
-            .and_then(|r| r["us_per_frame"].as_f64())
             .expect("a timed variant")
     };
+    let stat = |r: &serde_json::Value, key: &str| r[key].as_f64().expect("a number");
+    let us = |method, kernel, threads, normals| stat(row(method, kernel, threads, normals), "us_per_frame");
     let table3 = |m: Method| us(m, best, 1, true);
     let animation = animation.name;
     let report = json!({
@@ -165,9 +165,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     );
     println!("\nthe paper's Table 3: one thread, {} kernel, positions and normals", best.name());
     println!("{:<6} {:>10} {:>10} {:>10} {:>12}", "method", "median", "p10", "p90", "frames/s");
-    for v in variants.iter_mut().filter(|v| v.kernel == best && v.threads == 1 && v.normals) {
-        let (med, p10, p90) = (median(v), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
-        println!("{:<6} {med:>10.1} {p10:>10.1} {p90:>10.1} {:>12.0}", v.method.as_str().to_uppercase(), 1e6 / med);
+    for m in Method::ALL {
+        let r = row(m, best, 1, true);
+        let (med, p10, p90) = (stat(r, "us_per_frame"), stat(r, "p10_us"), stat(r, "p90_us"));
+        println!("{:<6} {med:>10.1} {p10:>10.1} {p90:>10.1} {:>12.0}", m.as_str().to_uppercase(), 1e6 / med);
     }
     println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", table3(Method::Dqb) / table3(Method::Lb), table3(Method::Dqb) / table3(Method::Qb));
     println!("\nkernels: one thread; positions and normals | positions only");

@@ -110,7 +110,7 @@ impl Deformer {
     /// The kernel that runs.
     #[must_use]
     pub fn kernel(&self) -> Kernel {
-        if self.kernel.available() { self.kernel } else { Kernel::best() }
+        self.kernel.or_best()
     }
 
     /// Deforms `mesh` by the skinning transforms into `out` (positions and normals, or
@@ -129,13 +129,17 @@ impl Deformer {
     pub fn deform(&mut self, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut Deformed) {
         assert_eq!(out.vertex_count, mesh.vertex_count(), "output buffers belong to another mesh");
         assert_eq!(skinning.len(), mesh.inverse_bind().len(), "one skinning transform per joint");
+        // Only the AVX-512 loop reads the lookup table (the same choice as `kernel::deform`'s).
+        let avx512 = self.kernel() == Kernel::Avx512;
         match self.method {
             Method::Lb => {
                 assert_eq!(self.lb.len(), skinning.len(), "deformer made for another joint count");
                 for (d, m) in self.lb.iter_mut().zip(skinning) {
                     *d = lb::params(m);
                 }
-                self.lb_table.update(&self.lb, &[], &[]);
+                if avx512 {
+                    self.lb_table.update(&self.lb, &[], &[]);
+                }
             }
             Method::Qb | Method::Dqb => {
                 assert_eq!(self.quat.len(), skinning.len(), "deformer made for another joint count");
@@ -149,7 +153,9 @@ impl Deformer {
                     let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
                     *sign = if dot < 0.0 { -1.0 } else { 1.0 };
                 }
-                self.quat_table.update(&self.quat, &mesh.pairs, &self.signs);
+                if avx512 {
+                    self.quat_table.update(&self.quat, &mesh.pairs, &self.signs);
+                }
             }
         }
         let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);

@@ -53,6 +53,12 @@ impl Kernel {
         }
     }
 
+    /// This kernel if this CPU runs it, else the fastest one it does.
+    #[must_use]
+    pub fn or_best(self) -> Self {
+        if self.available() { self } else { Self::best() }
+    }
+
     /// `portable`, `avx2` or `avx512`.
     #[must_use]
     pub fn name(self) -> &'static str {
@@ -119,9 +125,9 @@ pub(crate) struct Frame<'a, const W: usize> {
 }
 
 /// The AVX-512 loop's lookup table of a frame's parameters and pair signs (module `avx512`),
-/// kept by the deformer and updated once per frame, not once per piece of a split frame.
-/// Empty where the CPU has no AVX-512 or the skin has more joints than it holds: that loop
-/// then gathers.
+/// kept by the deformer and updated once per frame that runs that loop, not once per piece
+/// of a split frame. Empty where the CPU has no AVX-512 or the skin has more joints than it
+/// holds: that loop then gathers.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct FrameTable<const W: usize> {
     #[cfg(target_arch = "x86_64")]
@@ -164,8 +170,7 @@ pub(crate) fn deform<const W: usize, B: Blend<W>>(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
-    let kernel = if frame.kernel.available() { frame.kernel } else { Kernel::best() };
-    match kernel {
+    match frame.kernel.or_best() {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the CPU supports the features each function is compiled for.
         Kernel::Avx512 => unsafe { deform_avx512::<W, B>(mesh, frame, first, positions, normals) },
