@@ -7,7 +7,7 @@ use std::sync::{Arc, LazyLock};
 use dqhand::hand::{build, HandParams};
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
-use dqhand::stream::{Command, FrameView, Session};
+use dqhand_stream::{Command, FrameView, Session};
 use libfuzzer_sys::fuzz_target;
 
 static HAND: LazyLock<Arc<Model>> = LazyLock::new(|| Arc::new(build(&HandParams { vertices: 1000, ..HandParams::default() }).unwrap()));

@@ -2,7 +2,7 @@
 //! a frame that parses is written back byte for byte.
 #![no_main]
 
-use dqhand::stream::{FrameView, FrameWriter, Topology};
+use dqhand_stream::{FrameView, FrameWriter, Topology};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|bytes: &[u8]| {

@@ -11,7 +11,7 @@ use std::sync::{Arc, LazyLock};
 use dqhand::hand::{build, HandParams};
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
-use dqhand::stream::{Applied, FrameView, Session};
+use dqhand_stream::{Applied, FrameView, Session};
 use libfuzzer_sys::fuzz_target;
 use tungstenite::Message;
 

@@ -10,9 +10,9 @@ use std::time::Instant;
 
 use std::sync::Arc;
 
-use dqhand::engine::{Engine, ModelSource};
+use dqhand::engine::ModelSource;
 use dqhand::gesture::Sequence;
-use dqhand::kinematics::{JointModel, Pose, Transform};
+use dqhand::kinematics::{HandKinematics, JointModel, KinematicsLayer, Pose, Transform};
 use dqhand::model::Model;
 use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method};
 use glam::Quat;
@@ -105,7 +105,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for f in 0..100 {
         animation.pose(f);
         for v in &mut variants {
-            v.time(mesh, animation.engine.skinning());
+            v.time(mesh, animation.skinning());
         }
     }
     // Interleaved frame by frame, the order rotating: machine noise hits every variant alike.
@@ -114,7 +114,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         animation.pose(f);
         for k in 0..n {
             let v = &mut variants[(f + k) % n];
-            let us = v.time(mesh, animation.engine.skinning());
+            let us = v.time(mesh, animation.skinning());
             v.samples.push(us);
             std::hint::black_box(v.out.positions());
         }
@@ -190,30 +190,29 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// sampled at 60 frames per second for a hand with WebXR joints, else every joint swinging
 /// ±30° about its own X axis over 240 frames.
 struct Animation {
-    engine: Engine,
     name: &'static str,
     motion: Motion,
 }
 
 /// What moves the hand from frame to frame.
 enum Motion {
-    /// The gesture sequence and the pose sampled from it.
-    Sequence(Sequence, Pose),
-    /// Every joint's rest transform, and the swung transforms written each frame.
-    Swings { rest: Vec<Transform>, locals: Vec<Transform> },
+    /// The gesture sequence, the pose sampled from it, and the hand posing it.
+    Sequence(Sequence, Pose, Box<HandKinematics>),
+    /// Every joint's rest transform, the swung transforms written each frame, and the
+    /// skeleton they pose.
+    Swings { rest: Vec<Transform>, locals: Vec<Transform>, layer: Box<KinematicsLayer> },
 }
 
 impl Animation {
     fn new(model: Arc<Model>) -> Self {
-        match Engine::with_joint_model(model.clone(), JointModel::Full) {
-            Ok(engine) => Self {
-                engine,
+        match model.hand_kinematics(JointModel::Full) {
+            Ok(hand) => Self {
                 name: "the gesture sequence",
-                motion: Motion::Sequence(Sequence::gestures(JointModel::Full), Pose::rest(JointModel::Full.dof_count())),
+                motion: Motion::Sequence(Sequence::gestures(JointModel::Full), Pose::rest(JointModel::Full.dof_count()), Box::new(hand)),
             },
             Err(_) => {
                 let rest = model.skeleton.rest_locals();
-                Self { engine: Engine::new(model), name: "joint swings", motion: Motion::Swings { locals: rest.clone(), rest } }
+                Self { name: "joint swings", motion: Motion::Swings { locals: rest.clone(), rest, layer: Box::new(model.kinematics()) } }
             }
         }
     }
@@ -221,19 +220,26 @@ impl Animation {
     /// Poses frame `f` (the kinematics stage, untimed).
     fn pose(&mut self, f: usize) {
         match &mut self.motion {
-            Motion::Sequence(sequence, pose) => {
-                let rest_wrist = self.engine.rig().expect("a joint model").rest_wrist();
+            Motion::Sequence(sequence, pose, hand) => {
                 let time = (f as f32 / 60.0) % sequence.duration();
-                sequence.sample(time, rest_wrist, pose);
-                self.engine.pose(pose);
+                sequence.sample(time, hand.rig().rest_wrist(), pose);
+                hand.pose(pose);
             }
-            Motion::Swings { rest, locals } => {
+            Motion::Swings { rest, locals, layer } => {
                 let a = (f as f32 / 240.0 * std::f32::consts::TAU).sin() * 30f32.to_radians();
                 for (l, r) in locals.iter_mut().zip(rest.iter()) {
                     l.rotation = r.rotation * Quat::from_rotation_x(a);
                 }
-                self.engine.pose_locals(locals);
+                layer.pose_locals(locals);
             }
+        }
+    }
+
+    /// The skinning transforms of the frame posed last.
+    fn skinning(&self) -> &[glam::Affine3A] {
+        match &self.motion {
+            Motion::Sequence(_, _, hand) => hand.skinning(),
+            Motion::Swings { layer, .. } => layer.skinning(),
         }
     }
 }

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
-use dqhand::stream::FrameView;
+use dqhand_stream::FrameView;
 use serde_json::json;
 use tungstenite::Message;
 

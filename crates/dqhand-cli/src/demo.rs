@@ -16,7 +16,7 @@ use dqhand::kinematics::JointModel;
 use dqhand::interaction::{GestureLoop, ManipulationLoop};
 use dqhand::scene::Scene;
 use dqhand::skin::Method;
-use dqhand::stream::LiveInput;
+use dqhand_stream::LiveInput;
 
 use crate::feed::Feed;
 use crate::live::LiveRecords;
@@ -162,11 +162,9 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     };
     let announce = played.is_some() || udp.is_some();
     let input = match scene {
-        None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?.with_commands()?, source.clone(), announce),
+        None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?, source.clone(), announce)?,
         Some((name, scene)) => {
-            let manip = ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default())
-                .and_then(ManipulationLoop::with_commands)
-                .with_context(|| name.to_owned())?;
+            let manip = ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default()).with_context(|| name.to_owned())?;
             crate::warn_all(&manip.objects().warnings().iter().map(|w| format!("{name}: {w}")).collect::<Vec<_>>());
             println!("scene: {name}, {} objects ({})", manip.names().len(), manip.names().join(", "));
             LiveInput::with_scene(manip, source.clone(), announce).with_context(|| name.to_owned())?
@@ -245,7 +243,7 @@ fn write_gestures(out: &Path) -> anyhow::Result<()> {
     dqhand::io::write_skinned_glb(&model, &rigged)?;
     println!("{}", model.description);
     println!("rigged, skinned hand: {}", rigged.display());
-    let mut engine = Engine::with_joint_model(model.clone(), JointModel::Full)?;
+    let mut engine = Engine::new(model.clone(), JointModel::Full)?;
     println!("{:<10} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs");
     for (i, g) in GESTURES.iter().enumerate() {
         let pose = g.pose(JointModel::Full);
@@ -253,11 +251,11 @@ fn write_gestures(out: &Path) -> anyhow::Result<()> {
         let pose_path = out.join(format!("{stem}.pose.json"));
         let file = PoseFile::from_pose(JointModel::Full, &pose);
         std::fs::write(&pose_path, serde_json::to_string_pretty(&file)?).map_err(|e| anyhow::anyhow!("{}: {e}", pose_path.display()))?;
-        engine.pose(&pose);
+        engine.kinematics_mut().pose(&pose);
         let mut times = Vec::new();
         for m in Method::ALL {
             let t = Instant::now();
-            let posed = engine.skin(m);
+            let posed = engine.skin_with(m);
             times.push(t.elapsed().as_secs_f64() * 1e6);
             let path = out.join(format!("{stem}.{m}.glb"));
             dqhand::io::write_posed(&path, posed.positions(), posed.normals(), model.mesh.uvs(), model.mesh.indices())?;

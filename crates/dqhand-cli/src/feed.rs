@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicUsize;
 use std::time::{Duration, Instant};
 
 use dqhand::input::{Record, Rejection};
-use dqhand::stream::LiveInput;
+use dqhand_stream::LiveInput;
 
 use crate::live::{LiveRecords, MAX_DATAGRAM_BYTES};
 use crate::recording::{Format, InputArgs, RecordingReader};

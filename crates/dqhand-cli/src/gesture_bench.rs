@@ -140,7 +140,7 @@ impl SourceRun {
                 continue;
             }
             let t0 = Instant::now();
-            let pushed = gesture_loop.push(&record, None);
+            let pushed = gesture_loop.push(&record);
             self.push_us.push(t0.elapsed().as_secs_f64() * 1e6);
             if let Ok(new) = pushed {
                 events.extend(new.map(LoggedEvent::from));

@@ -17,7 +17,7 @@ use dqhand::input::{Record, Tracking};
 use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
 use dqhand::scene::Scene;
-use dqhand::skin::Method;
+use dqhand::skin::{Method, MethodSet, SkinLayer};
 use serde_json::{json, Map, Value};
 
 use crate::recording::RecordingArgs;
@@ -58,6 +58,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for w in manip.objects().warnings() {
         eprintln!("dqhand: warning: {}: {w}", args.scene);
     }
+    let mut skin = SkinLayer::new(Arc::clone(&manip.input().model().mesh), MethodSet::DQB);
     if let Some(dir) = &args.meshes {
         std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     }
@@ -85,7 +86,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let now = *clock.get_or_insert_with(|| next.map_or(0.0, |r| r.time));
         match next {
             Some(r) if r.time <= now => {
-                if manip.push(&r, None).is_err() {
+                if manip.push(&r).is_err() {
                     refused += 1;
                 }
                 continue;
@@ -98,10 +99,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         if let Some(dir) = &args.meshes {
             if frame % args.every == 0 {
                 let path = dir.join(format!("{frame}.ply"));
-                let mesh = manip.rendered_mut().skin(Method::Dqb);
-                let (positions, normals) = (mesh.positions().to_vec(), mesh.normals().to_vec());
-                let indices = manip.rendered().model().mesh.indices().to_vec();
-                dqhand::io::write_ply(&path, &positions, &normals, &indices)?;
+                skin.deform(manip.rendered().layer());
+                let mesh = skin.deformed(Method::Dqb).expect("DQB is the set");
+                dqhand::io::write_ply(&path, mesh.positions(), mesh.normals(), skin.mesh().indices())?;
             }
         }
         frame += 1;

@@ -73,7 +73,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 // A refusal by the loop is counted there.
                 Ok(()) => {
                     record.arrival = Some(start.elapsed().as_secs_f64()); // recorded: a replay takes it as it arrived
-                    if let Ok(events) = gesture_loop.push(&record, record.arrival) {
+                    if let Ok(events) = gesture_loop.push(&record) {
                         let mut out = stdout.lock();
                         for event in events {
                             serde_json::to_writer(&mut out, &event)?;

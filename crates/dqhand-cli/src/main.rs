@@ -109,3 +109,10 @@ pub(crate) fn warn_all(warnings: &[String]) {
         eprintln!("dqhand: warning: {w}");
     }
 }
+
+/// Warns of each angle the anatomical limits clamped, and how to keep it.
+pub(crate) fn warn_clamped(origin: &str, clamped: &[dqhand::kinematics::ClampedAngle]) {
+    for c in clamped {
+        eprintln!("dqhand: warning: {origin}: {c} (use --no-limits to allow it)");
+    }
+}

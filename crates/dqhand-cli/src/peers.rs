@@ -17,7 +17,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use dqhand::engine::{Engine, ModelSource};
+use dqhand::engine::ModelSource;
 use dqhand::gesture::gesture;
 use dqhand::hand::HandParams;
 use dqhand::io::PoseFile;
@@ -54,24 +54,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.frames > 0, "--frames must be at least 1");
     let model = Arc::new(ModelSource::Builtin(HandParams::default()).load()?);
     crate::warn_all(&model.warnings);
-    let (engine, pose) = match &args.pose {
+    let (layer, pose) = match &args.pose {
         Some(path) => {
             let target = PoseFile::load(path)?.resolve(&model.skeleton).map_err(|e| e.in_file(path))?;
-            let mut engine = Engine::for_target(model.clone(), &target).map_err(|e| e.in_file(path))?;
-            engine.set_limits(if args.no_limits { Limits::Off } else { Limits::Anatomical });
-            crate::warn_all(&engine.pose_target(&target));
-            (engine, path.display().to_string())
+            let limits = if args.no_limits { Limits::Off } else { Limits::Anatomical };
+            let (layer, clamped) = model.pose_target(&target, limits).map_err(|e| e.in_file(path))?;
+            crate::warn_clamped(&path.display().to_string(), &clamped);
+            (layer, path.display().to_string())
         }
         None => {
-            let mut engine = Engine::with_joint_model(model.clone(), JointModel::Full)?;
-            let pose = default_pose(engine.rig().expect("a joint model").rest_wrist())?;
-            engine.pose(&pose);
-            (engine, DEFAULT_POSE.to_owned())
+            let mut hand = model.hand_kinematics(JointModel::Full)?;
+            let pose = default_pose(hand.rig().rest_wrist())?;
+            hand.pose(&pose);
+            (hand.into_layer(), DEFAULT_POSE.to_owned())
         }
     };
     let mesh = &model.mesh;
     anyhow::ensure!(mesh.max_influences() <= SLOTS, "the hand has vertices with more than {SLOTS} influences");
-    let skinning = engine.skinning();
+    let skinning = layer.skinning();
 
     // Same timing as `dqhand bench` (warm-up, then LB and DQB alternating frame by frame), but
     // on this one pose and through the public deformer, as the peers are timed.

@@ -67,9 +67,14 @@ impl InputArgs {
         Ok(GloveMapper::new(&table, &calibration, joint_model)?)
     }
 
+    /// The input configuration; its `actions` must be the viewer's.
     pub fn config(&self) -> anyhow::Result<InputConfig> {
         Ok(match &self.config {
-            Some(path) => InputConfig::load(path)?,
+            Some(path) => {
+                let config = InputConfig::load(path)?;
+                dqhand_stream::ViewerAction::resolve(&config.actions).with_context(|| path.display().to_string())?;
+                config
+            }
             None => InputConfig::default(),
         })
     }

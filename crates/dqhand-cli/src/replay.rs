@@ -61,7 +61,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             gesture_loop.reject(rejection);
             continue;
         }
-        match gesture_loop.push(&record, record.arrival) {
+        match gesture_loop.push(&record) {
             Ok(events) => {
                 for event in events {
                     serde_json::to_writer(&mut events_out, &event)?;

@@ -7,9 +7,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use dqhand::engine::{Engine, ModelSource};
+use dqhand::engine::ModelSource;
 use dqhand::io::PoseFile;
-use dqhand::kinematics::{Limits, PoseTarget};
+use dqhand::kinematics::Limits;
 use dqhand::skin::{Deformed, Deformer, Method};
 
 /// Arguments of `dqhand skin`.
@@ -54,10 +54,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let origin = args.pose.clone().unwrap_or_else(|| "rest pose".into());
     let target = pose.resolve(&model.skeleton).map_err(|e| e.in_file(&origin))?;
     let model = Arc::new(model);
-    let mut engine = Engine::for_target(model.clone(), &target).map_err(|e| e.in_file(&origin))?;
-    engine.set_limits(if args.no_limits { Limits::Off } else { Limits::Anatomical });
-    crate::warn_all(&engine.pose_target(&target));
-    let out = engine.skin(args.method);
+    let (layer, clamped) = model.pose_target(&target, limits(args)).map_err(|e| e.in_file(&origin))?;
+    crate::warn_clamped(&origin.display().to_string(), &clamped);
+    let mut out = Deformed::new(&model.mesh);
+    Deformer::new(args.method, &model.mesh).deform(&model.mesh, &layer, &mut out);
     dqhand::io::write_posed(&args.out, out.positions(), out.normals(), model.mesh.uvs(), model.mesh.indices())?;
     println!(
         "wrote {} ({} vertices, {} triangles, {})",
@@ -75,28 +75,14 @@ fn batch(args: &Args, model: dqhand::model::Model, path: &Path) -> anyhow::Resul
     let poses = read_poses(path)?;
     anyhow::ensure!(!poses.is_empty(), "{}: no pose", path.display());
     let model = Arc::new(model);
-    let mut engine: Option<Engine> = None;
     let mut skinning = Vec::with_capacity(poses.len() * model.mesh.inverse_bind().len());
     for (i, pose) in poses.iter().enumerate() {
         let at = |e: dqhand::Error| anyhow::anyhow!("{}: line {}: {e}", path.display(), i + 1);
         let target = pose.resolve(&model.skeleton).map_err(at)?;
-        // Each line may use another joint model, or local rotations: an engine made for it.
-        let wanted = match &target {
-            PoseTarget::Angles { model, .. } => Some(*model),
-            PoseTarget::LocalRotations(_) => None,
-        };
-        let engine = match &mut engine {
-            Some(e) if e.rig().map(|r| r.model()) == wanted => e,
-            slot => {
-                let mut e = Engine::for_target(model.clone(), &target).map_err(at)?;
-                e.set_limits(if args.no_limits { Limits::Off } else { Limits::Anatomical });
-                slot.insert(e)
-            }
-        };
-        for w in engine.pose_target(&target) {
-            eprintln!("dqhand: warning: {}: line {}: {w}", path.display(), i + 1);
-        }
-        skinning.extend_from_slice(engine.skinning());
+        // Each line may use another joint model, or local rotations.
+        let (layer, clamped) = model.pose_target(&target, limits(args)).map_err(at)?;
+        crate::warn_clamped(&format!("{}: line {}", path.display(), i + 1), &clamped);
+        skinning.extend_from_slice(layer.skinning());
     }
     let mesh = &model.mesh;
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
@@ -143,4 +129,13 @@ fn read_poses(path: &Path) -> anyhow::Result<Vec<PoseFile>> {
         poses.push(serde_json::from_value(value).map_err(bad)?);
     }
     Ok(poses)
+}
+
+/// The limits `--no-limits` asks for.
+fn limits(args: &Args) -> Limits {
+    if args.no_limits {
+        Limits::Off
+    } else {
+        Limits::Anatomical
+    }
 }

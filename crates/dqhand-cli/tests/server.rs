@@ -8,7 +8,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use dqhand::skin::MethodSet;
-use dqhand::stream::{FrameView, Topology};
+use dqhand_stream::{FrameView, Topology};
 use serde_json::Value;
 use tungstenite::stream::MaybeTlsStream;
 use tungstenite::{Message, WebSocket};

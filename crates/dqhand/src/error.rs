@@ -72,12 +72,6 @@ pub enum Error {
     /// An input configuration (filters, dropouts, tracker mount, gesture commands) is invalid.
     #[error("input configuration: {0}")]
     Config(String),
-    /// A viewer command has a value out of range.
-    #[error("{0}")]
-    Command(String),
-    /// A message of the viewer stream's binary format is malformed.
-    #[error("stream message: {0}")]
-    Frame(String),
     /// A glove mapping table is invalid: the table's name, then what ([`Error::Glove`] or
     /// [`Error::UnknownName`] for a DOF or sensor it does not have).
     #[error("glove table {table:?}: {problem}")]

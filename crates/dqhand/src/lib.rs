@@ -24,8 +24,7 @@
 //! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
 //!   synthetic labelled sequences, and the loop's measures on them; the manipulation loop:
 //!   records → pose → contacts → grasp → physics, and scripted grasp recordings;
-//! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine;
-//! * [`stream`] — the engine side of the live viewer: sessions, commands, binary frames.
+//! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine.
 //!
 //! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names.
@@ -48,6 +47,5 @@ pub mod model;
 pub mod physics;
 pub mod scene;
 pub mod skin;
-pub mod stream;
 
 pub use error::{Error, GestureProblem, Result, SceneProblem};

@@ -1,8 +1,10 @@
 //! A skinned model: a skeleton and the mesh bound to it.
 
+use std::sync::Arc;
+
 use glam::Affine3A;
 
-use crate::kinematics::Skeleton;
+use crate::kinematics::{ClampedAngle, HandKinematics, JointModel, KinematicsLayer, Limits, PoseTarget, Skeleton};
 use crate::skin::SkinnedMesh;
 
 /// A skeleton with its skinned mesh, as loaded from a glTF file or built as the built-in hand.
@@ -13,7 +15,7 @@ pub struct Model {
     /// The joints as stored (for glTF: the file's node hierarchy), in their rest pose.
     pub skeleton: Skeleton,
     /// The mesh, in bind space; its influences index `skeleton`'s joints.
-    pub mesh: SkinnedMesh,
+    pub mesh: Arc<SkinnedMesh>,
     /// Problems that were repaired while loading (for example renormalised weights).
     pub warnings: Vec<String>,
 }
@@ -27,5 +29,42 @@ impl Model {
     #[must_use]
     pub fn bind_world(&self) -> Vec<Affine3A> {
         self.mesh.inverse_bind().iter().map(Affine3A::inverse).collect()
+    }
+
+    /// The kinematics layer of this model's own skeleton, posed by local transforms (any
+    /// skinned model).
+    #[must_use]
+    pub fn kinematics(&self) -> KinematicsLayer {
+        KinematicsLayer::new(self.skeleton.clone(), self.mesh.inverse_bind())
+    }
+
+    /// The kinematics layer posing joint angles of `joint_model` on this model's WebXR joints.
+    ///
+    /// # Errors
+    /// As [`HandKinematics::new`].
+    pub fn hand_kinematics(&self, joint_model: JointModel) -> crate::Result<HandKinematics> {
+        HandKinematics::new(&self.skeleton, self.mesh.inverse_bind(), joint_model)
+    }
+
+    /// The kinematics layer posed for a resolved pose file: joint angles on the anatomical
+    /// chain of its joint model (clamped with `limits`, saying which were), or local rotations
+    /// of this model's own skeleton.
+    ///
+    /// # Errors
+    /// As [`HandKinematics::new`], for angles on a skeleton without the WebXR joints.
+    pub fn pose_target(&self, target: &PoseTarget, limits: Limits) -> crate::Result<(KinematicsLayer, Vec<ClampedAngle>)> {
+        match target {
+            PoseTarget::Angles { model, pose } => {
+                let mut hand = self.hand_kinematics(*model)?;
+                hand.set_limits(limits);
+                let clamped = hand.pose_checked(pose);
+                Ok((hand.into_layer(), clamped))
+            }
+            PoseTarget::LocalRotations(rotations) => {
+                let mut layer = self.kinematics();
+                layer.pose_rotations(rotations);
+                Ok((layer, Vec::new()))
+            }
+        }
     }
 }

@@ -21,6 +21,11 @@ fn rig() -> HandRig {
     HandRig::new(&ours().skeleton, JointModel::Full).unwrap()
 }
 
+/// `record` as a live input takes it, at `arrival` (s) on its own clock.
+fn arriving(record: Record, arrival: f64) -> Record {
+    Record { arrival: Some(arrival), ..record }
+}
+
 fn joints_record(time: f64, pose: &Pose) -> Record {
     let rig = rig();
     let world = support::world_of(&rig, pose, Limits::Anatomical);
@@ -46,24 +51,24 @@ fn out_of_order_flood_and_late_records_are_refused_and_counted() {
     let fist = gesture("fist").unwrap().pose(JointModel::Full);
     let point = gesture("point").unwrap().pose(JointModel::Full);
     assert_eq!(p.tracking(), Tracking::Waiting);
-    p.push(&joints_record(1.0, &fist), None).unwrap();
+    p.push(&joints_record(1.0, &fist)).unwrap();
     assert_eq!(p.tracking(), Tracking::Tracking);
     for (record, kind) in [
         (joints_record(0.5, &point), RejectKind::OutOfOrder),
         (joints_record(1.0, &point), RejectKind::OutOfOrder),
         (joints_record(1.0002, &point), RejectKind::Flood),
     ] {
-        assert_eq!(p.push(&record, None).unwrap_err().kind, kind);
+        assert_eq!(p.push(&record).unwrap_err().kind, kind);
         assert!(max_diff_deg(p.pose(), &fist) < 0.5, "a refused record leaves the pose alone");
     }
     // Live: the clock offset is the fastest delivery; 0.3 s slower than that is late.
-    p.push(&joints_record(2.0, &fist), Some(102.01)).unwrap();
-    p.push(&joints_record(2.1, &fist), Some(102.10)).unwrap();
-    p.push(&joints_record(2.15, &fist), Some(102.33)).unwrap(); // 0.18 s slow: taken
+    p.push(&arriving(joints_record(2.0, &fist), 102.01)).unwrap();
+    p.push(&arriving(joints_record(2.1, &fist), 102.10)).unwrap();
+    p.push(&arriving(joints_record(2.15, &fist), 102.33)).unwrap(); // 0.18 s slow: taken
     // (Within the grace time of the last arrival: later, the hand is lost and a late record
     // starts a new stream.)
-    assert_eq!(p.push(&joints_record(2.2, &point), Some(102.55)).unwrap_err().kind, RejectKind::Late);
-    p.push(&joints_record(2.5, &point), Some(102.56)).unwrap();
+    assert_eq!(p.push(&arriving(joints_record(2.2, &point), 102.55)).unwrap_err().kind, RejectKind::Late);
+    p.push(&arriving(joints_record(2.5, &point), 102.56)).unwrap();
     let r = p.rejections();
     assert_eq!((r.count(RejectKind::OutOfOrder), r.count(RejectKind::Flood), r.count(RejectKind::Late), r.total()), (2, 1, 1, 4));
     assert_eq!(r.summary().count(), 3, "one line per kind");
@@ -79,7 +84,7 @@ fn a_dropout_holds_the_pose_marks_it_lost_and_recovers_smoothly() {
     let open = gesture("open_palm").unwrap().pose(JointModel::Full);
     let mut t = 0.0;
     while t < 1.0 {
-        p.push(&joints_record(t, &fist), None).unwrap();
+        p.push(&joints_record(t, &fist)).unwrap();
         t += 1.0 / 60.0;
     }
     let last = t - 1.0 / 60.0;
@@ -94,7 +99,7 @@ fn a_dropout_holds_the_pose_marks_it_lost_and_recovers_smoothly() {
     let mut t = back;
     let mut largest_step = 0.0f32;
     while t < back + recover + 0.2 {
-        p.push(&joints_record(t, &open), None).unwrap();
+        p.push(&joints_record(t, &open)).unwrap();
         assert_eq!(p.tracking(), Tracking::Tracking);
         largest_step = largest_step.max(max_diff_deg(p.pose(), &previous));
         previous = p.pose().clone();
@@ -113,8 +118,8 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     let mut fist = gesture("fist").unwrap().pose(JointModel::Full);
     fist.wrist = Some(dqhand::math::DualQuat::from_rotation_translation(Quat::from_rotation_y(0.7), Vec3::new(0.1, 1.2, -0.3)));
     // Live, arriving as captured.
-    p.push(&joints_record(0.0, &fist), Some(0.0)).unwrap();
-    p.push(&joints_record(0.1, &fist), Some(0.1)).unwrap();
+    p.push(&arriving(joints_record(0.0, &fist), 0.0)).unwrap();
+    p.push(&arriving(joints_record(0.1, &fist), 0.1)).unwrap();
     let wrist = p.pose().wrist;
     p.advance(0.1 + grace + rest_after - 0.01);
     assert_eq!(p.tracking(), Tracking::Lost);
@@ -126,7 +131,7 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     for i in 0..25 {
         set.set(i, TrackedJoint { position: Vec3::ZERO, orientation: None, radius: 0.0 });
     }
-    assert_eq!(p.push(&unusable, Some(0.1 + grace + 0.1)).unwrap_err().kind, RejectKind::Unusable);
+    assert_eq!(p.push(&arriving(unusable.clone(), 0.1 + grace + 0.1)).unwrap_err().kind, RejectKind::Unusable);
     p.advance(0.1 + grace + rest_after + recover / 2.0);
     let halfway = p.pose().angles.iter().zip(&fist.angles).filter(|(_, f)| f.abs() > 0.1).map(|(a, f)| a / f).collect::<Vec<_>>();
     assert!(halfway.iter().all(|r| (r - 0.5).abs() < 0.01), "half way through the ease, half the bend: {halfway:?}");
@@ -134,7 +139,7 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1e-3, "at rest");
     assert_eq!(p.pose().wrist, wrist, "the wrist stays where the hand was lost");
     // Records return: the hand blends from rest to them.
-    p.push(&joints_record(3.0, &fist), Some(3.0)).unwrap();
+    p.push(&arriving(joints_record(3.0, &fist), 3.0)).unwrap();
     assert!(max_diff_deg(p.pose(), &Pose::rest(fist.angles.len())) < 1.0);
 }
 
@@ -147,7 +152,7 @@ fn unusable_geometry_is_refused() {
     for i in 0..25 {
         set.set(i, TrackedJoint { position: wrist, orientation: None, radius: 0.0 });
     }
-    assert_eq!(p.push(&r, None).unwrap_err().kind, RejectKind::Unusable);
+    assert_eq!(p.push(&r).unwrap_err().kind, RejectKind::Unusable);
     assert_eq!(p.tracking(), Tracking::Waiting);
 }
 
@@ -173,8 +178,8 @@ fn the_filter_smooths_jitter() {
             let j = *set.get(i).unwrap();
             set.set(i, TrackedJoint { position: j.position + Vec3::new(noise(), noise(), noise()), ..j });
         }
-        raw.push(&r, None).unwrap();
-        filtered.push(&r, None).unwrap();
+        raw.push(&r).unwrap();
+        filtered.push(&r).unwrap();
         if k > 60 {
             raw_jitter += max_diff_deg(raw.pose(), last_raw.as_ref().unwrap());
             filtered_jitter += max_diff_deg(filtered.pose(), last_filtered.as_ref().unwrap());
@@ -198,7 +203,7 @@ fn glove_and_tracker_records_pose_the_hand() {
     let mut p = InputPipeline::new(&rig(), Some(mapper.clone()), config).unwrap();
     let fist_raw = GloveSample::new(&[4095.0; 14]);
     let tracker = RigidPose { position: Vec3::new(0.1, 1.0, -0.2), orientation: Quat::from_rotation_y(0.5) };
-    p.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: Some(tracker), arrival: None }, None).unwrap();
+    p.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: Some(tracker), arrival: None }).unwrap();
     let mut expected = vec![0.0; JointModel::Full.dof_count()];
     mapper.map(&fist_raw, &mut expected).unwrap();
     assert_eq!(p.pose().angles, expected);
@@ -207,12 +212,12 @@ fn glove_and_tracker_records_pose_the_hand() {
     assert!(p.pose().angles[index_pip] > 1.0, "a fist curls the index");
     // A raw value outside 0–4095 is refused and the pose kept.
     let bad = GloveSample::new(&[5000.0; 14]);
-    let e = p.push(&Record { time: 0.1, side: Side::Right, hand: Some(HandData::Glove(bad)), tracker: None, arrival: None }, None).unwrap_err();
+    let e = p.push(&Record { time: 0.1, side: Side::Right, hand: Some(HandData::Glove(bad)), tracker: None, arrival: None }).unwrap_err();
     assert_eq!(e.kind, RejectKind::OutOfRange);
     assert_eq!(p.pose().angles, expected);
     // A glove record without a configured glove is refused.
     let mut bare = InputPipeline::new(&rig(), None, unfiltered()).unwrap();
-    assert!(bare.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: None, arrival: None }, None).is_err());
+    assert!(bare.push(&Record { time: 0.0, side: Side::Right, hand: Some(HandData::Glove(fist_raw)), tracker: None, arrival: None }).is_err());
     // A glove for another joint model is a configuration error.
     let paper = GloveMapper::new(&table, &calibration, JointModel::Paper).unwrap();
     assert!(InputPipeline::new(&rig(), Some(paper), unfiltered()).is_err());
@@ -229,27 +234,27 @@ fn live_streams_jump_restart_and_go_lost_by_the_arrival_clock() {
     let fist = gesture("fist").unwrap().pose(JointModel::Full);
     let open = gesture("open_palm").unwrap().pose(JointModel::Full);
     // Arrival = capture + 100 s; one record 20 ms faster than the others is still taken.
-    p.push(&joints_record(5.0, &fist), Some(105.0)).unwrap();
-    p.push(&joints_record(5.1, &fist), Some(105.08)).unwrap();
-    let jump = p.push(&joints_record(1e300, &open), Some(105.2)).unwrap_err();
+    p.push(&arriving(joints_record(5.0, &fist), 105.0)).unwrap();
+    p.push(&arriving(joints_record(5.1, &fist), 105.08)).unwrap();
+    let jump = p.push(&arriving(joints_record(1e300, &open), 105.2)).unwrap_err();
     assert_eq!(jump.kind, RejectKind::OutOfRange, "{jump}");
     assert!(jump.to_string().contains("ahead of the stream's clock"), "{jump}");
-    p.push(&joints_record(5.2, &fist), Some(105.2)).unwrap();
+    p.push(&arriving(joints_record(5.2, &fist), 105.2)).unwrap();
     // Records that stop: lost after the grace time on the arrival clock.
     p.advance(105.2 + grace * 0.5);
     assert_eq!(p.tracking(), Tracking::Tracking);
     p.advance(105.2 + grace * 1.5);
     assert_eq!(p.tracking(), Tracking::Lost);
     // The sender restarts at t = 0: a new stream, taken, and the hand follows it.
-    p.push(&joints_record(0.0, &open), Some(300.0)).unwrap();
+    p.push(&arriving(joints_record(0.0, &open), 300.0)).unwrap();
     assert_eq!(p.tracking(), Tracking::Tracking);
     for k in 1..40 {
         let t = f64::from(k) / 60.0;
-        p.push(&joints_record(t, &open), Some(300.0 + t)).unwrap();
+        p.push(&arriving(joints_record(t, &open), 300.0 + t)).unwrap();
     }
     assert!(max_diff_deg(p.pose(), &open) < 0.5, "the new stream drives the hand");
     // While tracking, a second sender's clock is refused (out of order), not mixed in.
-    assert_eq!(p.push(&joints_record(0.1, &fist), Some(300.7)).unwrap_err().kind, RejectKind::OutOfOrder);
+    assert_eq!(p.push(&arriving(joints_record(0.1, &fist), 300.7)).unwrap_err().kind, RejectKind::OutOfOrder);
 }
 
 /// A live stream stalls: records captured 1/30 s apart arrive in a burst after a 2 s stall,
@@ -274,7 +279,7 @@ fn a_live_recording_replays_to_the_poses_shown_live() {
             lost |= live.tracking() == Tracking::Lost;
             tick += 1.0 / 120.0;
         }
-        if live.push(&record, record.arrival).is_ok() {
+        if live.push(&record).is_ok() {
             shown.push(live.pose().clone());
             write_record(&mut file, &record, &[] as &[&str]).unwrap();
         }
@@ -288,7 +293,7 @@ fn a_live_recording_replays_to_the_poses_shown_live() {
             let mut record = Record { time: 0.0, side: Side::Left, hand: None, tracker: None, arrival: None };
             parse_record(line, Side::Right, &[] as &[&str], &mut record).unwrap();
             assert!(record.arrival.is_some(), "{line}");
-            p.push(&record, if with_arrival { record.arrival } else { None }).unwrap();
+            p.push(&Record { arrival: record.arrival.filter(|_| with_arrival), ..record.clone() }).unwrap();
             out.push(p.pose().clone());
         }
         out

@@ -44,7 +44,7 @@ fn pose_file(value: Value) -> PoseFile {
 
 /// Poses `model` with `target` and deforms it with `method`; returns positions and the
 /// clamping warnings.
-fn deform_with(model: &Model, target: &PoseTarget, limits: Limits, method: Method) -> (Vec<[f32; 3]>, Vec<String>) {
+fn deform_with(model: &Model, target: &PoseTarget, limits: Limits, method: Method) -> (Vec<[f32; 3]>, Vec<dqhand::kinematics::ClampedAngle>) {
     let (skinning, warnings) = support::pose_skinning(model, target, limits).expect("pose the model");
     let mut out = Deformed::new(&model.mesh);
     Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
@@ -689,7 +689,7 @@ fn angle_beyond_limits_is_clamped_only_with_anatomical_limits() {
 
     let (clamped, warnings) = run(150.0, Limits::Anatomical);
     assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert!(warnings[0].contains(dof) && warnings[0].contains("clamped"), "{warnings:?}");
+    assert!(warnings[0].dof == dof && warnings[0].to_string().contains("clamped"), "{warnings:?}");
     let (at_limit, no_warnings) = run(110.0, Limits::Anatomical);
     assert!(no_warnings.is_empty(), "{no_warnings:?}");
     let all = all_vertices(&model);

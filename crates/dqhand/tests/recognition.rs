@@ -5,17 +5,16 @@
 
 use std::sync::{Arc, OnceLock};
 
-use dqhand::engine::Engine;
 use dqhand::gesture::{Event, EventKind, Feature, Finger, GestureSet, HandFeatures, Recognizer, GESTURES};
 use dqhand::hand::{build, HandParams, Side};
-use dqhand::kinematics::{JointModel, JointPositions, Pose};
+use dqhand::kinematics::{HandKinematics, JointModel, JointPositions, Pose};
 use dqhand::math::DualQuat;
 use dqhand::{Error, GestureProblem};
 use glam::{Quat, Vec3};
 
-/// A built hand, posed through the engine.
+/// A built hand, posed through its kinematics layer.
 struct Hand {
-    engine: Engine,
+    kinematics: HandKinematics,
     joints: JointPositions,
     side: Side,
 }
@@ -23,15 +22,15 @@ struct Hand {
 impl Hand {
     fn new(length: f32, breadth: f32, side: Side) -> Self {
         let model = Arc::new(build(&HandParams { length, breadth, side, vertices: 2000 }).unwrap());
-        let engine = Engine::with_joint_model(model, JointModel::Full).unwrap();
-        let joints = JointPositions::new(engine.skeleton()).unwrap();
-        Self { engine, joints, side }
+        let kinematics = model.hand_kinematics(JointModel::Full).unwrap();
+        let joints = JointPositions::new(kinematics.skeleton()).unwrap();
+        Self { kinematics, joints, side }
     }
 
     fn positions(&self, pose: &Pose) -> [Vec3; 25] {
-        let mut engine = self.engine.clone();
-        engine.pose(pose);
-        self.joints.read(engine.world())
+        let mut kinematics = self.kinematics.clone();
+        kinematics.pose(pose);
+        self.joints.read(kinematics.world())
     }
 
     fn features(&self, pose: &Pose) -> HandFeatures {
@@ -40,7 +39,7 @@ impl Hand {
 
     /// `pose` with the wrist turned by `turn` about the wrist joint.
     fn turned(&self, pose: &Pose, turn: Quat) -> Pose {
-        let rest = self.engine.rig().unwrap().rest_wrist();
+        let rest = self.kinematics.rig().rest_wrist();
         let (rotation, translation) = pose.wrist.unwrap_or(rest).to_rotation_translation();
         Pose { wrist: Some(DualQuat::from_rotation_translation(turn * rotation, translation)), angles: pose.angles.clone() }
     }

@@ -2,7 +2,7 @@
 //! the stream asks for. Apart from the connection code (it needs only tungstenite and the
 //! engine) so that the `websocket` fuzz target compiles it in and reads frames as the server does.
 
-use dqhand::stream::Command;
+use dqhand_stream::Command;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 

@@ -31,7 +31,7 @@ use parry3d::query::{self, NonlinearRigidMotion};
 
 use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectColliders, FINGERS};
-use crate::kinematics::{forward_kinematics, HandRig, Limits, Motion, Pose, Transform};
+use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
 use crate::math::DualQuat;
 
 /// Proxies closer than this to an object touch it (m).
@@ -101,8 +101,11 @@ struct FingerChain {
 pub struct ContactConstraint {
     proxies: HandProxies,
     fingers: [FingerChain; 5],
-    locals: Vec<Transform>,
-    world: Vec<Affine3A>,
+    /// The rendered hand, posed once per solve.
+    kinematics: HandKinematics,
+    /// The local and world transforms of the poses that conservative advancement tries.
+    trial_locals: Vec<Transform>,
+    trial_world: Vec<Affine3A>,
     tracked_world: Vec<Affine3A>,
     tracked: Pose,
     rendered: Pose,
@@ -133,9 +136,11 @@ pub struct ContactConstraint {
 }
 
 impl ContactConstraint {
-    /// A constraint for `proxies` on `rig`'s skeleton.
+    /// A constraint for `proxies` on the skeleton of `kinematics`, which poses the rendered
+    /// hand (with its limits).
     #[must_use]
-    pub fn new(proxies: HandProxies, rig: &HandRig) -> Self {
+    pub fn new(proxies: HandProxies, kinematics: HandKinematics) -> Self {
+        let rig = kinematics.rig();
         let skeleton = rig.skeleton();
         let joints = skeleton.joints();
         let rest = skeleton.rest_world();
@@ -210,8 +215,8 @@ impl ContactConstraint {
             moved_by,
             proxies,
             fingers,
-            locals: skeleton.rest_locals(),
-            world: vec![Affine3A::IDENTITY; n],
+            trial_locals: skeleton.rest_locals(),
+            trial_world: vec![Affine3A::IDENTITY; n],
             tracked_world: vec![Affine3A::IDENTITY; n],
             tracked: Pose::rest(rig.dofs().len()),
             rendered: Pose::rest(rig.dofs().len()),
@@ -221,6 +226,7 @@ impl ContactConstraint {
             held_back_since: None,
             closure: [Closure::default(); 5],
             near: Vec::new(),
+            kinematics,
         }
     }
 
@@ -247,13 +253,16 @@ impl ContactConstraint {
         }
     }
 
-    /// Takes the frame's `tracked` pose: its joint transforms ([`Self::tracked_world`]) and
-    /// finger closures ([`Self::closure`], tracked), which the grasp logic reads before the
-    /// rendered pose is solved. Allocates nothing.
-    pub fn track(&mut self, rig: &HandRig, limits: Limits, tracked: &Pose) {
+    /// Takes the frame's `tracked` pose and its joints' world transforms, as the tracked
+    /// hand's kinematics layer posed them (they are not computed again): the finger closures
+    /// ([`Self::closure`], tracked) and [`Self::tracked_world`], which the grasp logic reads
+    /// before the rendered pose is solved. Allocates nothing.
+    ///
+    /// # Panics
+    /// If `tracked_world` does not have one transform per joint.
+    pub fn track(&mut self, tracked: &Pose, tracked_world: &[Affine3A]) {
         self.tracked.clone_from(tracked);
-        rig.locals(tracked, limits, &mut self.locals);
-        forward_kinematics(rig.skeleton(), &self.locals, &mut self.tracked_world);
+        self.tracked_world.copy_from_slice(tracked_world);
         for (f, chain) in self.fingers.iter().enumerate() {
             self.closure[f].tracked = chain.dofs.iter().map(|&(i, _)| tracked.angles[i]).sum();
         }
@@ -263,12 +272,11 @@ impl ContactConstraint {
     /// against `objects`; `held`, the object in the hand, moves with the hand, so it does not
     /// stop the wrist, and the fingers that touched it keep their grip (the module
     /// documentation, stage 2). Allocates nothing once `near` has grown to the scene.
-    pub fn solve(&mut self, rig: &HandRig, limits: Limits, objects: &ObjectColliders, held: Option<usize>, now: f64) {
+    pub fn solve(&mut self, objects: &ObjectColliders, held: Option<usize>, now: f64) {
         if self.near.capacity() < objects.objects().len() {
             self.near.reserve(objects.objects().len());
         }
-        let tracked = &self.tracked;
-        let target = tracked.wrist.unwrap_or_else(|| rig.rest_wrist());
+        let target = self.tracked.wrist.unwrap_or_else(|| self.kinematics.rig().rest_wrist());
         let (wrist, carrier) = match self.grip {
             Some((object, offset)) if Some(object) == held => {
                 self.held_back_since = None;
@@ -277,7 +285,7 @@ impl ContactConstraint {
             }
             _ => {
                 self.grip = None;
-                (self.solve_wrist(rig, target, objects, held, now), None)
+                (self.solve_wrist(target, objects, held, now), None)
             }
         };
         // Carried by the same object last frame and this one, the hand has not moved on it:
@@ -290,12 +298,12 @@ impl ContactConstraint {
         // Per finger: its rendered angles are the last frame's.
         let mut kept = [false; 5];
         for (f, kept) in kept.iter_mut().enumerate() {
-            self.close_finger(rig, limits, f, objects, held, still_on.is_some());
+            self.close_finger(f, objects, held, still_on.is_some());
             let chain = &self.fingers[f];
             let same = |i: usize| self.rendered.angles[i].to_bits() == self.previous.angles[i].to_bits();
             *kept = chain.dofs.iter().all(|&(i, _)| same(i)) && chain.others.iter().all(|&i| same(i));
         }
-        self.forward(rig, limits);
+        self.kinematics.pose(&self.rendered);
         self.find_contacts(objects, still_on, kept);
         self.carried = carrier.map(|o| (o, objects.collider(o).pose));
         for (f, chain) in self.fingers.iter().enumerate() {
@@ -303,13 +311,16 @@ impl ContactConstraint {
         }
     }
 
-    fn forward(&mut self, rig: &HandRig, limits: Limits) {
-        rig.locals(&self.rendered, limits, &mut self.locals);
-        forward_kinematics(rig.skeleton(), &self.locals, &mut self.world);
+    /// Forward kinematics of a pose conservative advancement tries (the rendered angles so
+    /// far), into the trial transforms: a step of the search, not the rendered hand.
+    fn forward_trial(&mut self) {
+        let rig = self.kinematics.rig();
+        rig.locals(&self.rendered, self.kinematics.limits(), &mut self.trial_locals);
+        forward_kinematics(rig.skeleton(), &self.trial_locals, &mut self.trial_world);
     }
 
     /// Stage 1: the first time of impact of the palm on its way to `target`.
-    fn solve_wrist(&mut self, rig: &HandRig, target: DualQuat, objects: &ObjectColliders, held: Option<usize>, now: f64) -> DualQuat {
+    fn solve_wrist(&mut self, target: DualQuat, objects: &ObjectColliders, held: Option<usize>, now: f64) -> DualQuat {
         let Some(start) = self.wrist else { return target };
         let (r0, t0) = start.to_rotation_translation();
         let (r1, t1) = target.to_rotation_translation();
@@ -319,8 +330,9 @@ impl ContactConstraint {
         let start_affine = Affine3A::from_rotation_translation(r0, t0);
         // The whole hand moves rigidly, its fingers as last rendered: a finger or the thenar
         // must not be carried into an object by the wrist either.
-        let to_wrist = self.world[rig.wrist()].inverse();
-        let reach = self.proxies.colliders().iter().map(|p| (to_wrist * self.world[p.joint]).translation.length() + p.extent).fold(0.0, f32::max);
+        let world = self.kinematics.world();
+        let to_wrist = world[self.kinematics.rig().wrist()].inverse();
+        let reach = self.proxies.colliders().iter().map(|p| (to_wrist * world[p.joint]).translation.length() + p.extent).fold(0.0, f32::max);
         // The fastest any proxy point moves, m per unit of the motion: how far the hand moves,
         // and what turns the stop gap into a time.
         let speed = linvel.length() + angvel.length() * reach;
@@ -332,7 +344,7 @@ impl ContactConstraint {
         self.uncast = 0.0;
         let mut toi: f32 = 1.0;
         for p in self.proxies.colliders() {
-            let offset = to_wrist * self.world[p.joint];
+            let offset = to_wrist * world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
             let radius = offset.translation.length() + p.extent;
@@ -359,7 +371,7 @@ impl ContactConstraint {
             return target;
         }
         let since = *self.held_back_since.get_or_insert(now);
-        if now - since > SNAP_AFTER_S && self.hand_free(rig, target, objects, held) {
+        if now - since > SNAP_AFTER_S && self.hand_free(target, objects, held) {
             self.held_back_since = None;
             return target;
         }
@@ -368,9 +380,9 @@ impl ContactConstraint {
     }
 
     /// Whether the tracked hand is clear of every object with its wrist at `wrist`.
-    fn hand_free(&self, rig: &HandRig, wrist: DualQuat, objects: &ObjectColliders, held: Option<usize>) -> bool {
+    fn hand_free(&self, wrist: DualQuat, objects: &ObjectColliders, held: Option<usize>) -> bool {
         let (r, t) = wrist.to_rotation_translation();
-        let at = Affine3A::from_rotation_translation(r, t) * self.tracked_world[rig.wrist()].inverse();
+        let at = Affine3A::from_rotation_translation(r, t) * self.tracked_world[self.kinematics.rig().wrist()].inverse();
         self.proxies.colliders().iter().all(|p| {
             let pose = pose_of(&(at * self.tracked_world[p.joint]));
             let aabb = p.shape.compute_aabb(&pose);
@@ -392,7 +404,7 @@ impl ContactConstraint {
     /// a gripping finger that stopped on contacts with it last frame stop there again at once:
     /// they are kept without a query, and only the joints past them close (none, when every
     /// joint had stopped on it).
-    fn close_finger(&mut self, rig: &HandRig, limits: Limits, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
+    fn close_finger(&mut self, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
         let chain = std::mem::take(&mut self.fingers[f]);
         if chain.dofs.is_empty() {
             self.fingers[f] = chain;
@@ -420,8 +432,8 @@ impl ContactConstraint {
                 self.rendered.angles[i] = self.previous.angles[i];
             }
         }
-        self.forward(rig, limits);
-        let root = Vec3::from(self.world[chain.dofs[0].1].translation);
+        self.forward_trial();
+        let root = Vec3::from(self.trial_world[chain.dofs[0].1].translation);
         let reach = Aabb::from_half_extents(root, Vec3::splat(chain.reach));
         self.near.clear();
         self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
@@ -453,7 +465,7 @@ impl ContactConstraint {
             }
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
-                self.forward(rig, limits);
+                self.forward_trial();
                 // The nearest moving proxy (its distance, last DOF and the object), and the
                 // largest step no point of any can overrun.
                 let mut nearest = (f32::INFINITY, 0, usize::MAX);
@@ -463,7 +475,7 @@ impl ContactConstraint {
                         continue;
                     }
                     let proxy = &self.proxies.colliders()[*p];
-                    let pose = pose_of(&self.world[proxy.joint]);
+                    let pose = pose_of(&self.trial_world[proxy.joint]);
                     let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                     for &o in &self.near {
                         let here = objects.collider(o).distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE);
@@ -542,7 +554,7 @@ impl ContactConstraint {
             }
         }
         for p in self.proxies.colliders() {
-            let pose = pose_of(&self.world[p.joint]);
+            let pose = pose_of(&self.kinematics.world()[p.joint]);
             let aabb = p.shape.compute_aabb(&pose);
             let skip = still_on.map(|(o, _)| o).filter(|_| unmoved(p.joint));
             for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, skip).filter(|(i, _)| *i < objects.objects().len()) {
@@ -566,7 +578,14 @@ impl ContactConstraint {
     /// The world transform of each joint in the rendered pose.
     #[must_use]
     pub fn world(&self) -> &[Affine3A] {
-        &self.world
+        self.kinematics.world()
+    }
+
+    /// The rendered hand's kinematics layer (posed once per [`Self::solve`]): what the skin
+    /// layer deforms for the hand the user sees.
+    #[must_use]
+    pub fn kinematics(&self) -> &HandKinematics {
+        &self.kinematics
     }
 
     /// The world transform of each joint in the tracked pose.

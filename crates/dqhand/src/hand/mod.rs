@@ -143,7 +143,7 @@ pub fn build(params: &HandParams) -> Result<Model> {
     Ok(Model {
         description: format!("anatomical {} hand, length {l} m, breadth {b} m, {vertices} vertices", side.name()),
         skeleton,
-        mesh,
+        mesh: std::sync::Arc::new(mesh),
         warnings,
     })
 }

@@ -45,7 +45,7 @@ pub struct InputConfig {
     pub max_rate_hz: f64,
     /// The wrist tracker's mounting offset.
     pub tracker_mount: MountingOffset,
-    /// Gestures as commands: which held gesture triggers which viewer action.
+    /// Gestures as commands: which held gesture triggers which of the application's actions.
     pub actions: Vec<GestureAction>,
 }
 
@@ -58,21 +58,9 @@ pub struct GestureAction {
     /// How long the gesture must be held, seconds from its start event.
     #[serde(default)]
     pub hold_s: f32,
-    /// The action: `next_method` (cycle LB → QB → DQB in the single view), `split_view`
-    /// (LB, QB, DQB side by side), `toggle_heatmap`.
-    pub action: Action,
-}
-
-/// What a gesture command does in the viewer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Action {
-    /// Show the next skinning method alone.
-    NextMethod,
-    /// Show LB, QB and DQB side by side.
-    SplitView,
-    /// Toggle the distortion heat map.
-    ToggleHeatmap,
+    /// The action, named as the application that carries it out defines it (the dqhand
+    /// viewer's: `next_method`, `split_view`, `toggle_heatmap`).
+    pub action: String,
 }
 
 impl Default for InputConfig {
@@ -89,9 +77,9 @@ impl Default for InputConfig {
             max_rate_hz: 1_000.0,
             tracker_mount: MountingOffset::default(),
             actions: vec![
-                GestureAction { gesture: "thumbs_up".into(), hold_s: 0.5, action: Action::NextMethod },
-                GestureAction { gesture: "victory".into(), hold_s: 0.5, action: Action::SplitView },
-                GestureAction { gesture: "rock".into(), hold_s: 0.8, action: Action::ToggleHeatmap },
+                GestureAction { gesture: "thumbs_up".into(), hold_s: 0.5, action: "next_method".into() },
+                GestureAction { gesture: "victory".into(), hold_s: 0.5, action: "split_view".into() },
+                GestureAction { gesture: "rock".into(), hold_s: 0.8, action: "toggle_heatmap".into() },
             ],
         }
     }

@@ -19,7 +19,7 @@ mod rejection;
 mod retarget;
 mod tracker_mount;
 
-pub use config::{Action, GestureAction, InputConfig};
+pub use config::{GestureAction, InputConfig};
 pub use glove_calibration::{Calibration, SensorCalibration, MIN_HOLD_FRAMES, MIN_MOVEMENT};
 pub use glove_csv::{GloveCsvReader, GloveCsvWriter};
 pub use glove_layout::{GloveLayout, Sensor, SensorKind, RAW_MAX};

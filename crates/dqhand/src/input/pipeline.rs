@@ -206,14 +206,16 @@ impl InputPipeline {
         true
     }
 
-    /// Takes one record: from a file with `arrival` `None`, live with its local arrival time
-    /// (seconds, any origin, monotonic). The hand is first brought up to that time as by
+    /// Takes one record: from a file without [`Record::arrival`], live (or recorded live) with
+    /// its local arrival time (seconds, any origin, monotonic), which lateness and loss of
+    /// tracking are judged on. The hand is first brought up to that time as by
     /// [`Self::advance`], so the pose it blends back from after a loss does not depend on
     /// when the caller last advanced it: a replay gives the poses the live input gave.
     ///
     /// # Errors
     /// The record's refusal (also counted in [`Self::rejections`]); the shown pose is kept.
-    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
+    pub fn push(&mut self, record: &Record) -> Result<(), Rejection> {
+        let arrival = record.arrival;
         self.advance(arrival.unwrap_or(record.time));
         let result = self.take(record, arrival);
         if let Err(r) = &result {

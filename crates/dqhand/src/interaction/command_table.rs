@@ -1,9 +1,8 @@
 //! Gestures as commands: a table of held gestures and the commands they trigger (the
-//! paper's "gestures act as commands"), each once per hold: the input configuration's viewer
-//! actions, a scene file's scene actions.
+//! paper's "gestures act as commands"), each once per hold: a scene file's scene actions, or
+//! an application's own rows (the viewer's, from the input configuration's `actions`).
 
 use crate::gesture::{Event, EventKind, GestureSet};
-use crate::input::{Action, GestureAction};
 use crate::scene::{SceneAction, SceneCommand};
 use crate::{Error, Result};
 
@@ -17,19 +16,6 @@ pub trait CommandRow {
     fn hold_s(&self) -> f32;
     /// The command.
     fn command(&self) -> Self::Command;
-}
-
-impl CommandRow for GestureAction {
-    type Command = Action;
-    fn gesture(&self) -> &str {
-        &self.gesture
-    }
-    fn hold_s(&self) -> f32 {
-        self.hold_s
-    }
-    fn command(&self) -> Action {
-        self.action
-    }
 }
 
 impl CommandRow for SceneAction {
@@ -97,9 +83,25 @@ impl<R: CommandRow + Clone> CommandTable<R> {
 mod tests {
     use super::*;
 
-    fn table(rows: &[(&str, f32, Action)]) -> CommandTable<GestureAction> {
-        let actions: Vec<_> = rows.iter().map(|&(g, hold_s, action)| GestureAction { gesture: g.into(), hold_s, action }).collect();
-        CommandTable::new(&actions, &GestureSet::builtin()).unwrap()
+    /// A row whose command is a number.
+    #[derive(Clone, Debug)]
+    struct Row(&'static str, f32, u8);
+
+    impl CommandRow for Row {
+        type Command = u8;
+        fn gesture(&self) -> &str {
+            self.0
+        }
+        fn hold_s(&self) -> f32 {
+            self.1
+        }
+        fn command(&self) -> u8 {
+            self.2
+        }
+    }
+
+    fn table(rows: &[Row]) -> CommandTable<Row> {
+        CommandTable::new(rows, &GestureSet::builtin()).unwrap()
     }
 
     fn start(t: f64, gesture: &str) -> [Event<'_>; 1] {
@@ -112,41 +114,40 @@ mod tests {
 
     #[test]
     fn fires_once_per_hold_after_its_time() {
-        let mut t = table(&[("thumbs_up", 0.5, Action::NextMethod)]);
+        let mut t = table(&[Row("thumbs_up", 0.5, 1)]);
         assert_eq!(t.update(1.0, start(1.0, "thumbs_up")), None);
         assert_eq!(t.update(1.49, []), None);
-        assert_eq!(t.update(1.5, []), Some(Action::NextMethod));
+        assert_eq!(t.update(1.5, []), Some(1));
         assert_eq!(t.update(2.5, []), None, "once per hold");
         assert_eq!(t.update(2.6, end(2.6, "thumbs_up")), None);
         assert_eq!(t.update(3.0, start(3.0, "thumbs_up")), None);
-        assert_eq!(t.update(3.5, []), Some(Action::NextMethod), "a new hold fires again");
+        assert_eq!(t.update(3.5, []), Some(1), "a new hold fires again");
     }
 
     #[test]
     fn another_gesture_restarts_the_hold() {
-        let mut t = table(&[("rock", 0.8, Action::ToggleHeatmap)]);
+        let mut t = table(&[Row("rock", 0.8, 3)]);
         assert_eq!(t.update(0.0, start(0.0, "rock")), None);
         let switch = [Event { t: 0.5, event: EventKind::End, gesture: "rock" }, Event { t: 0.5, event: EventKind::Start, gesture: "fist" }];
         assert_eq!(t.update(0.5, switch), None);
         assert_eq!(t.update(1.0, []), None, "fist has no row");
         assert_eq!(t.update(1.1, start(1.1, "rock")), None);
         assert_eq!(t.update(1.8, []), None, "0.7 s of this hold");
-        assert_eq!(t.update(1.95, []), Some(Action::ToggleHeatmap));
+        assert_eq!(t.update(1.95, []), Some(3));
     }
 
     #[test]
     fn rows_of_one_gesture_fire_in_turn() {
-        let mut t = table(&[("victory", 0.0, Action::SplitView), ("point", 0.0, Action::NextMethod), ("victory", 1.0, Action::ToggleHeatmap)]);
-        assert_eq!(t.update(0.0, start(0.0, "victory")), Some(Action::SplitView));
+        let mut t = table(&[Row("victory", 0.0, 2), Row("point", 0.0, 1), Row("victory", 1.0, 3)]);
+        assert_eq!(t.update(0.0, start(0.0, "victory")), Some(2));
         assert_eq!(t.update(0.5, []), None);
-        assert_eq!(t.update(1.0, []), Some(Action::ToggleHeatmap));
+        assert_eq!(t.update(1.0, []), Some(3));
         assert_eq!(t.update(5.0, []), None);
     }
 
     #[test]
     fn an_unknown_gesture_is_a_config_error_naming_it() {
-        let actions = [GestureAction { gesture: "wave".into(), hold_s: 0.5, action: Action::NextMethod }];
-        let e = CommandTable::new(&actions, &GestureSet::builtin()).unwrap_err().to_string();
+        let e = CommandTable::new(&[Row("wave", 0.5, 1)], &GestureSet::builtin()).unwrap_err().to_string();
         assert!(e.contains("\"wave\""), "{e}");
     }
 }

@@ -14,11 +14,10 @@ use parry3d::query::Ray;
 
 use super::synthetic::joint_set;
 use crate::collision::ObjectColliders;
-use crate::engine::Engine;
 use crate::gesture::gesture;
 use crate::hand::Side;
 use crate::input::{HandData, Record};
-use crate::kinematics::{JointModel, JointPositions, Motion, Pose};
+use crate::kinematics::{HandKinematics, JointModel, JointPositions, Motion, Pose};
 use crate::math::DualQuat;
 use crate::model::Model;
 use crate::{Error, Result, SceneProblem};
@@ -93,25 +92,25 @@ struct HandFrame {
     grip: Vec3,
 }
 
-/// The WebXR joints of `engine`'s hand in `pose`, in its wrist's frame.
-fn in_wrist(engine: &mut Engine, joints: &JointPositions, pose: &Pose) -> [Vec3; 25] {
-    engine.pose(pose);
-    let world = engine.world();
-    let wrist = engine.rig().expect("a joint-model engine").wrist();
+/// The WebXR joints of `hand` in `pose`, in its wrist's frame.
+fn in_wrist(hand: &mut HandKinematics, joints: &JointPositions, pose: &Pose) -> [Vec3; 25] {
+    hand.pose(pose);
+    let world = hand.world();
+    let wrist = hand.rig().wrist();
     let to_wrist = world[wrist].inverse();
     joints.read(world).map(|p| to_wrist.transform_point3(p))
 }
 
-fn hand_frame(engine: &mut Engine, joints: &JointPositions, closing: &Closing) -> HandFrame {
-    let dofs = engine.rig().expect("a joint-model engine").dofs().len();
-    let p = in_wrist(engine, joints, &Pose::rest(dofs));
+fn hand_frame(hand: &mut HandKinematics, joints: &JointPositions, closing: &Closing) -> HandFrame {
+    let dofs = hand.rig().dofs().len();
+    let p = in_wrist(hand, joints, &Pose::rest(dofs));
     // WebXR order: 0 wrist, 11 middle proximal; palmar is the wrist's −Y.
     let fingers = p[11].normalize();
     let palmar = (-Vec3::Y - fingers * fingers.dot(-Vec3::Y)).normalize();
     // The palm's surface: its thickness is about a third of a metacarpal's length.
     let palm = p[11] * 0.55 + palmar * (p[11].length() * 0.3);
     let pinch = closing.pinch;
-    let half = in_wrist(engine, joints, &closing.pose(if pinch { 1.0 / PINCH_OVERSHOOT } else { 0.5 }));
+    let half = in_wrist(hand, joints, &closing.pose(if pinch { 1.0 / PINCH_OVERSHOOT } else { 0.5 }));
     // WebXR order: 4 thumb tip, 9 index tip, 14 middle tip.
     let grip = (half[4] + half[if pinch { 9 } else { 14 }]) / 2.0;
     HandFrame { palm, palmar, fingers, grip }
@@ -202,7 +201,7 @@ type Key = (f64, Vec3, f32);
 ///
 /// # Errors
 /// [`SceneProblem::NoObject`] if the scene has no object of the task's; as
-/// [`Engine::with_joint_model`].
+/// [`Model::hand_kinematics`].
 pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &GraspTask, side: Side) -> Result<Script> {
     let object = objects
         .objects()
@@ -211,10 +210,10 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         .ok_or_else(|| Error::Scene { file: file.to_owned(), problem: SceneProblem::NoObject(task.object.clone()) })?;
     let d = task.approach.normalize();
     let f = (task.fingers - d * task.fingers.dot(d)).normalize();
-    let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
-    let joints = JointPositions::new(engine.skeleton())?;
+    let mut hand = model.hand_kinematics(JointModel::Full)?;
+    let joints = JointPositions::new(hand.skeleton())?;
     let closing = Closing::new(task.pinch);
-    let frame = hand_frame(&mut engine, &joints, &closing);
+    let frame = hand_frame(&mut hand, &joints, &closing);
     let rotation = {
         let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
         let world = Mat3::from_cols(d, f, d.cross(f));
@@ -271,8 +270,8 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
         let palm = p0.lerp(p1, s);
         let mut pose = closing.pose(c0 + (c1 - c0) * s);
         pose.wrist = Some(DualQuat::from_rotation_translation(rotation, palm - rotation * frame.palm));
-        engine.pose(&pose);
-        let world: &[Affine3A] = engine.world();
+        hand.pose(&pose);
+        let world: &[Affine3A] = hand.world();
         let positions = joints.read(world);
         script.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None, arrival: None });
         script.truth.push(pose);

@@ -16,11 +16,10 @@ use glam::{Quat, Vec3};
 
 use super::{CommandTable, GestureLoop};
 use crate::collision::{fit_proxies, Contact, ContactConstraint, HandProxies, ObjectColliders, PROXY_MARGIN};
-use crate::engine::Engine;
 use crate::gesture::{Events, GestureSet};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
 use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
-use crate::kinematics::JointModel;
+use crate::kinematics::{HandKinematics, JointModel};
 use crate::model::Model;
 use crate::physics::ScenePhysics;
 use crate::scene::{Scene, SceneAction, SceneCommand};
@@ -40,7 +39,6 @@ pub struct ManipulationLoop {
     constraint: ContactConstraint,
     grasp: Grasp,
     physics: ScenePhysics,
-    rendered: Engine,
     poses: Vec<(Quat, Vec3)>,
     last: Option<f64>,
     reset_due: bool,
@@ -60,10 +58,9 @@ impl ManipulationLoop {
             Some(set) if !scene.actions.is_empty() => Some(CommandTable::new(&scene.actions, set)?),
             _ => None,
         };
-        let rendered = Engine::with_joint_model(model.clone(), joint_model)?;
-        let rig = rendered.rig().expect("an engine with a joint model has a rig");
-        let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rig.skeleton());
-        let constraint = ContactConstraint::new(proxies.clone(), rig);
+        let rendered = input.kinematics().clone();
+        let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rendered.skeleton());
+        let constraint = ContactConstraint::new(proxies.clone(), rendered);
         let objects = ObjectColliders::new(scene)?;
         let mut physics = ScenePhysics::new(scene, &objects);
         physics.add_hand(&proxies);
@@ -78,7 +75,6 @@ impl ManipulationLoop {
             constraint,
             grasp: Grasp::new(params, n),
             physics,
-            rendered,
             poses,
             last: None,
             reset_due: false,
@@ -86,25 +82,15 @@ impl ManipulationLoop {
         })
     }
 
-    /// The loop with the input configuration's viewer commands too ([`GestureLoop::with_commands`]),
-    /// where gestures also drive a viewer.
-    ///
-    /// # Errors
-    /// As [`GestureLoop::with_commands`].
-    pub fn with_commands(mut self) -> Result<Self> {
-        self.input = self.input.with_commands()?;
-        Ok(self)
-    }
-
-    /// Takes one record (`arrival` as in [`GestureLoop::push`]) and returns the gesture events
+    /// Takes one record (as [`GestureLoop::push`]) and returns the gesture events
     /// it caused; a scene action its gesture completes ([`Self::command`]) is carried out at
     /// the next [`Self::step`]. Allocates nothing.
     ///
     /// # Errors
     /// The record's refusal; the hand keeps its pose.
-    pub fn push(&mut self, record: &Record, arrival: Option<f64>) -> std::result::Result<Events<'_>, Rejection> {
+    pub fn push(&mut self, record: &Record) -> std::result::Result<Events<'_>, Rejection> {
         self.command = None;
-        let events = self.input.push(record, arrival)?;
+        let events = self.input.push(record)?;
         if let Some(table) = &mut self.scene_commands {
             self.command = table.update(record.time, events.clone());
             self.reset_due |= self.command == Some(SceneCommand::Reset);
@@ -147,10 +133,8 @@ impl ManipulationLoop {
             self.constraint.restart();
         }
         self.was_tracking = tracking;
-        let engine = self.input.engine();
-        let rig = engine.rig().expect("a gesture loop's engine has a rig");
-        let limits = engine.limits();
-        self.constraint.track(rig, limits, self.input.pipeline().pose());
+        let tracked = self.input.kinematics();
+        self.constraint.track(self.input.pipeline().pose(), tracked.world());
         let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world(), self.constraint.world());
         if let Some((q, t)) = self.grasp.target() {
             let held = self.grasp.held().expect("a target is a held object's");
@@ -158,9 +142,9 @@ impl ManipulationLoop {
             self.objects.set_pose(held, q, t);
             self.poses[held] = (q, t);
         }
-        self.constraint.solve(rig, limits, &self.objects, self.grasp.held(), now);
+        self.constraint.solve(&self.objects, self.grasp.held(), now);
         if event.is_none() {
-            event = self.grasp.detect(now, tracking, self.constraint.contacts(), self.constraint.closure(), self.constraint.world(), self.constraint.tracked_world(), rig.wrist(), &self.poses);
+            event = self.grasp.detect(now, tracking, self.constraint.contacts(), self.constraint.closure(), self.constraint.world(), self.constraint.tracked_world(), tracked.rig().wrist(), &self.poses);
         }
         match event {
             Some(GraspEvent::Grasp { object }) => self.constraint.grip(object, &self.objects.objects()[object].pose),
@@ -174,7 +158,6 @@ impl ManipulationLoop {
         self.physics.move_hand(self.constraint.world());
         self.physics.step(dt as f32);
         self.read_poses();
-        self.rendered.pose(self.constraint.rendered());
         event
     }
 
@@ -228,15 +211,11 @@ impl ManipulationLoop {
         &self.constraint
     }
 
-    /// The engine posed with the rendered hand, to skin ([`Engine::skin`]).
-    pub fn rendered_mut(&mut self) -> &mut Engine {
-        &mut self.rendered
-    }
-
-    /// The engine posed with the rendered hand.
+    /// The rendered hand's kinematics layer, posed once per frame by the contact constraint:
+    /// what a [`crate::skin::SkinLayer`] deforms for the hand the user sees.
     #[must_use]
-    pub fn rendered(&self) -> &Engine {
-        &self.rendered
+    pub fn rendered(&self) -> &HandKinematics {
+        self.constraint.kinematics()
     }
 
     /// The gesture loop under it (pipeline, recognised gesture).

@@ -11,12 +11,10 @@
 //! dropped. Records carry joints (with orientations), MediaPipe landmarks, or glove values
 //! with a wrist tracker.
 
-use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::engine::Engine;
 use crate::gesture::{gesture, GESTURES};
 use crate::hand::{HandParams, Side};
 use crate::input::{mediapipe, Calibration, GloveSample, HandData, JointSet, MappingTable, MountingOffset, Record, RigidPose, TrackedJoint};
@@ -157,15 +155,15 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         }
     });
     let model = crate::hand::build(&HandParams { vertices: *crate::hand::VERTEX_RANGE.start(), ..hand })?;
-    let mut engine = Engine::with_joint_model(Arc::new(model), JointModel::Full)?;
-    let rig = engine.rig().expect("an engine with a joint model has a rig").clone();
-    let joints = JointPositions::new(engine.skeleton())?;
+    let mut posed = model.hand_kinematics(JointModel::Full)?;
+    let rig = posed.rig().clone();
+    let joints = JointPositions::new(posed.skeleton())?;
     let rest_wrist = rig.rest_wrist();
 
     // The shapes: the library and thumbs down, in a shuffled cycle.
     let thumbs_up = gesture("thumbs_up")?.pose(JointModel::Full);
-    engine.pose(&thumbs_up);
-    let thumb = joints.read(engine.world());
+    posed.pose(&thumbs_up);
+    let thumb = joints.read(posed.world());
     let thumb_direction = (thumb[4] - thumb[2]).normalize();
     let up_turn = Quat::from_rotation_arc(thumb_direction, Vec3::Y);
     let down_turn = Quat::from_rotation_arc(thumb_direction, -Vec3::Y);
@@ -249,8 +247,8 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         if rng.next_f64() < params.drop_rate {
             continue;
         }
-        engine.pose(&pose);
-        let world = engine.world();
+        posed.pose(&pose);
+        let world = posed.world();
         let mut positions = joints.read(world);
         for p in &mut positions {
             *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;

@@ -227,7 +227,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     let (mesh, mesh_warnings) = SkinnedMesh::new(data)?;
     warnings.extend(mesh_warnings);
     let name = path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into_owned());
-    Ok(Model { description: format!("glTF file {name}"), skeleton, mesh, warnings })
+    Ok(Model { description: format!("glTF file {name}"), skeleton, mesh: std::sync::Arc::new(mesh), warnings })
 }
 
 /// How many JOINTS/WEIGHTS sets (of four influences) a primitive has: 1 or 2.

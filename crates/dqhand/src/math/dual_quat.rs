@@ -6,7 +6,7 @@
 //! the paper uses them as the hand's pseudo-muscle layer.
 
 use core::ops::{Add, Mul, Neg};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Affine3A, Mat4, Quat, Vec3};
 
 use super::Screw;
 
@@ -69,6 +69,13 @@ impl DualQuat {
     /// which is why DQB and QB ignore scaled bones that LB follows).
     #[must_use]
     pub fn from_mat4(m: &Mat4) -> Self {
+        let (_, rotation, translation) = m.to_scale_rotation_translation();
+        Self::from_rotation_translation(rotation.normalize(), translation)
+    }
+
+    /// The rigid part of an affine transform, as [`Self::from_mat4`].
+    #[must_use]
+    pub fn from_affine(m: &Affine3A) -> Self {
         let (_, rotation, translation) = m.to_scale_rotation_translation();
         Self::from_rotation_translation(rotation.normalize(), translation)
     }

@@ -9,11 +9,10 @@ use serde_json::{json, Value};
 
 use super::{count_self_intersections, edge_distortion, JointRegion};
 use crate::geometry::{check_closed, edges, enclosed_volume};
-use crate::engine::Engine;
 use crate::gesture::gesture;
-use crate::kinematics::{HandRig, JointModel, Limits, Pose, Transform};
+use crate::kinematics::{HandRig, JointModel, KinematicsLayer, Limits, Pose, Transform};
 use crate::model::Model;
-use crate::skin::{Method, MethodSet};
+use crate::skin::{Method, MethodSet, SkinLayer};
 use crate::{Error, Result};
 
 /// What one sweep moves.
@@ -109,15 +108,18 @@ pub struct Report {
 /// The gestures whose self-intersections are counted.
 const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs_up"];
 
-/// Measures LB, QB and DQB on every sweep, each frame one step of the [`Engine`].
+/// Measures LB, QB and DQB on every sweep, each frame posed once by the kinematics layer
+/// and deformed by each method of the skin layer.
 ///
 /// # Errors
 /// [`Error::MissingJoint`] or [`Error::JointFrame`] if the model lacks the WebXR hand joints
 /// the sweeps move; [`Error::NoSkin`] if no skin lies around a measured joint.
 pub fn measure(model: Arc<Model>) -> Result<Report> {
-    let mut engine = Engine::with_joint_model(model.clone(), JointModel::Full)?;
-    engine.set_methods(MethodSet::ALL);
-    let rig = engine.rig().expect("made with a joint model").clone();
+    let mut hand = model.hand_kinematics(JointModel::Full)?;
+    // The sweeps turn joints by local transforms of the rig's chain, the gestures by angles.
+    let mut layer = KinematicsLayer::new(hand.skeleton().clone(), model.mesh.inverse_bind());
+    let mut skin = SkinLayer::new(Arc::clone(&model.mesh), MethodSet::ALL);
+    let rig = hand.rig().clone();
     let skeleton = rig.skeleton();
     let mesh = &model.mesh;
     let closed = check_closed(mesh.indices());
@@ -140,11 +142,11 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         let mut previous: [Option<Vec<[f32; 3]>>; 3] = Default::default();
         for &value in &spec.values {
             pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
-            engine.pose_locals(&locals);
+            layer.pose_locals(&locals);
+            skin.deform(&layer);
             for m in Method::ALL {
-                engine.skin(m);
-                let posed = engine.deformed(m).positions();
-                let world = engine.world();
+                let posed = skin.deformed(m).expect("every method is in the set").positions();
+                let world = layer.world();
                 let (min_distance, max_distance) = region.distance_ratios(mesh, &bind_world, world, posed);
                 let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
                 let jump = previous[m.index()].as_ref().map_or(0.0, |p| {
@@ -166,8 +168,9 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     }
     let mut intersections = Vec::new();
     for name in INTERSECTION_GESTURES {
-        engine.step(&gesture(name)?.pose(JointModel::Full));
-        let counts = Method::ALL.map(|m| count_self_intersections(engine.deformed(m).positions(), mesh.indices()));
+        hand.pose(&gesture(name)?.pose(JointModel::Full));
+        skin.deform(hand.layer());
+        let counts = Method::ALL.map(|m| count_self_intersections(skin.deformed(m).expect("every method is in the set").positions(), mesh.indices()));
         intersections.push((name, counts));
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());

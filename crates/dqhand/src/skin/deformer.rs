@@ -8,9 +8,11 @@ use rayon::prelude::*;
 
 use super::crew::Crew;
 use super::kernel::{self, Frame, FrameTable, Kernel};
-use super::skinned_mesh::{SkinnedMesh, LANES};
+use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
 use super::Method;
 use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
+use crate::kinematics::KinematicsLayer;
+use crate::math::DualQuat;
 
 /// Deformed positions and normals of one frame, in the mesh's vertex order.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +48,50 @@ impl Deformed {
     pub fn normals(&self) -> &[[f32; 3]] {
         &self.normals[..self.vertex_count.min(self.normals.len())]
     }
+}
+
+/// The bones' transforms a deformation reads: the skinning matrices and, where the
+/// kinematics layer has made them, their unit dual quaternions (then not converted again).
+#[derive(Clone, Copy, Debug)]
+pub struct Bones<'a> {
+    /// #joints skinning transforms `world · inverse_bind`.
+    pub skinning: &'a [Affine3A],
+    /// The same as unit dual quaternions (#joints), if already computed.
+    pub dual_quats: Option<&'a [DualQuat]>,
+}
+
+impl<'a> From<&'a [Affine3A]> for Bones<'a> {
+    fn from(skinning: &'a [Affine3A]) -> Self {
+        Self { skinning, dual_quats: None }
+    }
+}
+
+impl<'a> From<&'a Vec<Affine3A>> for Bones<'a> {
+    fn from(skinning: &'a Vec<Affine3A>) -> Self {
+        Self { skinning, dual_quats: None }
+    }
+}
+
+impl<'a> From<&'a KinematicsLayer> for Bones<'a> {
+    fn from(layer: &'a KinematicsLayer) -> Self {
+        Self { skinning: layer.skinning(), dual_quats: Some(layer.dual_quats()) }
+    }
+}
+
+/// The caller's memory a deformation writes ([`Deformer::deform_into`]): `f32` components
+/// `[x, y, z]` per vertex, unpadded, in the mesh's vertex order.
+#[derive(Debug)]
+pub enum VertexBuffers<'a> {
+    /// Positions (#V × 3, m) and, if given, unit normals (#V × 3); without normals their work
+    /// is skipped.
+    Separate {
+        /// #V × 3 floats.
+        positions: &'a mut [f32],
+        /// #V × 3 floats, or none.
+        normals: Option<&'a mut [f32]>,
+    },
+    /// `[px, py, pz, nx, ny, nz]` per vertex (#V × 6 floats), as many vertex buffers are laid out.
+    Interleaved(&'a mut [f32]),
 }
 
 /// Vertices below which a deformation is not split across threads (a split costs a few µs
@@ -113,21 +159,78 @@ impl Deformer {
         self.kernel.or_best()
     }
 
-    /// Deforms `mesh` by the skinning transforms into `out` (positions and normals, or
+    /// Deforms `mesh` by the bones' transforms into `out` (positions and normals, or
     /// positions only, as `out` was made).
     ///
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
-    /// and translation, or dual quaternion), and for the quaternion methods one sign per pair
-    /// of joints that share a vertex, aligning the other joint's rotation to the hemisphere
-    /// of the heaviest one. Steps 2–6: every vertex is blended, split across the crew's
-    /// threads if there is one. Allocates nothing.
+    /// and translation, or dual quaternion: the kinematics layer's own, where `bones` carries
+    /// them), and for the quaternion methods one sign per pair of joints that share a vertex,
+    /// aligning the other joint's rotation to the hemisphere of the heaviest one. Steps 2–6:
+    /// every vertex is blended, split across the crew's threads if there is one. Allocates
+    /// nothing.
     ///
-    /// * `skinning` — #joints transforms `world · inverse_bind`, from [`skinning_transforms`].
+    /// * `bones` — #joints skinning transforms `world · inverse_bind`: a
+    ///   [`KinematicsLayer`], or a slice of them ([`skinning_transforms`]).
     ///
     /// # Panics
-    /// If `skinning`, `out` or the deformer were made for a mesh with other joints or pairs.
-    pub fn deform(&mut self, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut Deformed) {
+    /// If `bones`, `out` or the deformer were made for a mesh with other joints or pairs.
+    ///
+    /// [`skinning_transforms`]: crate::kinematics::skinning_transforms
+    pub fn deform<'a>(&mut self, mesh: &SkinnedMesh, bones: impl Into<Bones<'a>>, out: &mut Deformed) {
         assert_eq!(out.vertex_count, mesh.vertex_count(), "output buffers belong to another mesh");
+        self.prepare(mesh, bones.into());
+        self.blend(mesh, 0, &mut out.positions, &mut out.normals);
+    }
+
+    /// [`Self::deform`] into the caller's own memory (a mapped GPU buffer, a NumPy array),
+    /// unpadded, in the mesh's vertex order. Separate buffers are written directly by the
+    /// vertex loop (the last vertices of a partial block through a small stack buffer); an
+    /// interleaved buffer is written block by block through one. Allocates nothing.
+    ///
+    /// # Panics
+    /// As [`Self::deform`]; if a buffer's length is not #V × 3 (#V × 6 interleaved).
+    pub fn deform_into<'a>(&mut self, mesh: &SkinnedMesh, bones: impl Into<Bones<'a>>, out: VertexBuffers<'_>) {
+        let n = mesh.vertex_count();
+        let padded = mesh.pos[0].len();
+        self.prepare(mesh, bones.into());
+        let (mut tail_p, mut tail_n) = ([[0.0f32; 3]; BLOCK], [[0.0f32; 3]; BLOCK]);
+        match out {
+            VertexBuffers::Separate { positions, normals } => {
+                assert_eq!(positions.len(), n * 3, "positions: #V × 3 floats");
+                let (positions, _) = positions.as_chunks_mut::<3>();
+                let mut normals = normals.map(|b| {
+                    assert_eq!(b.len(), n * 3, "normals: #V × 3 floats");
+                    b.as_chunks_mut::<3>().0
+                });
+                // Whole blocks in place, the rest (fewer than a block, padded) on the stack.
+                let bulk = n / BLOCK * BLOCK;
+                let tail_n = if normals.is_some() { &mut tail_n[..padded - bulk] } else { &mut [][..] };
+                self.blend(mesh, 0, &mut positions[..bulk], normals.as_deref_mut().map_or(&mut [], |b| &mut b[..bulk]));
+                self.run(mesh, bulk / LANES, &mut tail_p[..padded - bulk], tail_n);
+                positions[bulk..].copy_from_slice(&tail_p[..n - bulk]);
+                if let Some(normals) = normals {
+                    normals[bulk..].copy_from_slice(&tail_n[..n - bulk]);
+                }
+            }
+            VertexBuffers::Interleaved(buffer) => {
+                assert_eq!(buffer.len(), n * 6, "interleaved: #V × 6 floats");
+                let (vertices, _) = buffer.as_chunks_mut::<6>();
+                for (b, block) in vertices.chunks_mut(BLOCK).enumerate() {
+                    let end = ((b + 1) * BLOCK).min(padded);
+                    let len = end - b * BLOCK;
+                    self.run(mesh, b * BLOCK / LANES, &mut tail_p[..len], &mut tail_n[..len]);
+                    for ((v, p), nrm) in block.iter_mut().zip(&tail_p).zip(&tail_n) {
+                        v[..3].copy_from_slice(p);
+                        v[3..].copy_from_slice(nrm);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Step 1 of paper 4.4 for this frame: bone parameters, pair signs, lookup tables.
+    fn prepare(&mut self, mesh: &SkinnedMesh, bones: Bones<'_>) {
+        let skinning = bones.skinning;
         assert_eq!(skinning.len(), mesh.inverse_bind().len(), "one skinning transform per joint");
         // Only the AVX-512 loop reads the lookup table (the same choice as `kernel::deform`'s).
         let avx512 = self.kernel() == Kernel::Avx512;
@@ -143,9 +246,19 @@ impl Deformer {
             }
             Method::Qb | Method::Dqb => {
                 assert_eq!(self.quat.len(), skinning.len(), "deformer made for another joint count");
-                let convert = if self.method == Method::Qb { qb::params } else { dqb::params };
-                for (d, m) in self.quat.iter_mut().zip(skinning) {
-                    *d = convert(m);
+                match bones.dual_quats {
+                    Some(dqs) if self.method == Method::Dqb => {
+                        assert_eq!(dqs.len(), skinning.len(), "one dual quaternion per joint");
+                        for (d, q) in self.quat.iter_mut().zip(dqs) {
+                            *d = q.to_array();
+                        }
+                    }
+                    _ => {
+                        let convert = if self.method == Method::Qb { qb::params } else { dqb::params };
+                        for (d, m) in self.quat.iter_mut().zip(skinning) {
+                            *d = convert(m);
+                        }
+                    }
                 }
                 assert_eq!(self.signs.len(), mesh.pairs.len() + 1, "deformer made for another mesh");
                 for (sign, &(h, j)) in self.signs[1..].iter_mut().zip(&mesh.pairs) {
@@ -158,17 +271,21 @@ impl Deformer {
                 }
             }
         }
-        let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(mesh.vertex_count() / MIN_VERTICES_PER_THREAD).max(1);
+    }
+
+    /// Steps 2–6 over whole chunks from chunk `first`, split across the crew if there is one.
+    fn blend(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+        let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(positions.len() / MIN_VERTICES_PER_THREAD).max(1);
         match &self.crew {
-            Some(crew) if threads > 1 => self.split(crew, threads, mesh, out),
-            _ => self.run(mesh, 0, &mut out.positions, &mut out.normals),
+            Some(crew) if threads > 1 => self.split(crew, threads, mesh, positions, normals),
+            _ => self.run(mesh, first, positions, normals),
         }
     }
 
     /// The vertex loop split into pieces claimed by `crew`'s threads: whole chunks per piece,
     /// an even number so the AVX-512 loop keeps its blocks, four pieces per thread so a
     /// helper that joins late still takes its share.
-    fn split(&self, crew: &Crew, threads: usize, mesh: &SkinnedMesh, out: &mut Deformed) {
+    fn split(&self, crew: &Crew, threads: usize, mesh: &SkinnedMesh, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         /// The output buffers, written piece by piece from several threads.
         struct Outputs {
             positions: *mut [f32; 3],
@@ -178,15 +295,15 @@ impl Deformer {
         }
         // SAFETY: the threads write disjoint pieces (below).
         unsafe impl Sync for Outputs {}
-        let len = out.positions.len();
+        let len = positions.len();
         let span = (len / LANES).div_ceil(4 * threads).next_multiple_of(2) * LANES;
-        let o = Outputs { positions: out.positions.as_mut_ptr(), normals: out.normals.as_mut_ptr(), len, with_normals: !out.normals.is_empty() };
+        let o = Outputs { positions: positions.as_mut_ptr(), normals: normals.as_mut_ptr(), len, with_normals: !normals.is_empty() };
         let o = &o; // The whole struct, not its (non-Sync) fields, is captured.
         crew.run(len.div_ceil(span), &|i| {
             let (start, end) = (i * span, ((i + 1) * span).min(o.len));
             // SAFETY: the crew runs each piece once, pieces are disjoint ranges within the
-            // buffers (normals as long as positions, or unused), and `out` is borrowed
-            // mutably until `run` returns, after every piece.
+            // buffers (normals as long as positions, or unused), and the buffers are
+            // borrowed mutably until `run` returns, after every piece.
             let (p, n) = unsafe {
                 (
                     core::slice::from_raw_parts_mut(o.positions.add(start), end - start),
@@ -221,20 +338,5 @@ impl Deformer {
         pool.install(|| {
             out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
         });
-    }
-}
-
-/// The skinning transform of each joint, `world · inverse_bind` (design.md).
-///
-/// * `world` — #joints world transforms from forward kinematics;
-/// * `inverse_bind` — #joints, from the mesh;
-/// * `out` — #joints, overwritten.
-///
-/// # Panics
-/// If the lengths differ.
-pub fn skinning_transforms(world: &[Affine3A], inverse_bind: &[Affine3A], out: &mut [Affine3A]) {
-    assert!(world.len() == inverse_bind.len() && out.len() == world.len(), "one transform per joint");
-    for ((o, w), ib) in out.iter_mut().zip(world).zip(inverse_bind) {
-        *o = *w * *ib;
     }
 }

@@ -18,7 +18,7 @@ pub(crate) const W: usize = 8;
 
 /// The unit dual quaternion of a skinning matrix's rigid part.
 pub(crate) fn params(m: &Affine3A) -> [f32; W] {
-    DualQuat::from_mat4(&(*m).into()).to_array()
+    DualQuat::from_affine(m).to_array()
 }
 
 pub(crate) struct Dqb;

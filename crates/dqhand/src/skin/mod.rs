@@ -1,4 +1,5 @@
-//! Skin layer (paper 4.1, 4.4): the skinned mesh and the LB, QB and DQB deformers.
+//! Skin layer (paper 4.1, 4.4): the skinned mesh, the LB, QB and DQB deformers, and the
+//! [`SkinLayer`] that runs a set of them on the kinematics layer's transforms.
 
 mod crew;
 mod deformer;
@@ -8,11 +9,13 @@ mod linear_blend;
 mod method;
 mod method_set;
 mod quaternion_blend;
+mod skin_layer;
 mod skinned_mesh;
 
 pub use crew::Crew;
-pub use deformer::{skinning_transforms, Deformed, Deformer, MIN_VERTICES_PER_THREAD};
+pub use deformer::{Bones, Deformed, Deformer, VertexBuffers, MIN_VERTICES_PER_THREAD};
 pub use kernel::Kernel;
 pub use method::Method;
 pub use method_set::MethodSet;
+pub use skin_layer::SkinLayer;
 pub use skinned_mesh::{MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};

@@ -49,13 +49,11 @@ pub fn rotation() -> impl Strategy<Value = Quat> {
     })
 }
 
-/// Poses `model` with `target` through the engine; returns the skinning transforms and the
-/// clamping warnings.
-pub fn pose_skinning(model: &dqhand::model::Model, target: &dqhand::kinematics::PoseTarget, limits: dqhand::kinematics::Limits) -> dqhand::Result<(Vec<glam::Affine3A>, Vec<String>)> {
-    let mut engine = dqhand::engine::Engine::for_target(std::sync::Arc::new(model.clone()), target)?;
-    engine.set_limits(limits);
-    let warnings = engine.pose_target(target);
-    Ok((engine.skinning().to_vec(), warnings))
+/// Poses `model` with `target` through its kinematics layer; returns the skinning transforms
+/// and the angles clamped.
+pub fn pose_skinning(model: &dqhand::model::Model, target: &dqhand::kinematics::PoseTarget, limits: dqhand::kinematics::Limits) -> dqhand::Result<(Vec<glam::Affine3A>, Vec<dqhand::kinematics::ClampedAngle>)> {
+    let (layer, clamped) = model.pose_target(target, limits)?;
+    Ok((layer.skinning().to_vec(), clamped))
 }
 
 /// World transforms of `rig`'s skeleton posed by `pose`: the rig's local transforms, then

@@ -9,6 +9,7 @@
 //! number passes ½, which holds for an open mesh like the Utah teapot too) and its distance,
 //! within [`MESH_DEPTH_RANGE_M`] of the surface.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Affine3A, Vec3};
@@ -22,7 +23,7 @@ use crate::grasp::GraspEvent;
 use crate::interaction::grasp_script::{Script, RATE_HZ};
 use crate::interaction::ManipulationLoop;
 use crate::kinematics::JointPositions;
-use crate::skin::Method;
+use crate::skin::{Method, MethodSet, SkinLayer};
 
 /// Farthest a set-down object may rest from where the script carried it, m.
 pub const PLACE_TOLERANCE_M: f32 = 0.03;
@@ -94,6 +95,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         .map(|o| o.mesh.as_ref().map(|m| (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect())))
         .collect();
     let joints = JointPositions::new(manip.rendered().skeleton()).expect("a hand with WebXR joints");
+    let mut rendered_skin = SkinLayer::new(Arc::clone(&manip.input().model().mesh), MethodSet::DQB);
     let times = script.times;
     let mut score = RunScore {
         success: false,
@@ -113,7 +115,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let mut skin: Vec<[f32; 3]> = Vec::new();
     for record in &script.records {
         // The loop takes records as they come; a script's records are all good.
-        let _ = manip.push(record, None);
+        let _ = manip.push(record);
         let started = Instant::now();
         let event = manip.step(record.time);
         score.step_s.push(started.elapsed().as_secs_f64());
@@ -125,7 +127,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         if t >= times.carry_start && t <= times.carry_end {
             held_through_carry &= held;
             if held {
-                let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().expect("a rig").wrist()];
+                let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().wrist()];
                 let here = wrist.inverse().transform_point3(manip.poses()[object].1);
                 let first = *in_wrist.get_or_insert(here);
                 score.slip_m = score.slip_m.max(here.distance(first));
@@ -147,7 +149,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             score.tunnelled |= crossed(manip.objects(), held_index, last, centre);
         }
         skin.clear();
-        skin.extend_from_slice(manip.rendered_mut().skin(Method::Dqb).positions());
+        rendered_skin.deform(manip.rendered().layer());
+        skin.extend_from_slice(rendered_skin.deformed(Method::Dqb).expect("DQB is the set").positions());
         let colliders = manip.objects().objects();
         let mut deepest = 0.0f32;
         for v in &skin {

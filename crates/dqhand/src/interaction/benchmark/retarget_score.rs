@@ -14,10 +14,9 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::AngleError;
-use crate::engine::Engine;
 use crate::input::{HandData, Retargeter, CONTACT_FADE, JOINT_COUNT};
 use crate::interaction::synthetic::Synthetic;
-use crate::kinematics::{JointModel, JointPositions, Pose};
+use crate::kinematics::{HandKinematics, JointModel, JointPositions, Pose};
 use crate::model::Model;
 use crate::Result;
 
@@ -71,13 +70,13 @@ impl RetargetScore {
     /// joint model) onto `model` and compares with the truth.
     ///
     /// # Errors
-    /// As [`Engine::with_joint_model`] and [`Retargeter::new`] for a model without the WebXR
+    /// As [`Model::hand_kinematics`] and [`Retargeter::new`] for a model without the WebXR
     /// joints; [`crate::Error::Sequence`] for a record without joints or landmarks (a glove's).
     pub fn measure(model: Arc<Model>, sequences: &[Synthetic]) -> Result<Self> {
-        let mut engine = Engine::with_joint_model(model, JointModel::Full)?;
-        let rig = engine.rig().expect("an engine with a joint model has a rig").clone();
+        let mut hand = model.hand_kinematics(JointModel::Full)?;
+        let rig = hand.rig().clone();
         let mut retargeter = Retargeter::new(&rig)?;
-        let joints = JointPositions::new(engine.skeleton())?;
+        let joints = JointPositions::new(hand.skeleton())?;
         let mut solved = Pose::rest(JointModel::Full.dof_count());
         let mut score = Self::default();
         for (record, truth) in sequences.iter().flat_map(|s| s.records.iter().zip(&s.truth)) {
@@ -101,12 +100,12 @@ impl RetargetScore {
             score.angles.add(truth, &solved);
             let gap = thumb_index_gap(&tracked);
             if gap <= CONTACT_GAP_M {
-                score.add_contact(&mut engine, &joints, &solved, gap);
+                score.add_contact(&mut hand, &joints, &solved, gap);
             }
             if gap <= CONTACT_FADE {
                 for closed_gap in CLOSED_GAPS_M {
                     if retargeter.solve(&close_pinch(&tracked, closed_gap), record.side, &mut solved).is_ok() {
-                        score.add_contact(&mut engine, &joints, &solved, closed_gap);
+                        score.add_contact(&mut hand, &joints, &solved, closed_gap);
                     }
                 }
             }
@@ -114,10 +113,10 @@ impl RetargetScore {
         Ok(score)
     }
 
-    /// Counts a contact of `tracked_gap` (m) and the virtual gap of `solved` on `engine`'s hand.
-    fn add_contact(&mut self, engine: &mut Engine, joints: &JointPositions, solved: &Pose, tracked_gap: f32) {
-        engine.pose(solved);
-        let gap = thumb_index_gap(&joints.read(engine.world()));
+    /// Counts a contact of `tracked_gap` (m) and the virtual gap of `solved` on `hand`.
+    fn add_contact(&mut self, hand: &mut HandKinematics, joints: &JointPositions, solved: &Pose, tracked_gap: f32) {
+        hand.pose(solved);
+        let gap = thumb_index_gap(&joints.read(hand.world()));
         self.contacts += 1;
         self.max_contact_gap_m = self.max_contact_gap_m.max(gap);
         self.max_contact_excess_m = self.max_contact_excess_m.max(gap - tracked_gap);

@@ -48,8 +48,8 @@
 use glam::Vec3;
 use serde_json::{json, Map, Value};
 
-use crate::interaction::ManipulationLoop;
-use crate::skin::{Method, MethodSet};
+use dqhand::interaction::ManipulationLoop;
+use dqhand::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// Version of the format written here; a reader refuses any other.

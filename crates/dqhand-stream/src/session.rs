@@ -10,16 +10,15 @@ use std::time::Instant;
 use glam::{EulerRot, Quat, Vec3};
 use serde_json::json;
 
-use super::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYING, VERSION};
-use super::{Command, LiveInput};
-use crate::engine::Engine;
-use crate::gesture::{gesture, Sequence, GESTURES};
-use crate::input::Action;
-use crate::kinematics::{HandRig, JointModel, Limits, Pose};
-use crate::math::DualQuat;
-use crate::metrics::VertexDistortion;
-use crate::model::Model;
-use crate::skin::{Method, MethodSet};
+use crate::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYING, VERSION};
+use crate::{Action, Command, LiveInput};
+use dqhand::engine::Engine;
+use dqhand::gesture::{gesture, Sequence, GESTURES};
+use dqhand::kinematics::{HandRig, JointModel, Limits, Pose};
+use dqhand::math::DualQuat;
+use dqhand::metrics::VertexDistortion;
+use dqhand::model::Model;
+use dqhand::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// Length of a move to a gesture chosen without a duration, seconds.
@@ -60,20 +59,20 @@ impl Session {
     /// bundled gesture sequence.
     ///
     /// # Errors
-    /// As [`Engine::with_joint_model`]: [`Error::MissingJoint`] if the model's skeleton lacks
-    /// the WebXR hand joints, [`Error::JointFrame`] if its joint frames are not WebXR's.
+    /// As [`Engine::new`]: [`dqhand::Error::MissingJoint`] if the model's skeleton lacks
+    /// the WebXR hand joints, [`dqhand::Error::JointFrame`] if its joint frames are not WebXR's.
     pub fn new(model: Arc<Model>, joint_model: JointModel) -> Result<Self> {
         let mesh = &model.mesh;
         let n = mesh.vertex_count();
         let vertex_distortion = VertexDistortion::new(&mesh.positions(), mesh.indices());
-        let engine = Engine::with_joint_model(model, joint_model)?;
+        let engine = Engine::new(model, joint_model)?;
         Ok(Self {
             pose: Pose::rest(joint_model.dof_count()),
             wrist: None,
             heatmap: false,
             distortion: Method::ALL.map(|_| vec![0.0; n]),
             vertex_distortion,
-            joints: vec![[0.0; 3]; engine.skeleton().len()],
+            joints: vec![[0.0; 3]; engine.kinematics().skeleton().len()],
             timeline: Sequence::gestures(joint_model),
             time: 0.0,
             playing: true,
@@ -99,7 +98,7 @@ impl Session {
             "description": description,
             "vertices": mesh.vertex_count(),
             "triangles": mesh.triangle_count(),
-            "joints": self.engine.skeleton().names().collect::<Vec<_>>(),
+            "joints": self.engine.kinematics().skeleton().names().collect::<Vec<_>>(),
             "joint_model": model.as_str(),
             "joint_models": JointModel::ALL.map(JointModel::as_str),
             "dofs": dofs,
@@ -120,7 +119,7 @@ impl Session {
         Topology {
             vertex_count: self.engine.model().mesh.vertex_count() as u32,
             indices: self.engine.model().mesh.indices().to_vec(),
-            parents: self.engine.skeleton().joints().iter().map(|j| j.parent).collect(),
+            parents: self.engine.kinematics().skeleton().joints().iter().map(|j| j.parent).collect(),
         }
     }
 
@@ -137,7 +136,7 @@ impl Session {
     }
 
     fn rig(&self) -> &HandRig {
-        self.engine.rig().expect("a session's engine has a joint model")
+        self.engine.kinematics().rig()
     }
 
     /// What a pose without a wrist stands for.
@@ -149,15 +148,15 @@ impl Session {
     /// nothing here.
     ///
     /// # Errors
-    /// [`Error::Command`] or [`Error::UnknownName`] naming the bad value; the session is
+    /// [`Error::Command`] or [`dqhand::Error::UnknownName`] naming the bad value; the session is
     /// unchanged then.
     pub fn apply(&mut self, command: &Command) -> Result<Applied> {
         match command {
             Command::Ack { .. } => {}
             Command::View { methods } => {
                 let set = MethodSet::parse(methods).map_err(|e| match e {
-                    Error::Methods(why) => Error::Command(format!("view: {why}")),
-                    other => other,
+                    dqhand::Error::Methods(why) => Error::Command(format!("view: {why}")),
+                    other => other.into(),
                 })?;
                 self.engine.set_methods(set);
             }
@@ -171,7 +170,7 @@ impl Session {
             Command::Angle { dof, deg } => {
                 let i = self.joint_model().dof_index(dof)?;
                 let d = self.joint_model().dofs().nth(i).expect("index from the model");
-                let (lo, hi) = match self.engine.limits() {
+                let (lo, hi) = match self.engine.kinematics().limits() {
                     Limits::Anatomical => (d.min_deg, d.max_deg),
                     Limits::Off => (-180.0, 180.0),
                 };
@@ -215,7 +214,7 @@ impl Session {
                 self.sample_timeline();
             }
             Command::Heatmap { on } => self.heatmap = *on,
-            Command::Limits { on } => self.engine.set_limits(if *on { Limits::Anatomical } else { Limits::Off }),
+            Command::Limits { on } => self.engine.kinematics_mut().set_limits(if *on { Limits::Anatomical } else { Limits::Off }),
             Command::Rest {} => {
                 self.stop();
                 self.wrist = None;
@@ -241,7 +240,7 @@ impl Session {
     pub fn act(&mut self, action: Action) {
         match action {
             Action::NextMethod => {
-                let first = self.engine.methods().as_slice()[0];
+                let first = self.engine.skin().methods().as_slice()[0];
                 let next = Method::ALL[(first.index() + 1) % Method::ALL.len()];
                 self.engine.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
             }
@@ -259,7 +258,7 @@ impl Session {
     /// The methods in view.
     #[must_use]
     pub fn methods(&self) -> MethodSet {
-        self.engine.methods()
+        self.engine.skin().methods()
     }
 
     fn stop(&mut self) {
@@ -308,13 +307,13 @@ impl Session {
     pub fn render(&mut self, engine_fps: f32, out: &mut Vec<u8>) {
         let start = Instant::now();
         self.engine.step(&self.pose);
-        let methods = self.engine.methods();
+        let methods = self.engine.skin().methods();
         if self.heatmap {
             for &m in methods.as_slice() {
-                self.vertex_distortion.compute(self.engine.deformed(m).positions(), &mut self.distortion[m.index()]);
+                self.vertex_distortion.compute(self.engine.deformed(m).expect("the methods in view are skinned").positions(), &mut self.distortion[m.index()]);
             }
         }
-        for (j, w) in self.joints.iter_mut().zip(self.engine.world()) {
+        for (j, w) in self.joints.iter_mut().zip(self.engine.kinematics().world()) {
             *j = w.translation.into();
         }
         let engine_us = start.elapsed().as_secs_f32() * 1e6;
@@ -333,14 +332,14 @@ impl Session {
             engine_fps,
             time: self.time,
             duration: self.timeline.duration(),
-            state: if self.playing { STATE_PLAYING } else { 0 } | if self.engine.limits() == Limits::Anatomical { STATE_LIMITS } else { 0 },
+            state: if self.playing { STATE_PLAYING } else { 0 } | if self.engine.kinematics().limits() == Limits::Anatomical { STATE_LIMITS } else { 0 },
             wrist,
         };
         self.sequence = self.sequence.wrapping_add(1);
         let mut w = FrameWriter::begin(out, header);
         w.floats(&self.pose.angles).floats(self.joints.as_flattened());
         for &m in methods.as_slice() {
-            let deformed = self.engine.deformed(m);
+            let deformed = self.engine.deformed(m).expect("the methods in view are skinned");
             w.floats(deformed.positions().as_flattened()).floats(deformed.normals().as_flattened());
             if self.heatmap {
                 w.floats(&self.distortion[m.index()]);

@@ -1,6 +1,7 @@
 //! The viewer stream: the binary format (golden vectors shared with the page's tests, round
 //! trips, refusals) and a session's behaviour against the engine it wraps.
 
+#[path = "../../dqhand/tests/support/mod.rs"]
 mod support;
 
 use std::path::PathBuf;
@@ -12,9 +13,10 @@ use dqhand::kinematics::{HandRig, JointModel, Limits, Pose};
 use dqhand::math::DualQuat;
 use dqhand::metrics::VertexDistortion;
 use dqhand::model::Model;
-use dqhand::skin::{skinning_transforms, Deformed, Deformer, Method, MethodSet};
-use dqhand::stream::frame::{STATE_LIMITS, STATE_PLAYING};
-use dqhand::stream::{Applied, Command, FrameHeader, FrameView, FrameWriter, Session, Topology};
+use dqhand::kinematics::skinning_transforms;
+use dqhand::skin::{Deformed, Deformer, Method, MethodSet};
+use dqhand_stream::frame::{STATE_LIMITS, STATE_PLAYING};
+use dqhand_stream::{Applied, Command, FrameHeader, FrameView, FrameWriter, Session, Topology};
 use proptest::prelude::*;
 
 static HAND: LazyLock<Arc<Model>> = LazyLock::new(|| Arc::new(build(&HandParams { vertices: 3000, ..HandParams::default() }).unwrap()));
@@ -404,7 +406,7 @@ fn following_an_input_of_another_joint_model_takes_the_shared_angles() {
 /// Gesture commands change the view: the next method alone (cycling), all three, the heat map.
 #[test]
 fn gesture_commands_change_the_view() {
-    use dqhand::input::Action;
+    use dqhand_stream::Action;
     let mut s = paused();
     let shown = |s: &Session| s.methods().as_slice().to_vec();
     assert_eq!(shown(&s), [Method::Dqb]);

@@ -32,14 +32,14 @@ use std::time::{Duration, Instant};
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 
-use super::frame::{check_scene, scene_hello, scene_message};
-use super::Session;
-use crate::gesture::{Event, EventKind, Events};
-use crate::hand::Side;
-use crate::input::{Action, Record, Rejection, Tracking};
-use crate::interaction::{GestureLoop, ManipulationLoop};
-use crate::kinematics::{JointModel, Pose};
-use crate::scene::SceneCommand;
+use crate::frame::{check_scene, scene_hello, scene_message};
+use crate::{Action, Session, ViewerAction};
+use dqhand::gesture::{Event, EventKind, Events};
+use dqhand::hand::Side;
+use dqhand::input::{Record, Rejection, Tracking};
+use dqhand::interaction::{CommandTable, GestureLoop, ManipulationLoop};
+use dqhand::kinematics::{JointModel, Pose};
+use dqhand::scene::SceneCommand;
 use crate::Result;
 
 /// Log entries kept for viewers that have not read them yet; a viewer further behind misses
@@ -66,6 +66,8 @@ pub struct LiveInput {
 
 struct State {
     driver: Driver,
+    /// The viewer's gesture actions (the input configuration's `actions`), with recognition on.
+    actions: Option<CommandTable<ViewerAction>>,
     /// Poses taken or stepped: a viewer whose last one is older follows the new one.
     posed: u64,
     log: VecDeque<Entry>,
@@ -118,10 +120,10 @@ impl Driver {
         }
     }
 
-    fn push(&mut self, record: &Record, arrival: f64) -> std::result::Result<Events<'_>, Rejection> {
+    fn push(&mut self, record: &Record) -> std::result::Result<Events<'_>, Rejection> {
         match self {
-            Driver::Gestures(g) => g.push(record, Some(arrival)),
-            Driver::Scene(s) => s.manip.push(record, Some(arrival)),
+            Driver::Gestures(g) => g.push(record),
+            Driver::Scene(s) => s.manip.push(record),
         }
     }
 
@@ -179,9 +181,13 @@ pub struct InputUpdate {
 impl LiveInput {
     /// The input of `gesture_loop` from `source` (for display: a path, `udp 127.0.0.1:9000`).
     /// With `announce` the viewers are told of it from the start; otherwise from its first
-    /// record (the demo's `/input` WebSocket, open whether or not anyone uses it).
-    #[must_use]
-    pub fn new(gesture_loop: GestureLoop, source: impl Into<String>, announce: bool) -> Self {
+    /// record (the demo's `/input` WebSocket, open whether or not anyone uses it). With
+    /// recognition on, the input configuration's `actions` are the viewers' commands.
+    ///
+    /// # Errors
+    /// As [`ViewerAction::resolve`] and [`CommandTable::new`]: an action that is no viewer
+    /// action, or names a gesture not recognised.
+    pub fn new(gesture_loop: GestureLoop, source: impl Into<String>, announce: bool) -> Result<Self> {
         Self::driving(Driver::Gestures(Box::new(gesture_loop)), None, source.into(), announce)
     }
 
@@ -189,20 +195,24 @@ impl LiveInput {
     /// are sent the scene.
     ///
     /// # Errors
-    /// As [`check_scene`]: a scene too large to stream.
+    /// As [`check_scene`]: a scene too large to stream; as [`Self::new`].
     pub fn with_scene(manip: ManipulationLoop, source: impl Into<String>, announce: bool) -> Result<Self> {
         check_scene(&manip)?;
         let scene = Some(scene_hello(&manip));
         let state = SceneState { poses: manip.poses().to_vec(), contacts: 0, held: None, stepped: 0.0, version: 0, message: (u64::MAX, String::new()), manip };
-        Ok(Self::driving(Driver::Scene(Box::new(state)), scene, source.into(), announce))
+        Self::driving(Driver::Scene(Box::new(state)), scene, source.into(), announce)
     }
 
-    fn driving(driver: Driver, scene: Option<Value>, source: String, announce: bool) -> Self {
+    fn driving(driver: Driver, scene: Option<Value>, source: String, announce: bool) -> Result<Self> {
         let gesture_loop = driver.gestures();
         let gestures = gesture_loop.gestures().map_or_else(Vec::new, |set| set.gestures().iter().map(|g| g.name().to_owned()).collect());
+        let actions = match gesture_loop.gestures() {
+            Some(set) => Some(CommandTable::new(&ViewerAction::resolve(&gesture_loop.pipeline().config().actions)?, set)?),
+            None => None,
+        };
         let joint_model = gesture_loop.pipeline().retargeter().rig().model();
-        let state = State { driver, posed: 0, log: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
-        Self { source, announce, gestures, joint_model, scene, start: Instant::now(), state: Mutex::new(state) }
+        let state = State { driver, actions, posed: 0, log: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
+        Ok(Self { source, announce, gestures, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
     }
 
     /// The index of the gesture called `name` in the recognised set.
@@ -254,7 +264,7 @@ impl LiveInput {
         // Read under the lock, so that the records taken have increasing arrival times.
         let arrival = self.clock();
         let record = &Record { arrival: Some(arrival), ..*record };
-        let State { driver, posed, log, logged } = &mut *guard;
+        let State { driver, actions, posed, log, logged } = &mut *guard;
         let mut add = |entry| {
             if log.len() == LOG_CAPACITY {
                 log.pop_front();
@@ -263,13 +273,14 @@ impl LiveInput {
             *logged += 1;
         };
         let index = |name: &str| self.index(name).expect("events name gestures of the set");
-        for e in driver.push(record, arrival)? {
+        let events = driver.push(record)?;
+        for e in events.clone() {
             add(Entry::Event { t: e.t, event: e.event, gesture: index(e.gesture) });
         }
+        let action = actions.as_mut().and_then(|table| table.update(record.time, events));
         taken(record);
         *posed += 1;
-        let gesture_loop = driver.gestures();
-        if let (Some(action), Some(gesture)) = (gesture_loop.action(), gesture_loop.gesture()) {
+        if let (Some(action), Some(gesture)) = (action, driver.gestures().gesture()) {
             add(Entry::Action { t: record.time, gesture: index(gesture), action });
         }
         if let Driver::Scene(s) = driver {

@@ -1,0 +1,110 @@
+//! The skin layer (paper 4.4): a mesh deformed by the kinematics layer's transforms with one
+//! or several of LB, QB and DQB.
+
+use std::sync::Arc;
+
+use super::{Bones, Crew, Deformed, Deformer, Kernel, Method, MethodSet, SkinnedMesh, VertexBuffers};
+
+/// A skinned mesh with a deformer and an output per method of a [`MethodSet`], every buffer
+/// allocated when a method joins the set; deforming allocates nothing.
+///
+/// It reads only the bones' transforms, so one kinematics layer can feed several skin layers
+/// (one per viewer, one per method set), and a loop that only needs the skeleton (gesture
+/// recognition, collision) holds no skin at all.
+#[derive(Clone, Debug)]
+pub struct SkinLayer {
+    mesh: Arc<SkinnedMesh>,
+    methods: MethodSet,
+    /// Per method, in [`Method::ALL`] order: its deformer and output, once it has been in the set.
+    slots: [Option<(Deformer, Deformed)>; 3],
+    kernel: Kernel,
+    crew: Option<Arc<Crew>>,
+}
+
+impl SkinLayer {
+    /// A skin layer deforming `mesh` with `methods` (positions and normals), on the fastest
+    /// kernel this CPU runs, on the calling thread.
+    #[must_use]
+    pub fn new(mesh: Arc<SkinnedMesh>, methods: MethodSet) -> Self {
+        let mut layer = Self { mesh, methods, slots: [None, None, None], kernel: Kernel::best(), crew: None };
+        layer.set_methods(methods);
+        layer
+    }
+
+    /// The methods [`Self::deform`] runs; a method new to the layer gets its buffers here.
+    pub fn set_methods(&mut self, methods: MethodSet) {
+        self.methods = methods;
+        for &m in methods.as_slice() {
+            if self.slots[m.index()].is_none() {
+                let mut deformer = Deformer::new(m, &self.mesh).with_kernel(self.kernel);
+                if let Some(crew) = &self.crew {
+                    deformer = deformer.with_crew(Arc::clone(crew));
+                }
+                self.slots[m.index()] = Some((deformer, Deformed::new(&self.mesh)));
+            }
+        }
+    }
+
+    /// Runs the skinning on `kernel` (to compare kernels; the fastest this CPU runs by default).
+    pub fn use_kernel(&mut self, kernel: Kernel) {
+        self.kernel = kernel;
+        for (d, _) in self.slots.iter_mut().flatten() {
+            *d = d.clone().with_kernel(kernel);
+        }
+    }
+
+    /// Splits each deformation across `crew`'s threads (see [`Deformer::with_crew`]).
+    pub fn use_crew(&mut self, crew: &Arc<Crew>) {
+        self.crew = Some(Arc::clone(crew));
+        for (d, _) in self.slots.iter_mut().flatten() {
+            *d = d.clone().with_crew(Arc::clone(crew));
+        }
+    }
+
+    /// The mesh.
+    #[must_use]
+    pub fn mesh(&self) -> &Arc<SkinnedMesh> {
+        &self.mesh
+    }
+
+    /// The methods [`Self::deform`] runs.
+    #[must_use]
+    pub fn methods(&self) -> MethodSet {
+        self.methods
+    }
+
+    /// Deforms the mesh with every method of [`Self::methods`] by `bones` (a
+    /// [`crate::kinematics::KinematicsLayer`], or #joints skinning transforms).
+    ///
+    /// # Panics
+    /// If `bones` has another joint count than the mesh.
+    pub fn deform<'a>(&mut self, bones: impl Into<Bones<'a>>) {
+        let bones = bones.into();
+        for &m in self.methods.as_slice() {
+            let (deformer, out) = self.slots[m.index()].as_mut().expect("every method of the set has its buffers");
+            deformer.deform(&self.mesh, bones, out);
+        }
+    }
+
+    /// Deforms the mesh with `method` alone into the caller's memory (see
+    /// [`Deformer::deform_into`]); `method` joins the layer's buffers if it was never in the set.
+    ///
+    /// # Panics
+    /// As [`Self::deform`], and if a buffer's length is not the mesh's (#V × 3, or #V × 6
+    /// interleaved).
+    pub fn deform_into<'a>(&mut self, method: Method, bones: impl Into<Bones<'a>>, out: VertexBuffers<'_>) {
+        if self.slots[method.index()].is_none() {
+            let methods = self.methods;
+            self.set_methods(MethodSet::new(&[method]).expect("one method is a set"));
+            self.methods = methods;
+        }
+        let (deformer, _) = self.slots[method.index()].as_mut().expect("made above");
+        deformer.deform_into(&self.mesh, bones, out);
+    }
+
+    /// The mesh as `method` last deformed it: `None` if `method` was never in the set.
+    #[must_use]
+    pub fn deformed(&self, method: Method) -> Option<&Deformed> {
+        self.slots[method.index()].as_ref().map(|(_, out)| out)
+    }
+}
