@@ -21,6 +21,7 @@ build:
 
 # Sample recordings of the gesture library: synthetic (made from our own kinematics by
 # `dqhand synthesize`, seeded, labelled so in their .labels.json), not captured from a person.
+# The tests replay them; no command needs them (`demo --scene` makes its grasps itself).
 RECORDINGS := crates/dqhand/data/recordings
 DQHAND_DEBUG := target/debug/dqhand
 

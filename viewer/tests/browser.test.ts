@@ -355,7 +355,7 @@ describe('the viewer page with a scene', () => {
   let p: Page;
 
   beforeAll(async () => {
-    // No --input: the bundled grasp recording plays (make recordings writes it).
+    // No --input: the demo makes a scripted grasp of each object and plays it.
     sceneServer = await startServer({ args: ['--scene', 'grasp'] });
     p = await newPage(browser);
     await p.goto(sceneServer.url);
@@ -381,7 +381,7 @@ describe('the viewer page with a scene', () => {
     await expect.poll(() => countColour(p, { r: [120, 230], g: [80, 180], b: [40, 130] }), { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
   });
 
-  test('shows the ball held while the bundled recording grasps it', async () => {
+  test('shows the ball held while the scripted recording grasps it', async () => {
     // The state and the Input panel's line together (the ball is held for about 2 s of each pass).
     await waitState(p, 's.scene.held === "ball" && document.getElementById("held").textContent === "ball" && s.input.tracking === "tracking"', 90_000);
     expect((await p.evaluate(() => (window as unknown as { dqhand: { state(): { errors: string[] } } }).dqhand.state())).errors).toEqual([]);

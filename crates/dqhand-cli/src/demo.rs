@@ -11,6 +11,8 @@ use anyhow::{bail, Context};
 use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::GESTURES;
 use dqhand::grasp::GraspParams;
+use dqhand::hand::Side;
+use dqhand::input::Record;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
 use dqhand::interaction::{GestureLoop, ManipulationLoop};
@@ -45,7 +47,8 @@ pub struct Args {
     /// The hand: `builtin` or a skinned glTF with WebXR joint names.
     #[arg(long, default_value = "builtin")]
     model: ModelSource,
-    /// The built page (default: viewer/dist of this checkout).
+    /// The built page (default: viewer/dist here, else beside this program: viewer,
+    /// ../share/dqhand/viewer, or the checkout's viewer/dist for target/release/dqhand).
     #[arg(long)]
     viewer: Option<PathBuf>,
     /// Instead of serving, write the gesture library posed with LB, QB and DQB (GLB), its
@@ -76,14 +79,32 @@ pub struct Args {
     #[arg(long)]
     gestures_file: Option<PathBuf>,
     /// Manipulate a scene: a built-in one (`grasp`, `objects`) or a scene JSON file. Without
-    /// --input or --udp the bundled grasp recording plays.
+    /// --input or --udp a scripted grasp of each of its objects plays (made at start).
     #[arg(long)]
     scene: Option<String>,
 }
 
-/// The recording `demo --scene` plays when no input is given (`make recordings` writes it).
-fn grasp_recording() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../dqhand/data/recordings/grasp-joints.jsonl")
+/// What a played input reads: a recording file, or records made at start.
+enum Played {
+    File(PathBuf),
+    Records(Arc<[Record]>),
+}
+
+/// The recording `demo --scene` plays when no input is given: every object of the scene
+/// grasped from above in turn by the demo's hand (`dqhand synthesize --scene` writes the same
+/// for the built-in hand), made now in memory; `None` for a scene without objects.
+fn scripted_grasps(model: &Arc<dqhand::model::Model>, name: &str, scene: &Scene) -> anyhow::Result<Option<Arc<[Record]>>> {
+    if scene.objects.is_empty() {
+        println!("input: {name} has no object to grasp, so nothing plays (give --input or --udp, or send records to /input)");
+        return Ok(None);
+    }
+    let start = Instant::now();
+    print!("scene {name}: making a scripted grasp of each object to play (synthetic, from the hand's own kinematics)... ");
+    std::io::Write::flush(&mut std::io::stdout())?;
+    let (_, scripts) = crate::synthesize::scripted_grasps(model, name, scene, Side::default()).with_context(|| name.to_owned())?;
+    let records: Arc<[Record]> = scripts.iter().flat_map(|s| s.records.iter().copied()).collect();
+    println!("{} records in {} ms", records.len(), start.elapsed().as_millis());
+    Ok(Some(records))
 }
 
 pub(crate) fn parse_fps(s: &str) -> Result<f64, String> {
@@ -134,15 +155,11 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     let mapper = Some(args.common.mapper(args.joint_model)?);
     let scene = args.scene.as_deref().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
     let played = match (&args.input, &scene, args.udp) {
-        (Some(path), _, _) => Some(path.clone()),
-        (None, Some(_), None) => {
-            let path = grasp_recording();
-            anyhow::ensure!(path.is_file(), "{}: the bundled grasp recording is missing: run `make recordings`", path.display());
-            Some(path.canonicalize()?)
-        }
+        (Some(path), _, _) => Some(Played::File(path.clone())),
+        (None, Some((name, scene)), None) => scripted_grasps(model, name, scene)?.map(Played::Records),
         (None, _, _) => None,
     };
-    if let (Some(input), Some(record)) = (&played, &args.record) {
+    if let (Some(Played::File(input)), Some(record)) = (&played, &args.record) {
         if input.canonicalize().ok() == record.canonicalize().ok() {
             anyhow::bail!("{}: --record would replace the recording being played", record.display());
         }
@@ -156,7 +173,8 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
         None => None,
     };
     let source = match (&played, &udp) {
-        (Some(path), _) => path.display().to_string(),
+        (Some(Played::File(path)), _) => path.display().to_string(),
+        (Some(Played::Records(_)), _) => format!("scripted grasps in scene {} (synthetic)", args.scene.as_deref().unwrap_or_default()),
         (None, Some(socket)) => format!("udp {}", socket.local_addr()?),
         (None, None) => "WebSocket /input".to_owned(),
     };
@@ -173,14 +191,28 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     let feed = Arc::new(Feed { input, records, clients: AtomicUsize::new(0) });
     let reporter = Arc::clone(&feed);
     std::thread::spawn(move || reporter.report());
-    if let Some(path) = &played {
-        RecordingReader::open(path, args.format, &args.common)?; // fail now, not in the thread
-        let (feed, path, format, common) = (Arc::clone(&feed), path.clone(), args.format, args.common.clone());
-        std::thread::spawn(move || {
-            if let Err(e) = feed.play(&path, format, &common) {
-                eprintln!("dqhand: error: {e:#}");
-            }
-        });
+    let played_now = played.is_some();
+    match played {
+        Some(Played::File(path)) => {
+            RecordingReader::open(&path, args.format, &args.common)?; // fail now, not in the thread
+            let (feed, format, common, name) = (Arc::clone(&feed), args.format, args.common.clone(), source.clone());
+            std::thread::spawn(move || {
+                if let Err(e) = feed.play(&name, || RecordingReader::open(&path, format, &common)) {
+                    eprintln!("dqhand: error: {e:#}");
+                }
+            });
+        }
+        Some(Played::Records(records)) => {
+            let (feed, name) = (Arc::clone(&feed), source.clone());
+            std::thread::spawn(move || {
+                if let Err(e) = feed.play(&name, || Ok(RecordingReader::Records(Arc::clone(&records), 0))) {
+                    eprintln!("dqhand: error: {e:#}");
+                }
+            });
+        }
+        None => {}
+    }
+    if played_now {
         println!("input: {source}, played in real time over and over");
     }
     if let Some(socket) = udp {
@@ -196,21 +228,30 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     Ok(feed)
 }
 
-/// The built page: `--viewer`, else `viewer/dist` here or in this checkout.
+/// The built page: `--viewer`, else the first of these with an `index.html`: `viewer/dist`
+/// here (a checkout), then beside this program `viewer` (a copied program), then
+/// `../share/dqhand/viewer` (an installed one: `bin/dqhand`), then `../../viewer/dist` (the
+/// checkout's `target/release/dqhand`, run from elsewhere). Looked up when the program runs,
+/// never where it was built.
 fn viewer_dir(given: Option<&Path>) -> anyhow::Result<PathBuf> {
-    let candidates: Vec<PathBuf> = match given {
-        Some(p) => vec![p.into()],
-        None => vec!["viewer/dist".into(), Path::new(env!("CARGO_MANIFEST_DIR")).join("../../viewer/dist")],
-    };
+    if let Some(p) = given {
+        anyhow::ensure!(p.join("index.html").is_file(), "{}: no index.html (give the directory of the built viewer)", p.display());
+        return p.canonicalize().with_context(|| p.display().to_string());
+    }
+    let mut candidates = vec![PathBuf::from("viewer/dist")];
+    if let Some(dir) = std::env::current_exe().ok().as_deref().and_then(Path::parent) {
+        candidates.extend([dir.join("viewer"), dir.join("../share/dqhand/viewer"), dir.join("../../viewer/dist")]);
+    }
     for c in &candidates {
         if c.join("index.html").is_file() {
             return c.canonicalize().with_context(|| c.display().to_string());
         }
     }
-    match given {
-        Some(p) => bail!("{}: no index.html (give the directory of the built viewer)", p.display()),
-        None => bail!("the viewer is not built (no viewer/dist/index.html): run `make viewer` or `make demo`"),
-    }
+    let searched: Vec<String> = candidates.iter().map(|c| c.display().to_string()).collect();
+    bail!(
+        "the viewer is not built: no index.html in {}: run `make viewer` (or `make demo`) in the checkout, or give --viewer DIR",
+        searched.join(", ")
+    )
 }
 
 /// Opens `url` in the desktop's browser when there is a desktop; otherwise the printed URL

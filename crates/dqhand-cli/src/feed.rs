@@ -3,7 +3,6 @@
 
 use std::io::ErrorKind;
 use std::net::UdpSocket;
-use std::path::Path;
 use std::sync::atomic::AtomicUsize;
 use std::time::{Duration, Instant};
 
@@ -11,7 +10,7 @@ use dqhand::input::{Record, Rejection};
 use dqhand_stream::LiveInput;
 
 use crate::live::{LiveRecords, MAX_DATAGRAM_BYTES};
-use crate::recording::{Format, InputArgs, RecordingReader};
+use crate::recording::RecordingReader;
 
 /// The demo's live input and how bytes reach it.
 pub struct Feed {
@@ -63,8 +62,9 @@ impl Feed {
     /// pass follows the previous one by its last interval between records, so the input's
     /// clock runs on and the hand does not drop out between passes; a scene starts over with
     /// each pass. Pauses longer than [`MAX_PAUSE_S`] are shortened to it; unreadable records
-    /// are counted on the first pass.
-    pub fn play(&self, path: &Path, format: Option<Format>, args: &InputArgs) -> anyhow::Result<()> {
+    /// are counted on the first pass. `open` opens the recording for each pass; `name` names
+    /// it in messages.
+    pub fn play(&self, name: &str, open: impl Fn() -> anyhow::Result<RecordingReader>) -> anyhow::Result<()> {
         let start = Instant::now();
         let mut record = self.records.blank();
         let (mut shift, mut pass) = (0.0, 0);
@@ -72,12 +72,12 @@ impl Feed {
             if pass > 0 {
                 self.input.reset_scene();
             }
-            let mut reader = RecordingReader::open(path, format, args)?;
+            let mut reader = open()?;
             let (mut first, mut last, mut interval, mut played) = (None::<f64>, None::<f64>, FIRST_INTERVAL, 0.0);
             while let Some(read) = reader.next(&mut record)? {
                 if let Err(rejection) = read {
                     if pass == 0 {
-                        self.input.reject(rejection.at(path.display()));
+                        self.input.reject(rejection.at(name));
                     }
                     continue;
                 }
@@ -104,7 +104,7 @@ impl Feed {
                 let _ = self.input.push(&record, |_| {}); // refusals are counted and shown
             }
             if first.is_none() {
-                anyhow::bail!("{}: no record to play", path.display());
+                anyhow::bail!("{name}: no record to play");
             }
             shift += played + interval;
             pass += 1;

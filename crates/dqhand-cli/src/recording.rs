@@ -4,6 +4,7 @@
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::Context;
 use dqhand::gesture::GestureSet;
@@ -112,6 +113,8 @@ pub fn gesture_set(file: Option<&Path>, on: bool) -> anyhow::Result<Option<Gestu
 pub enum RecordingReader {
     Json(JsonRecordReader<BufReader<File>>),
     Glove(GloveCsvReader<BufReader<File>>),
+    /// Records made in memory (the scripted grasps `demo --scene` plays), and the next one.
+    Records(Arc<[Record]>, usize),
 }
 
 /// A recording to play and what to do with it: the options `replay` and `grasp` share.
@@ -156,6 +159,11 @@ impl RecordingReader {
         match self {
             Self::Json(r) => r.next_record(out),
             Self::Glove(r) => Ok(r.next_record(out)),
+            Self::Records(records, next) => Ok(records.get(*next).map(|r| {
+                *out = *r;
+                *next += 1;
+                Ok(())
+            })),
         }
     }
 }

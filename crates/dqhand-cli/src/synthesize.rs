@@ -1,8 +1,9 @@
 //! `dqhand synthesize`: a synthetic, labelled recording of the gesture library made from our
 //! own kinematics (`dqhand::interaction::synthetic`), with its labels beside it; with
 //! `--scene`, a scripted manipulation recording instead (`dqhand::interaction::grasp_script`:
-//! every object of the scene grasped from above, lifted, carried and set down in turn). The
-//! sample recordings in `crates/dqhand/data/recordings` are made by `make recordings` with it.
+//! every object of the scene grasped from above, lifted, carried and set down in turn; what
+//! `demo --scene` plays when given no input, made there in memory). The sample recordings in
+//! `crates/dqhand/data/recordings` are made by `make recordings` with it.
 
 use std::path::PathBuf;
 
@@ -11,7 +12,8 @@ use std::sync::Arc;
 
 use dqhand::collision::ObjectColliders;
 use dqhand::hand::{HandParams, Side};
-use dqhand::interaction::grasp_script::{self, GraspTask};
+use dqhand::interaction::grasp_script::{self, GraspTask, Script};
+use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::input::MappingTable;
 use dqhand::interaction::synthetic::{generate, SyntheticFormat, SyntheticParams};
@@ -102,14 +104,21 @@ pub fn synthetic_format(format: Format, table: Option<&MappingTable>) -> Synthet
     }
 }
 
+/// Every object of `scene` (called `name`) grasped from above in turn by `model`'s `side`
+/// hand: the tasks, and each one's script on one clock.
+pub fn scripted_grasps(model: &Arc<Model>, name: &str, scene: &Scene, side: Side) -> anyhow::Result<(Vec<GraspTask>, Vec<Script>)> {
+    let objects = ObjectColliders::new(scene)?;
+    let tasks: Vec<GraspTask> = scene.objects.iter().map(|o| GraspTask::from_above(&o.name)).collect();
+    let scripts = grasp_script::sequence(model, name, &objects, &tasks, side)?;
+    Ok((tasks, scripts))
+}
+
 /// `--scene`: every object of the scene grasped in turn.
 fn manipulation(args: &Args, name: &str) -> anyhow::Result<()> {
     anyhow::ensure!(matches!(args.format, Format::Joints), "--scene: scripted manipulation recordings carry joints only (--format joints)");
     let scene = Scene::named(name)?;
-    let objects = ObjectColliders::new(&scene)?;
     let model = Arc::new(dqhand::hand::build(&HandParams::default())?);
-    let tasks: Vec<GraspTask> = scene.objects.iter().map(|o| GraspTask::from_above(&o.name)).collect();
-    let scripts = grasp_script::sequence(&model, name, &objects, &tasks, args.side.unwrap_or_default())?;
+    let (tasks, scripts) = scripted_grasps(&model, name, &scene, args.side.unwrap_or_default())?;
     let records: Vec<_> = scripts.iter().flat_map(|s| s.records.iter().copied()).collect();
     write_recording(&args.out, &records, None)?;
     let labels_path = args.out.with_extension("labels.json");

@@ -394,3 +394,131 @@ fn skin_poses_writes_one_file_per_pose_as_skin_pose_does() {
     let e = run_error(&["skin", "--poses", &path_arg(&poses), "--out", &path_arg(&out)]);
     assert!(e.contains("poses.jsonl: line 2: not a pose"), "{e}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// A copied or installed binary
+// ---------------------------------------------------------------------------------------------
+
+/// The dqhand binary copied into `dir` as it would be on a machine without this checkout:
+/// every occurrence of the checkout's path in it is replaced by a path of the same length
+/// that does not exist, so anything it looks up at a path compiled in (the source tree it was
+/// built from) is not there, as on a user's machine.
+#[cfg(unix)]
+fn relocated_binary(dir: &Path) -> PathBuf {
+    use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::fs::PermissionsExt;
+    let checkout = Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).expect("the workspace root");
+    let from = checkout.as_os_str().as_bytes();
+    let to: Vec<u8> = std::iter::once(b'/').chain(std::iter::repeat(b'x')).take(from.len()).collect();
+    assert!(from.len() >= 4 && !Path::new(std::ffi::OsStr::from_bytes(&to)).exists(), "{} cannot be hidden", checkout.display());
+    let mut bytes = std::fs::read(env!("CARGO_BIN_EXE_dqhand")).expect("read the built binary");
+    let mut i = 0;
+    while let Some(k) = bytes[i..].windows(from.len()).position(|w| w == from) {
+        bytes[i + k..i + k + from.len()].copy_from_slice(&to);
+        i += k + from.len();
+    }
+    let exe = dir.join("dqhand");
+    std::fs::write(&exe, &bytes).expect("write the copy");
+    std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+    exe
+}
+
+/// Runs `exe` with `args` in `cwd` (retrying while the copy just written is still busy: a
+/// test thread that forked meanwhile may hold it open for writing for a moment).
+fn spawn_in(exe: &Path, cwd: &Path, args: &[&str], piped: bool) -> std::process::Child {
+    let stdio = || if piped { std::process::Stdio::piped() } else { std::process::Stdio::inherit() };
+    for _ in 0..50 {
+        match Command::new(exe).args(args).current_dir(cwd).stdout(stdio()).stderr(stdio()).spawn() {
+            Err(e) if e.raw_os_error() == Some(26) => std::thread::sleep(std::time::Duration::from_millis(100)),
+            spawned => return spawned.expect("run the copied dqhand"),
+        }
+    }
+    panic!("{} stayed busy", exe.display());
+}
+
+fn output_in(exe: &Path, cwd: &Path, args: &[&str]) -> Output {
+    spawn_in(exe, cwd, args, true).wait_with_output().unwrap()
+}
+
+/// A copy of the binary, run away from the source tree it was built from (which it cannot
+/// reach: see `relocated_binary`), finds everything the documented commands need: the
+/// built-in scenes and their meshes, the grasp recording `demo --scene` plays (made on first
+/// use), and the built page beside the binary; without a page it names where it looked.
+#[cfg(unix)]
+#[test]
+fn a_copied_binary_runs_the_scene_commands_without_the_source_tree() {
+    use std::io::BufRead;
+    let dir = temp_dir("relocated");
+    let (bin, cwd) = (dir.join("bin"), dir.join("cwd"));
+    std::fs::create_dir_all(&bin).unwrap();
+    std::fs::create_dir_all(&cwd).unwrap();
+    let exe = relocated_binary(&bin);
+
+    // A built-in scene and its mesh (the teapot): a scripted recording made, then run through
+    // the manipulation loop, which picks up both objects.
+    let out = output_in(&exe, &cwd, &["synthesize", "--scene", "grasp", "--side", "right", "--out", "grasp.jsonl"]);
+    assert_exit(&out, 0);
+    let out = output_in(&exe, &cwd, &["grasp", "--scene", "grasp", "--input", "grasp.jsonl", "--trace", "trace.jsonl"]);
+    assert_exit(&out, 0);
+    let trace = std::fs::read_to_string(cwd.join("trace.jsonl")).unwrap();
+    for object in ["ball", "teapot"] {
+        assert!(trace.contains(&format!("\"held\":\"{object}\"")), "the {object} was never held");
+    }
+
+    // No page anywhere: the error says where it looked (here, beside the binary).
+    let out = output_in(&exe, &cwd, &["demo", "--no-open", "--port", "0"]);
+    assert_exit(&out, 1);
+    let e = stderr(&out);
+    assert!(e.contains("viewer/dist") && e.contains(&bin.join("viewer").display().to_string()) && e.contains("--viewer"), "{e}");
+
+    // The page beside the binary, and `demo --scene grasp` with no input: it makes the grasp
+    // recording itself and plays it; a viewer sees the hand tracked.
+    std::fs::create_dir_all(bin.join("viewer")).unwrap();
+    std::fs::write(bin.join("viewer/index.html"), "<!doctype html><title>viewer</title>").unwrap();
+    let mut child = spawn_in(&exe, &cwd, &["demo", "--no-open", "--port", "0", "--scene", "grasp"], true);
+    let stderr_pipe = child.stderr.take().unwrap();
+    let errors = std::thread::spawn(move || std::io::read_to_string(stderr_pipe).unwrap_or_default());
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut banner = String::new();
+    let address = loop {
+        let Some(Ok(line)) = lines.next() else {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("demo --scene grasp stopped:\n{banner}\n{}", errors.join().unwrap());
+        };
+        banner += &line;
+        banner.push('\n');
+        if let Some(url) = line.strip_prefix("viewer: http://") {
+            break url.trim_end_matches('/').to_owned();
+        }
+    };
+    std::thread::spawn(move || lines.for_each(drop));
+    let tracked = (|| {
+        let (mut ws, _) = tungstenite::connect(format!("ws://{address}/stream")).ok()?;
+        if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_mut() {
+            s.set_read_timeout(Some(std::time::Duration::from_secs(20))).unwrap();
+        }
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while std::time::Instant::now() < deadline {
+            match ws.read().ok()? {
+                tungstenite::Message::Text(t) => {
+                    let m: Value = serde_json::from_str(&t).ok()?;
+                    if m["type"] == "input" && m["tracking"] == "tracking" {
+                        return Some(m);
+                    }
+                }
+                tungstenite::Message::Binary(b) if b.starts_with(b"DQHF") && b.len() >= 12 => {
+                    // Acknowledged, or the server stops at three frames (the sequence: bytes 8–11).
+                    let seq = u32::from_le_bytes([b[8], b[9], b[10], b[11]]);
+                    ws.send(tungstenite::Message::text(format!(r#"{{"type":"ack","seq":{seq}}}"#))).ok()?;
+                }
+                _ => {}
+            }
+        }
+        None
+    })();
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(banner.contains("scene: grasp, 2 objects (ball, teapot)") && banner.contains("played in real time"), "{banner}");
+    assert!(tracked.is_some(), "no viewer saw the hand tracked:\n{banner}\n{}", errors.join().unwrap());
+}

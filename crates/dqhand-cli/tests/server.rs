@@ -519,7 +519,7 @@ fn the_input_socket_refuses_other_origins() {
     assert_eq!(text(&mut viewer)["type"], "hello");
 }
 
-/// `--scene grasp` without an input plays the bundled grasp recording (`make recordings`):
+/// `--scene grasp` without an input plays a scripted grasp of each object, made at start:
 /// the hello carries the table and the objects' shapes, and scene messages follow the objects
 /// and the contacts until the hand holds the ball.
 #[test]
@@ -528,7 +528,7 @@ fn a_scene_is_in_the_hello_and_streamed_until_the_ball_is_held() {
     assert!(server.banner.contains("scene: grasp, 2 objects (ball, teapot)"), "{}", server.banner);
     let mut ws = connect(&server);
     let hello = text(&mut ws);
-    assert!(hello["input"]["source"].as_str().unwrap().ends_with("grasp-joints.jsonl"), "{}", hello["input"]);
+    assert_eq!(hello["input"]["source"], "scripted grasps in scene grasp (synthetic)", "{}", hello["input"]);
     let scene = &hello["scene"];
     assert_eq!(scene["table"]["height"], 0.75);
     assert!(scene["table"]["half"][0].as_f64().unwrap() >= 0.6, "{}", scene["table"]);

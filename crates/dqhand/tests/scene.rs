@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use dqhand::scene::{ObjectMesh, ObjectShape, Scene, SceneCommand, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
+use dqhand::scene::{MeshSource, ObjectMesh, ObjectShape, Scene, SceneCommand, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
 use dqhand::{Error, SceneProblem};
 use glam::{Quat, Vec3};
 
@@ -56,7 +56,7 @@ fn a_scene_reads_with_its_defaults() {
     assert!((cube.rotation.length() - 1.0).abs() < 1e-6 && cube.rotation.angle_between(Quat::from_rotation_y(45f32.to_radians())) < 1e-4);
     assert_eq!((cube.friction, cube.restitution), (0.8, 0.1));
     assert_eq!(scene.object("mug").unwrap().shape, ObjectShape::Cylinder { radius: 0.04, height: 0.1 });
-    assert_eq!(scene.object("teapot").unwrap().shape, ObjectShape::Mesh { file: dir.join("teapot.obj"), scale: 1.0 }, "relative to the scene file");
+    assert_eq!(scene.object("teapot").unwrap().shape, ObjectShape::Mesh { source: MeshSource::File(dir.join("teapot.obj")), scale: 1.0 }, "relative to the scene file");
     assert_eq!((scene.actions[0].gesture.as_str(), scene.actions[0].hold_s, scene.actions[0].action), ("open_palm", 1.0, SceneCommand::Reset));
     // No table, no actions: both optional.
     let bare = parse(r#"{"objects": []}"#).unwrap();
@@ -95,6 +95,30 @@ fn bad_scenes_name_the_object_and_the_field() {
     assert!(matches!(problem(&ball(r#", "restitution": 2"#)).0, SceneProblem::OutOfRange { field: "restitution", .. }));
     let missing = Scene::load(Path::new("/no/such/scene.json")).unwrap_err().to_string();
     assert!(missing.starts_with("/no/such/scene.json: "), "{missing}");
+}
+
+/// The built-in scenes are compiled in, with their meshes: each is its file in `data/scenes`,
+/// its mesh objects naming the built-in copy of the file (which reads the same), so a copied
+/// or installed program needs no source tree.
+#[test]
+fn builtin_scenes_and_their_meshes_are_compiled_in() {
+    for name in Scene::BUILTIN {
+        let builtin = Scene::named(name).unwrap();
+        let mut file = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes").join(format!("{name}.json"))).unwrap();
+        assert!(file.objects.iter().any(|o| matches!(o.shape, ObjectShape::Mesh { .. })), "{name} has no mesh object");
+        for o in &mut file.objects {
+            if let ObjectShape::Mesh { source: MeshSource::File(path), scale } = &o.shape {
+                let relative = path.canonicalize().unwrap().strip_prefix(Path::new(env!("CARGO_MANIFEST_DIR")).join("data").canonicalize().unwrap()).unwrap().to_str().unwrap().to_owned();
+                let built_in = ObjectMesh::BUILTIN.into_iter().find(|&m| m == relative).unwrap_or_else(|| panic!("{relative} is not built in"));
+                assert_eq!(ObjectMesh::builtin(built_in).unwrap(), ObjectMesh::load(path).unwrap(), "{relative}");
+                o.shape = ObjectShape::Mesh { source: MeshSource::Builtin(built_in), scale: *scale };
+            }
+        }
+        assert_eq!(builtin, file, "{name}");
+    }
+    let e = ObjectMesh::builtin("objects/kettle.obj").unwrap_err().to_string();
+    assert!(e.contains("objects/kettle.obj") && e.contains("objects/teapot.obj"), "{e}");
+    assert_eq!(MeshSource::Builtin("objects/teapot.obj").to_string(), "objects/teapot.obj (built in)");
 }
 
 fn teapot_path() -> std::path::PathBuf {

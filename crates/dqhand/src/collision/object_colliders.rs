@@ -115,13 +115,13 @@ impl ObjectColliders {
                     let s = SharedShape::cylinder(height / 2.0, *radius);
                     (s.clone(), s, None)
                 }
-                ObjectShape::Mesh { file, scale } => {
-                    let mut mesh = ObjectMesh::load(file)?;
+                ObjectShape::Mesh { source, scale } => {
+                    let mut mesh = source.load()?;
                     for v in &mut mesh.vertices {
                         *v *= *scale;
                     }
                     warnings.extend(mesh.warnings.iter().map(|w| format!("{}: {w}", o.name)));
-                    let (surface, solid) = mesh_shapes(&mesh).map_err(|problem| Error::ObjectMesh(format!("{}: {}: {problem}", file.display(), o.name)))?;
+                    let (surface, solid) = mesh_shapes(&mesh).map_err(|problem| Error::ObjectMesh(format!("{source}: {}: {problem}", o.name)))?;
                     (surface, solid, Some(mesh))
                 }
             };

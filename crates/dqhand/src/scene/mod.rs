@@ -5,4 +5,4 @@ mod object_mesh;
 mod scene_file;
 
 pub use object_mesh::ObjectMesh;
-pub use scene_file::{ObjectShape, Scene, SceneAction, SceneCommand, SceneObject, Table, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
+pub use scene_file::{MeshSource, ObjectShape, Scene, SceneAction, SceneCommand, SceneObject, Table, DEFAULT_FRICTION, DEFAULT_RESTITUTION};

@@ -4,7 +4,11 @@
 //! collision: triangles without area dropped (a warning says how many).
 //! A mesh need not be closed (the Utah teapot is not) or have a volume (a plate modelled as
 //! one sheet): it then collides as a surface, and a warning says so.
+//!
+//! The meshes the built-in scenes name ship inside the crate ([`ObjectMesh::BUILTIN`]): a
+//! copied or installed program finds them without the source tree.
 
+use std::io::BufRead;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
@@ -29,7 +33,15 @@ pub struct ObjectMesh {
     pub warnings: Vec<String>,
 }
 
+/// The meshes compiled into the crate, by their path under its `data/` folder (where the
+/// built-in scenes, in `data/scenes/`, find them).
+const BUILTIN_MESHES: [(&str, &[u8]); 1] = [("objects/teapot.obj", include_bytes!("../../data/objects/teapot.obj"))];
+
 impl ObjectMesh {
+    /// The meshes that ship with the crate, compiled in, by their path under its `data/`
+    /// folder: the Utah teapot of the built-in scenes (`objects/teapot.obj`).
+    pub const BUILTIN: [&'static str; 1] = [BUILTIN_MESHES[0].0];
+
     /// Reads `path`, an `.obj`, `.glb` or `.gltf` file.
     ///
     /// # Errors
@@ -37,15 +49,40 @@ impl ObjectMesh {
     /// file the reader refuses, coordinates that are not finite, indices out of range, no
     /// triangle with an area), or [`Error::Io`].
     pub fn load(path: &Path) -> Result<Self> {
-        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-        match extension.as_deref() {
+        match extension(path).as_deref() {
             Some("obj") => {
-                let (vertices, indices) = read_obj(path)?;
-                Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))
+                let file = std::fs::File::open(path).map_err(Error::io(path))?;
+                Self::from_obj_reader(&mut std::io::BufReader::new(file), path)
             }
             Some("glb" | "gltf") => Self::from_gltf_slice(&std::fs::read(path).map_err(Error::io(path))?, path),
-            _ => Err(Error::ObjectMesh("not a mesh file (.obj, .glb or .gltf)".into()).in_file(path)),
+            _ => Err(not_a_mesh_file(path)),
         }
+    }
+
+    /// The built-in mesh `name` ([`Self::BUILTIN`]), from the copy compiled in.
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] for another name; none otherwise (a test reads each).
+    pub fn builtin(name: &str) -> Result<Self> {
+        let Some(&(name, bytes)) = BUILTIN_MESHES.iter().find(|(n, _)| *n == name) else {
+            return Err(Error::UnknownName { kind: "built-in mesh", name: name.to_owned(), valid: Self::BUILTIN.join(", ") });
+        };
+        let path = Path::new(name);
+        match extension(path).as_deref() {
+            Some("obj") => Self::from_obj_reader(&mut &bytes[..], path),
+            Some("glb" | "gltf") => Self::from_gltf_slice(bytes, path),
+            _ => Err(not_a_mesh_file(path)),
+        }
+    }
+
+    /// A mesh from OBJ text being read; `path` names it in errors. Material libraries are not
+    /// read (only the shape matters).
+    ///
+    /// # Errors
+    /// As [`Self::load`].
+    pub fn from_obj_reader(reader: &mut impl BufRead, path: &Path) -> Result<Self> {
+        let (vertices, indices) = read_obj(reader, path)?;
+        Self::from_triangles(vertices, &indices).map_err(|e| e.in_file(path))
     }
 
     /// A mesh from glTF bytes (`.glb`, or `.gltf` JSON) already in memory; `path` names them
@@ -104,10 +141,20 @@ impl ObjectMesh {
     }
 }
 
-/// An OBJ's positions and triangles (every object of the file; faces fanned into triangles).
-fn read_obj(path: &Path) -> Result<(Vec<Vec3>, Vec<u32>)> {
+fn extension(path: &Path) -> Option<String> {
+    path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase())
+}
+
+fn not_a_mesh_file(path: &Path) -> Error {
+    Error::ObjectMesh("not a mesh file (.obj, .glb or .gltf)".into()).in_file(path)
+}
+
+/// An OBJ's positions and triangles (every object of the file; faces fanned into triangles);
+/// `path` names it in errors.
+fn read_obj(reader: &mut impl BufRead, path: &Path) -> Result<(Vec<Vec3>, Vec<u32>)> {
     let options = tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| match e {
+    let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
+    let (models, _materials) = tobj::load_obj_buf(reader, &options, no_materials).map_err(|e| match e {
         tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => Error::io(path)(std::io::Error::other(e.to_string())),
         other => Error::ObjectMesh(format!("not a readable OBJ: {other}")).in_file(path),
     })?;

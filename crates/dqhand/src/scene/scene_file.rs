@@ -22,12 +22,17 @@
 //! a friction or restitution out of range, a rotation far from unit length, NaN, two objects
 //! of one name, a mesh file that is not there. A mesh path is relative to the scene file; its
 //! optional `scale` (default 1) scales the file's coordinates.
+//!
+//! The built-in scenes ([`Scene::BUILTIN`]) and the meshes they name are compiled in: a copied
+//! or installed program has them without the source tree.
 
-use std::path::{Path, PathBuf};
+use std::fmt;
+use std::path::{Component, Path, PathBuf};
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
+use super::ObjectMesh;
 use crate::{Error, Result, SceneProblem};
 
 /// Default friction coefficient (rubber-ish on wood).
@@ -92,13 +97,45 @@ pub enum ObjectShape {
         /// Metres, along +Y.
         height: f32,
     },
-    /// A triangle mesh (an `.obj`, `.glb` or `.gltf` file; read with [`super::ObjectMesh::load`]).
+    /// A triangle mesh (an `.obj`, `.glb` or `.gltf` file, or one built in; read with
+    /// [`MeshSource::load`]).
     Mesh {
-        /// The file, resolved against the scene file's folder.
-        file: PathBuf,
+        /// Where its triangles come from.
+        source: MeshSource,
         /// Uniform scale applied to the file's coordinates (files come in any unit).
         scale: f32,
     },
+}
+
+/// Where a mesh object's triangles come from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MeshSource {
+    /// A file, resolved against the scene file's folder.
+    File(PathBuf),
+    /// A mesh compiled into the crate ([`ObjectMesh::BUILTIN`]), named by a built-in scene.
+    Builtin(&'static str),
+}
+
+impl MeshSource {
+    /// Reads the mesh.
+    ///
+    /// # Errors
+    /// As [`ObjectMesh::load`] for a file.
+    pub fn load(&self) -> Result<ObjectMesh> {
+        match self {
+            Self::File(path) => ObjectMesh::load(path),
+            Self::Builtin(name) => ObjectMesh::builtin(name),
+        }
+    }
+}
+
+impl fmt::Display for MeshSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::File(path) => write!(f, "{}", path.display()),
+            Self::Builtin(name) => write!(f, "{name} (built in)"),
+        }
+    }
 }
 
 /// A held gesture that commands the scene.
@@ -173,20 +210,32 @@ struct ActionJson {
 /// Shape parameters each shape takes (the others must be absent).
 const SHAPES: [(&str, &[&str]); 4] = [("sphere", &["radius"]), ("box", &["size"]), ("cylinder", &["radius", "height"]), ("mesh", &["file", "scale"])];
 
-impl Scene {
-    /// The scenes that ship with the crate (`data/scenes/`): `grasp` (the paper's Figure 9: a
-    /// ball and the Utah teapot on a table) and `objects` (every kind of object).
-    pub const BUILTIN: [&'static str; 2] = ["grasp", "objects"];
+/// The built-in scenes' files (`data/scenes/`), compiled in.
+const BUILTIN_SCENES: [(&str, &str); 2] =
+    [("grasp", include_str!("../../data/scenes/grasp.json")), ("objects", include_str!("../../data/scenes/objects.json"))];
 
-    /// A built-in scene by name ([`Self::BUILTIN`]), else the scene file at that path.
+/// Where a scene's mesh paths start: a folder, or (a built-in scene) `data/scenes/` of the
+/// crate, whose meshes are compiled in.
+#[derive(Clone, Copy)]
+enum Folder<'a> {
+    Path(&'a Path),
+    Builtin,
+}
+
+impl Scene {
+    /// The scenes that ship with the crate (`data/scenes/`, compiled in): `grasp` (the paper's
+    /// Figure 9: a ball and the Utah teapot on a table) and `objects` (every kind of object).
+    pub const BUILTIN: [&'static str; 2] = [BUILTIN_SCENES[0].0, BUILTIN_SCENES[1].0];
+
+    /// A built-in scene by name ([`Self::BUILTIN`]; its meshes built in too), else the scene
+    /// file at that path.
     ///
     /// # Errors
     /// As [`Self::load`].
     pub fn named(name: &str) -> Result<Self> {
-        if Self::BUILTIN.contains(&name) {
-            Self::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes").join(format!("{name}.json")))
-        } else {
-            Self::load(Path::new(name))
+        match BUILTIN_SCENES.iter().find(|(n, _)| *n == name) {
+            Some((name, text)) => Self::parse(text, &format!("{name} (built-in scene)"), Folder::Builtin),
+            None => Self::load(Path::new(name)),
         }
     }
 
@@ -204,6 +253,10 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] naming the first problem.
     pub fn from_json(text: &str, file: &str, folder: &Path) -> Result<Self> {
+        Self::parse(text, file, Folder::Path(folder))
+    }
+
+    fn parse(text: &str, file: &str, folder: Folder<'_>) -> Result<Self> {
         let fail = |problem| Error::Scene { file: file.to_owned(), problem };
         let json: SceneJson = serde_json::from_str(text).map_err(|e| fail(SceneProblem::Json(e.to_string())))?;
         let table = match json.table {
@@ -239,7 +292,7 @@ impl Scene {
     }
 }
 
-fn object(o: ObjectJson, folder: &Path) -> std::result::Result<SceneObject, SceneProblem> {
+fn object(o: ObjectJson, folder: Folder<'_>) -> std::result::Result<SceneObject, SceneProblem> {
     let name = o.name.as_str();
     let Some((_, parameters)) = SHAPES.iter().find(|(s, _)| *s == o.shape) else {
         return Err(SceneProblem::UnknownShape { object: o.name.clone(), shape: o.shape.clone() });
@@ -263,11 +316,19 @@ fn object(o: ObjectJson, folder: &Path) -> std::result::Result<SceneObject, Scen
         }
         "cylinder" => ObjectShape::Cylinder { radius: length("radius", o.radius)?, height: length("height", o.height)? },
         _ => {
-            let file = folder.join(o.file.as_deref().expect("checked present"));
-            if !file.is_file() {
-                return Err(SceneProblem::MeshFile { object: o.name.clone(), file });
-            }
-            ObjectShape::Mesh { file, scale: positive(name, "scale", o.scale.unwrap_or(1.0))? }
+            let file = o.file.as_deref().expect("checked present");
+            let source = match folder {
+                Folder::Path(folder) => Some(folder.join(file)).filter(|f| f.is_file()).map(MeshSource::File),
+                Folder::Builtin => builtin_mesh(file).map(MeshSource::Builtin),
+            };
+            let Some(source) = source else {
+                let folder = match folder {
+                    Folder::Path(folder) => folder,
+                    Folder::Builtin => Path::new("scenes"),
+                };
+                return Err(SceneProblem::MeshFile { object: o.name.clone(), file: folder.join(file) });
+            };
+            ObjectShape::Mesh { source, scale: positive(name, "scale", o.scale.unwrap_or(1.0))? }
         }
     };
     let mut position = Vec3::ZERO;
@@ -297,6 +358,24 @@ fn object(o: ObjectJson, folder: &Path) -> std::result::Result<SceneObject, Scen
         return Err(SceneProblem::OutOfRange { object: o.name.clone(), field: "restitution", value: restitution, range: "0 to 1" });
     }
     Ok(SceneObject { name: o.name, shape, position, rotation, mass, friction, restitution })
+}
+
+/// The built-in mesh a built-in scene's `file` names: the path resolved against `scenes/`,
+/// within the crate's `data/` (`../objects/teapot.obj` is `objects/teapot.obj`).
+fn builtin_mesh(file: &Path) -> Option<&'static str> {
+    let mut parts = vec!["scenes"];
+    for c in file.components() {
+        match c {
+            Component::Normal(part) => parts.push(part.to_str()?),
+            Component::ParentDir => {
+                parts.pop()?;
+            }
+            Component::CurDir => {}
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    let path = parts.join("/");
+    ObjectMesh::BUILTIN.into_iter().find(|&m| m == path)
 }
 
 fn finite(object: &str, field: &'static str, value: f32) -> std::result::Result<f32, SceneProblem> {
