@@ -30,22 +30,36 @@
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names.
 
 mod error;
+#[cfg(feature = "interaction")]
 pub mod collision;
 pub mod engine;
 pub mod geometry;
+#[cfg(feature = "interaction")]
 pub mod gesture;
+#[cfg(feature = "gltf")]
 pub mod gltf_file;
+#[cfg(feature = "interaction")]
 pub mod grasp;
+#[cfg(feature = "hand")]
 pub mod hand;
+#[cfg(feature = "interaction")]
 pub mod input;
+#[cfg(feature = "interaction")]
 pub mod interaction;
+#[cfg(feature = "gltf")]
 pub mod io;
 pub mod kinematics;
 pub mod math;
+#[cfg(feature = "metrics")]
 pub mod metrics;
 pub mod model;
+#[cfg(feature = "interaction")]
 pub mod physics;
+#[cfg(feature = "interaction")]
 pub mod scene;
 pub mod skin;
+
+/// The glam this crate's types are made of: use it rather than matching versions by hand.
+pub use glam;
 
 pub use error::{Error, GestureProblem, Result, SceneProblem};

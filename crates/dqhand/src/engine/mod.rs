@@ -14,7 +14,9 @@
 //! those below it (see ARCHITECTURE.md).
 
 mod interaction_cycle;
+#[cfg(all(feature = "gltf", feature = "hand"))]
 mod model_source;
 
 pub use interaction_cycle::Engine;
+#[cfg(all(feature = "gltf", feature = "hand"))]
 pub use model_source::ModelSource;

@@ -30,7 +30,7 @@
 
 use glam::Vec3;
 
-use crate::hand::Side;
+use crate::kinematics::Side;
 
 /// A finger, thumb first (WebXR order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -251,7 +251,7 @@ mod tests {
     use glam::Vec3;
 
     use super::{Feature, Finger, HandFeatures};
-    use crate::hand::Side;
+    use crate::kinematics::Side;
 
     /// A flat right hand, palm down (dorsal +Y), fingers along −Z; the index chain turned by
     /// `index_knuckle` toward the palm at its knuckle.

@@ -26,6 +26,8 @@ use crate::model::Model;
 use crate::skin::{MeshData, SkinnedMesh};
 use crate::{Error, Result};
 pub use anthropometry::measure;
+/// The side of the hand to build (the kinematics layer's; re-exported for [`HandParams`]).
+pub use crate::kinematics::Side;
 use anthropometry::Anatomy;
 use shape::HandShape;
 
@@ -33,27 +35,6 @@ use shape::HandShape;
 pub const DEFAULT_VERTICES: usize = 8_668;
 /// Densities [`build`] accepts.
 pub const VERTEX_RANGE: core::ops::RangeInclusive<usize> = 1_000..=60_000;
-
-/// Which hand.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Side {
-    /// Left hand: the thumb on +X when the palm faces down and the fingers point along −Z.
-    Left,
-    /// Right hand: the thumb on −X.
-    #[default]
-    Right,
-}
-
-impl Side {
-    /// `"left"` or `"right"`.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-}
 
 /// What the user gives: two measurements, the side and the level of detail.
 #[derive(Clone, Copy, Debug, PartialEq)]

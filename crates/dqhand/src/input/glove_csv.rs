@@ -23,7 +23,7 @@ use glam::{Quat, Vec3};
 use super::glove_layout::check_raw;
 use super::record::unit_as_read;
 use super::{GloveSample, HandData, MappingTable, Record, RejectKind, Rejection, RigidPose, MAX_GLOVE_SENSORS};
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::{Error, Result};
 
 /// The tracker's columns, in record order (position, then quaternion `x, y, z, w`).

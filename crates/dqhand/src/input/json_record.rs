@@ -35,7 +35,7 @@ use serde::Deserialize;
 
 use super::record::{unit_as_read, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 use super::{openxr, GloveSample, HandData, JointSet, RejectKind, Rejection, Record, RigidPose, TrackedJoint};
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::kinematics::webxr;
 
 /// Longest line or message accepted, bytes (a 25-joint record with orientations is ~3 KiB).

@@ -19,7 +19,7 @@ use glam::Vec3;
 
 use super::record::JOINT_COUNT;
 use super::{GloveMapper, HandData, InputConfig, OneEuro, OneEuroRotation, OneEuroVec3, Record, RejectKind, Rejection, Rejections, Retargeter};
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::kinematics::{HandRig, Pose};
 use crate::math::DualQuat;
 

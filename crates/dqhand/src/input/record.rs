@@ -7,7 +7,7 @@
 
 use glam::{Quat, Vec3};
 
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::kinematics::webxr;
 
 /// Most sensors a glove record carries (the CyberGlove's 18, with room for 22-sensor gloves).

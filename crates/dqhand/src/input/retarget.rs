@@ -27,7 +27,7 @@ use glam::{Affine3A, Mat3, Quat, Vec3};
 
 use super::record::{JOINT_COUNT, LANDMARK_COUNT};
 use super::{mediapipe, RejectKind, Rejection};
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::kinematics::{webxr, HandRig, JointPositions, Motion, Pose, RigDof};
 use crate::math::DualQuat;
 

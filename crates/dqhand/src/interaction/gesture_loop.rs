@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::gesture::{Events, GestureSet, HandFeatures, Recognizer};
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::input::{GloveMapper, InputConfig, InputPipeline, Record, Rejection};
 use crate::kinematics::{HandKinematics, JointModel, JointPositions};
 use crate::model::Model;

@@ -15,7 +15,7 @@ use parry3d::query::Ray;
 use super::synthetic::joint_set;
 use crate::collision::ObjectColliders;
 use crate::gesture::gesture;
-use crate::hand::Side;
+use crate::kinematics::Side;
 use crate::input::{HandData, Record};
 use crate::kinematics::{HandKinematics, JointModel, JointPositions, Motion, Pose};
 use crate::math::DualQuat;

@@ -6,6 +6,7 @@ use std::path::Path;
 use serde_json::{json, Value};
 
 use super::{check_lengths, write_bytes};
+#[cfg(feature = "interaction")]
 use crate::collision::ProxyShape;
 use crate::model::Model;
 use crate::Result;
@@ -104,10 +105,10 @@ fn skin_material() -> Value {
 /// Writes the model as a rigged, skinned GLB in its rest pose, which three.js and Blender load
 /// and animate: the joint hierarchy as nodes (rest TRS), one skin with the inverse bind
 /// matrices, one primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
-/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences). Each joint node with
-/// vertices of its own carries its collision proxy ([`crate::collision::fit_proxies`]) in the
-/// node's frame as `extras.dqhand_collision`: `{"capsule": {"start", "end", "radius"}}` or
-/// `{"convex_hull": {"points", "triangles"}}`.
+/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences). Built with the
+/// `interaction` feature, each joint node with vertices of its own carries its collision proxy
+/// (`collision::fit_proxies`) in the node's frame as `extras.dqhand_collision`:
+/// `{"capsule": {"start", "end", "radius"}}` or `{"convex_hull": {"points", "triangles"}}`.
 ///
 /// # Errors
 /// [`crate::Error::Io`] if the file cannot be written.
@@ -145,6 +146,7 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
     let ibm = glb.floats(&ibm, "MAT4", None);
 
     let joints = skeleton.joints();
+    #[cfg(feature = "interaction")]
     let proxies = crate::collision::fit_proxies(model, crate::collision::PROXY_MARGIN);
     let mut nodes: Vec<Value> = joints
         .iter()
@@ -162,6 +164,7 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
             if !children.is_empty() {
                 node["children"] = json!(children);
             }
+            #[cfg(feature = "interaction")]
             if let Some(proxy) = proxies.iter().find(|p| p.joint == i) {
                 node["extras"] = json!({ "dqhand_collision": proxy_json(&proxy.shape) });
             }
@@ -183,6 +186,7 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
     write_bytes(path, &glb.finish(doc))
 }
 
+#[cfg(feature = "interaction")]
 fn proxy_json(shape: &ProxyShape) -> Value {
     match shape {
         ProxyShape::Capsule { start, end, radius } => {

@@ -1,14 +1,17 @@
 //! Maths on top of glam: the dual quaternion and its screw form, point–segment distance, the
-//! best-fit rigid motion of two point sets, and the quantile rule of every report.
+//! best-fit rigid motion of two point sets (with `interaction`: on nalgebra's SVD), and the
+//! quantile rule of every report.
 
 mod dual_quat;
 mod quantile;
+#[cfg(feature = "interaction")]
 mod rigid_fit;
 mod screw;
 mod segment;
 
 pub use dual_quat::DualQuat;
 pub use quantile::quantile;
+#[cfg(feature = "interaction")]
 pub use rigid_fit::rigid_fit;
 pub use screw::Screw;
 pub use segment::segment_distance;

@@ -4,6 +4,7 @@ use glam::Affine3A;
 
 use std::sync::Arc;
 
+#[cfg(feature = "rayon")]
 use rayon::prelude::*;
 
 use super::crew::Crew;
@@ -324,6 +325,7 @@ impl Deformer {
         }
     }
 
+    #[cfg(feature = "rayon")]
     /// Deforms `mesh` once per pose, the poses split across `pool`'s threads (each pose on
     /// one thread): `skinning` holds the poses' transforms one after another (#joints each),
     /// `out` one buffer per pose. For data sets of posed hands. Each thread's scratch is made
