@@ -10,7 +10,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -59,10 +59,28 @@ chromium:
 	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; \
 	  else echo "make: $(CHROMIUM) missing: install Debian's chromium (sudo apt-get install chromium)" >&2; exit 1; fi; }
 
-# Rust tests (unit, property, golden, CLI, server), the Khronos glTF validator on what we write,
-# then the page: protocol unit tests and browser tests against a real `dqhand demo`.
+# The library's features, each built alone (a feature must not lean on another it does not
+# name), the core first: kinematics and the deformers on glam.
+LIB_FEATURES := gltf hand interaction metrics rayon
+
+features:
+	$(CARGO) check --locked -p dqhand --no-default-features --lib --examples
+	for f in $(LIB_FEATURES); do $(CARGO) check --locked -p dqhand --no-default-features --features $$f --lib --examples || exit 1; done
+
+# The library's examples, run (cargo test only builds them).
+examples: recordings
+	mkdir -p out/examples
+	$(CARGO) run --locked -q -p dqhand --no-default-features --example skin_into_buffer
+	$(CARGO) run --locked -q -p dqhand --example skin_a_pose -- out/examples/ok.glb
+	$(CARGO) run --locked -q -p dqhand --example gestures_from_a_recording -- $(RECORDINGS)/gestures-joints.jsonl
+	$(CARGO) run --locked -q -p dqhand --example grasp_the_ball
+
+# Rust tests (unit, property, golden, CLI, server, doctests), the features alone and the
+# examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
+# browser tests against a real `dqhand demo`.
 test: assets viewer chromium recordings
 	$(CARGO) test --locked --workspace
+	$(MAKE) features examples
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
 

@@ -1,4 +1,4 @@
-// The stream's wire format, version 1 (crates/dqhand/src/stream/frame.rs is the reference):
+// The stream's wire format, version 1 (crates/dqhand-stream/src/frame.rs is the reference):
 // a topology message once, then binary frames; JSON text for hello, input state, scene state, errors and commands.
 // Arrays are 4-byte aligned, so they are read as typed-array views without copying.
 
@@ -85,7 +85,7 @@ export interface Hello {
   scene: HelloScene | null;
 }
 
-/** Bounds of the scene messages (crates/dqhand/src/stream/frame.rs): larger ones are refused. */
+/** Bounds of the scene messages (crates/dqhand-stream/src/frame.rs): larger ones are refused. */
 export const MAX_SCENE_OBJECTS = 256;
 export const MAX_SCENE_TRIANGLES = 50_000;
 export const MAX_SCENE_CONTACTS = 64;
@@ -444,7 +444,7 @@ function checkRecording(v: Record<string, unknown>): RecordingMessage {
   return { type: 'recording', on: v.on, path: v.path, records: v.records, failed };
 }
 
-/** The commands the engine accepts (crates/dqhand/src/stream/command.rs). */
+/** The commands the engine accepts (crates/dqhand-stream/src/command.rs). */
 export type Command =
   | { type: 'ack'; seq: number }
   | { type: 'view'; methods: Method[] }

@@ -1,12 +1,21 @@
 //! dqhand: a dual quaternion virtual hand (Chen, Zhu, Wan, Feng, "Dual quaternion based
-//! virtual hand interaction modeling", Sci China Inf Sci 56:032103, 2013).
+//! virtual hand interaction modeling", Sci China Inf Sci 56:032103, 2013), as a library.
+//!
+//! A pose goes through the paper's two stages, each usable alone: the **kinematics layer**
+//! ([`kinematics::HandKinematics`] for joint angles, [`kinematics::KinematicsLayer`] for any
+//! skeleton: one forward kinematics pass, each bone's skinning transform and its unit dual
+//! quaternion) and the **skin layer** ([`skin::SkinLayer`]: LB, QB or DQB on those transforms,
+//! into its own buffers or the caller's). [`engine::Engine`] holds one of each for a hand; the
+//! interaction loops ([`interaction::GestureLoop`], [`interaction::ManipulationLoop`]) hold
+//! only kinematics.
 //!
 //! Modules from the bottom up, each importing only those above it in this list (the
 //! paper's Figure 1, layer by layer; ARCHITECTURE.md draws it):
 //! * [`math`] — dual quaternions and screws on top of glam;
 //! * [`geometry`] — mesh helpers: normals, edges, closed surfaces, volume, winding number;
-//! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK;
-//! * [`skin`] — the skinned mesh and the LB, QB and DQB deformers;
+//! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK, and
+//!   the kinematics layer;
+//! * [`skin`] — the skinned mesh, the LB, QB and DQB deformers and the skin layer;
 //! * [`model`] — a skeleton and the mesh bound to it;
 //! * [`gltf_file`] — a glTF 2.0 file opened safely, for the importer and scene meshes;
 //! * [`scene`] — the objects and table of the manipulation loop, from scene files;
@@ -18,16 +27,26 @@
 //! * [`hand`] — the built-in anatomical hand;
 //! * [`io`] — glTF 2.0 in and out, PLY and OBJ out, pose files;
 //! * [`input`] — records from gloves, trackers and hand tracking, turned into poses;
-//! * [`gesture`] — the gesture library and pose sequences;
-//! * [`engine`] — one step of Figure 1: pose → kinematics → skin (collision and interaction
-//!   join in later issues);
+//! * [`gesture`] — the gesture library, pose sequences and recognition;
+//! * [`engine`] — a hand's two stages together: pose → kinematics → skin;
 //! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
 //!   synthetic labelled sequences, and the loop's measures on them; the manipulation loop:
 //!   records → pose → contacts → grasp → physics, and scripted grasp recordings;
-//! * [`metrics`] — realism metrics of LB, QB and DQB, measured through the engine.
+//! * [`metrics`] — realism metrics of LB, QB and DQB.
+//!
+//! # Features
+//! All on by default; without them (`default-features = false`) the core is `math`,
+//! `geometry`, `kinematics`, `skin`, `model` and `engine`, on glam and thiserror alone.
+//! * `gltf` — [`gltf_file`] and [`io`]: glTF 2.0 in and out, PLY and OBJ out, pose files;
+//! * `hand` — [`hand`]: the parametric anatomical hand and its mesher;
+//! * `interaction` — [`input`], [`gesture`], [`scene`], [`collision`], [`grasp`], [`physics`]
+//!   and [`interaction`] (turns on `gltf` and `hand`);
+//! * `metrics` — [`metrics`] (turns on `interaction`);
+//! * `rayon` — [`skin::Deformer::deform_batch`], poses deformed across a thread pool.
 //!
 //! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
-//! are `[x, y, z, w]`; joints carry WebXR hand joint names.
+//! are `[x, y, z, w]`; joints carry WebXR hand joint names. The types are glam's, re-exported
+//! as [`glam`]. Minimum Rust: 1.89.
 
 mod error;
 #[cfg(feature = "interaction")]
