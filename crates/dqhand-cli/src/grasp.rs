@@ -124,7 +124,7 @@ fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &
         .collect();
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({"p": p.to_array(), "q": q.to_array()}))).collect();
     let tracking = if manip.tracking() == Tracking::Tracking { "ok" } else { "lost" };
-    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": manip.held(), "contacts": contacts, "objects": objects}))?;
+    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": manip.held().map(|i| &manip.names()[i]), "contacts": contacts, "objects": objects}))?;
     out.write_all(b"\n")?;
     Ok(())
 }

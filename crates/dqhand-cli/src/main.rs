@@ -104,7 +104,7 @@ fn main() {
 }
 
 /// Prints the warnings of a load or pose step, one line each.
-pub(crate) fn warn_all(warnings: &[String]) {
+pub(crate) fn warn_all(warnings: &[impl std::fmt::Display]) {
     for w in warnings {
         eprintln!("dqhand: warning: {w}");
     }

@@ -426,5 +426,5 @@ pub fn scene_message(manip: &ManipulationLoop) -> String {
         .take(MAX_SCENE_CONTACTS)
         .map(|c| json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() }))
         .collect();
-    json!({ "type": "scene", "held": manip.held(), "objects": objects, "contacts": contacts }).to_string()
+    json!({ "type": "scene", "held": manip.held().map(|i| &manip.names()[i]), "objects": objects, "contacts": contacts }).to_string()
 }

@@ -102,7 +102,7 @@ impl SceneState {
         self.manip.step(now);
         self.stepped = now;
         let (poses, contacts) = (self.manip.poses(), self.manip.contacts().len());
-        let held = self.manip.held().and_then(|h| self.manip.names().iter().position(|n| n == h));
+        let held = self.manip.held();
         if poses != self.poses.as_slice() || contacts + self.contacts > 0 || held != self.held {
             self.poses.copy_from_slice(poses);
             (self.contacts, self.held) = (contacts, held);

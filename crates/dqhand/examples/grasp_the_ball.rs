@@ -35,7 +35,7 @@ fn main() -> Result<(), dqhand::Error> {
             }
             None => {}
         }
-        held_frames += usize::from(manipulation.held() == Some("ball"));
+        held_frames += usize::from(manipulation.held() == Some(ball));
     }
     let (_, at) = manipulation.poses()[ball];
     println!("held the ball for {held_frames} of {} frames; it rests at ({:.3}, {:.3}, {:.3}) m", script.records.len(), at.x, at.y, at.z);

@@ -49,6 +49,7 @@
 //! as [`glam`]. Minimum Rust: 1.89.
 
 mod error;
+mod warning;
 #[cfg(feature = "interaction")]
 pub mod collision;
 pub mod engine;
@@ -82,3 +83,4 @@ pub mod skin;
 pub use glam;
 
 pub use error::{Error, GestureProblem, Result, SceneProblem};
+pub use warning::Warning;

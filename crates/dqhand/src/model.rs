@@ -17,7 +17,7 @@ pub struct Model {
     /// The mesh, in bind space; its influences index `skeleton`'s joints.
     pub mesh: Arc<SkinnedMesh>,
     /// Problems that were repaired while loading (for example renormalised weights).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::Warning>,
 }
 
 impl Model {
@@ -49,6 +49,26 @@ impl Model {
     /// The kinematics layer posed for a resolved pose file: joint angles on the anatomical
     /// chain of its joint model (clamped with `limits`, saying which were), or local rotations
     /// of this model's own skeleton.
+    ///
+    /// ```
+    /// # #[cfg(feature = "hand")] {
+    /// use dqhand::kinematics::{JointModel, Limits, Pose, PoseTarget};
+    ///
+    /// let hand = dqhand::hand::build(&dqhand::hand::HandParams { vertices: 2000, ..Default::default() })?;
+    /// let mut pose = Pose::rest(JointModel::Paper.dof_count());
+    /// pose.angles[JointModel::Paper.dof_index("index-finger-phalanx-intermediate.flex")?] = 150f32.to_radians();
+    /// let target = PoseTarget::Angles { model: JointModel::Paper, pose }; // as a pose file resolves
+    /// let (layer, clamped) = hand.pose_target(&target, Limits::Anatomical)?;
+    /// assert_eq!(layer.passes(), 1);
+    /// assert_eq!(clamped.len(), 1, "{clamped:?}");
+    /// assert_eq!(clamped[0].dof, "index-finger-phalanx-intermediate.flex");
+    /// assert_eq!((clamped[0].asked_deg.round(), clamped[0].min_deg, clamped[0].max_deg), (150.0, 0.0, 110.0));
+    /// assert!(clamped[0].to_string().contains("clamped to its range 0..110 degrees"), "{}", clamped[0]);
+    /// let (_, clamped) = hand.pose_target(&target, Limits::Off)?;
+    /// assert!(clamped.is_empty(), "without limits nothing is clamped");
+    /// # }
+    /// # Ok::<(), dqhand::Error>(())
+    /// ```
     ///
     /// # Errors
     /// As [`HandKinematics::new`], for angles on a skeleton without the WebXR joints.

@@ -13,6 +13,7 @@ use parry3d::math::Pose;
 use parry3d::query;
 use parry3d::shape::{Shape, SharedShape, TriMeshFlags};
 
+use crate::Warning;
 use crate::scene::{ObjectMesh, ObjectShape, Scene};
 use crate::{Error, Result};
 
@@ -92,7 +93,7 @@ pub struct ObjectColliders {
     all: Vec<ObjectCollider>,
     count: usize,
     table: Option<TableTop>,
-    warnings: Vec<String>,
+    warnings: Vec<Warning>,
 }
 
 impl ObjectColliders {
@@ -120,7 +121,7 @@ impl ObjectColliders {
                     for v in &mut mesh.vertices {
                         *v *= *scale;
                     }
-                    warnings.extend(mesh.warnings.iter().map(|w| format!("{}: {w}", o.name)));
+                    warnings.extend(mesh.warnings.iter().map(|w| Warning::Object { object: o.name.clone(), warning: Box::new(w.clone()) }));
                     let (surface, solid) = mesh_shapes(&mesh).map_err(|problem| Error::ObjectMesh(format!("{source}: {}: {problem}", o.name)))?;
                     (surface, solid, Some(mesh))
                 }
@@ -160,7 +161,7 @@ impl ObjectColliders {
 
     /// What was accepted with a doubt (a flat mesh, dropped triangles), one line each.
     #[must_use]
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[Warning] {
         &self.warnings
     }
 

@@ -17,6 +17,7 @@ use crate::Result;
 /// kinematics layer's transforms. A new engine holds the rest pose, skinned with DQB.
 ///
 /// ```
+/// # #[cfg(feature = "hand")] {
 /// use std::sync::Arc;
 /// use dqhand::engine::Engine;
 /// use dqhand::kinematics::{JointModel, Pose};
@@ -29,6 +30,7 @@ use crate::Result;
 /// engine.step(&pose);
 /// let skin = engine.deformed(Method::Dqb).expect("DQB is in the default set");
 /// assert_eq!(skin.positions().len(), engine.model().mesh.vertex_count());
+/// # }
 /// # Ok::<(), dqhand::Error>(())
 /// ```
 #[derive(Clone, Debug)]

@@ -65,6 +65,30 @@ impl<'a> Iterator for Events<'a> {
 }
 
 /// Recognises the gestures of a [`GestureSet`], one current gesture at a time.
+///
+/// ```
+/// use dqhand::gesture::{gesture, EventKind, GestureSet, HandFeatures, Recognizer};
+/// use dqhand::hand::{build, HandParams, Side};
+/// use dqhand::kinematics::{JointModel, JointPositions};
+///
+/// // The built-in right hand showing the library's fist, and its features.
+/// let hand = build(&HandParams { vertices: 2000, ..Default::default() })?;
+/// let mut kinematics = hand.hand_kinematics(JointModel::Full)?;
+/// kinematics.pose(&gesture("fist")?.pose(JointModel::Full));
+/// let joints = JointPositions::new(kinematics.skeleton())?.read(kinematics.world());
+/// let features = HandFeatures::from_positions(&joints, Side::Right);
+///
+/// let mut recognizer = Recognizer::new(GestureSet::builtin());
+/// let mut events = Vec::new();
+/// for frame in 0..18 { // 0.2 s at 90 Hz: a change is reported once it has lasted min_hold_s
+///     events.extend(recognizer.update(f64::from(frame) / 90.0, &features).map(|e| (e.event, e.gesture.to_owned(), e.t)));
+/// }
+/// assert_eq!(events.len(), 1, "{events:?}");
+/// assert_eq!((events[0].0, events[0].1.as_str()), (EventKind::Start, "fist"));
+/// assert!(events[0].2 >= recognizer.set().min_hold_s());
+/// assert_eq!(recognizer.current(), Some("fist"));
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Recognizer {
     set: GestureSet,

@@ -98,6 +98,20 @@ impl InputConfig {
 
     /// Parses and checks a configuration.
     ///
+    /// ```
+    /// use dqhand::input::InputConfig;
+    ///
+    /// let config = InputConfig::from_json(r#"{"grace_s": 0.5, "filter": false}"#)?;
+    /// assert_eq!((config.grace_s, config.filter), (0.5, false));
+    /// assert_eq!(config.actions, InputConfig::default().actions, "fields left out keep their defaults");
+    /// let err = InputConfig::from_json(r#"{"grace_s": -1}"#).unwrap_err();
+    /// assert!(matches!(err, dqhand::Error::Config(_)));
+    /// assert_eq!(err.to_string(), "input configuration: grace_s: must be a positive number of seconds");
+    /// let err = InputConfig::from_json(r#"{"grace": 1}"#).unwrap_err().to_string();
+    /// assert!(err.contains("unknown field `grace`"), "{err}");
+    /// # Ok::<(), dqhand::Error>(())
+    /// ```
+    ///
     /// # Errors
     /// [`Error::Config`] naming the bad field.
     pub fn from_json(text: &str) -> Result<Self> {

@@ -17,6 +17,34 @@ use crate::model::Model;
 use crate::Result;
 
 /// One user's hand driving one virtual hand, with an optional gesture recogniser.
+///
+/// ```
+/// use std::sync::Arc;
+/// use dqhand::gesture::{gesture, GestureSet};
+/// use dqhand::hand::{build, HandParams, Side};
+/// use dqhand::input::{HandData, InputConfig, JointSet, Record, TrackedJoint};
+/// use dqhand::interaction::GestureLoop;
+/// use dqhand::kinematics::{JointModel, JointPositions};
+///
+/// let hand = Arc::new(build(&HandParams { vertices: 1000, ..Default::default() })?);
+/// // What a hand tracker reports: the 25 WebXR joints of a hand making a fist.
+/// let mut user = hand.hand_kinematics(JointModel::Full)?;
+/// user.pose(&gesture("fist")?.pose(JointModel::Full));
+/// let mut joints = JointSet::new();
+/// for (i, position) in JointPositions::new(user.skeleton())?.read(user.world()).into_iter().enumerate() {
+///     joints.set(i, TrackedJoint { position, orientation: None, radius: 0.0 });
+/// }
+/// let mut hands = GestureLoop::new(hand, JointModel::Full, None, InputConfig::default(), Some(GestureSet::builtin()))?;
+/// let mut started = Vec::new();
+/// for frame in 0..30u32 { // half a second at 60 Hz
+///     let record = Record { time: f64::from(frame) / 60.0, side: Side::Right, hand: Some(HandData::Joints(joints)), tracker: None, arrival: None };
+///     started.extend(hands.push(&record)?.map(|e| e.gesture.to_owned()));
+///     assert_eq!(hands.kinematics().layer().passes(), u64::from(frame) + 1, "posed once per record");
+/// }
+/// assert_eq!(started, ["fist"]);
+/// assert_eq!(hands.gesture(), Some("fist"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct GestureLoop {
     model: Arc<Model>,
     pipeline: InputPipeline,

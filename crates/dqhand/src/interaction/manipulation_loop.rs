@@ -175,10 +175,10 @@ impl ManipulationLoop {
         self.input.pipeline().tracking()
     }
 
-    /// The name of the object held, if any.
+    /// The object held, if any: its index in scene order (its name in [`Self::names`]).
     #[must_use]
-    pub fn held(&self) -> Option<&str> {
-        self.grasp.held().map(|i| self.names[i].as_str())
+    pub fn held(&self) -> Option<usize> {
+        self.grasp.held()
     }
 
     /// The rendered hand's contacts after the last frame.

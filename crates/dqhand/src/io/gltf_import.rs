@@ -13,6 +13,7 @@ use glam::{Affine3A, Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::Semantic;
 
+use crate::Warning;
 use crate::gltf_file::{self, check_accessor};
 use crate::kinematics::{Joint, Skeleton, Transform};
 use crate::model::Model;
@@ -50,7 +51,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     let mut warnings = Vec::new();
     let other = skinned.iter().filter(|n| n.skin().map(|s| s.index()) != Some(skin.index())).count();
     if other > 0 {
-        warnings.push(format!("{other} mesh nodes bound to other skins were ignored; only skin {} is read", skin.index()));
+        warnings.push(Warning::OtherSkinsIgnored { nodes: other, skin: skin.index() });
     }
 
     // Skeleton: the skin's joints and all their ancestors, in node order.
@@ -80,7 +81,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
         let mut name = node.name().map_or_else(|| format!("node{}", node.index()), str::to_owned);
         if !names.insert(name.clone()) {
             let renamed = format!("{name}#{}", node.index());
-            warnings.push(format!("node {} is also called {name:?}; it is called {renamed:?} here", node.index()));
+            warnings.push(Warning::NodeRenamed { node: node.index(), name: name.clone(), renamed: renamed.clone() });
             name = renamed;
             names.insert(name.clone());
         }
@@ -90,7 +91,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             return Err(bad(format!("node {name:?} has rotation {r:?}, which is not a rotation")));
         }
         if (norm - 1.0).abs() > 1e-3 {
-            warnings.push(format!("node {name:?} has a rotation of norm {norm}; it was normalised"));
+            warnings.push(Warning::RotationNormalised { node: name.clone(), norm });
         }
         joints.push(Joint {
             name,

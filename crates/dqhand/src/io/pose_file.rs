@@ -39,6 +39,26 @@ fn identity() -> [f32; 4] {
 }
 
 /// A pose file as written.
+///
+/// ```
+/// # #[cfg(feature = "hand")] {
+/// use dqhand::io::PoseFile;
+/// use dqhand::kinematics::{JointModel, PoseTarget};
+///
+/// let hand = dqhand::hand::build(&dqhand::hand::HandParams { vertices: 2000, ..Default::default() })?;
+/// let file: PoseFile = serde_json::from_str(r#"{"angles_deg": {"index-finger-phalanx-intermediate.flex": 90}}"#)?;
+/// let PoseTarget::Angles { model, pose } = file.resolve(&hand.skeleton)? else { panic!("angles resolve to angles") };
+/// assert_eq!(model, JointModel::Paper, "every angle is a paper DOF");
+/// let i = model.dof_index("index-finger-phalanx-intermediate.flex")?;
+/// assert!((pose.angles[i] - 90f32.to_radians()).abs() < 1e-6, "degrees in the file, radians in the pose");
+/// assert_eq!(pose.angles.iter().filter(|&&a| a != 0.0).count(), 1);
+/// // Node rotations name joints of the skeleton; an unknown one is refused, listing the valid ones.
+/// let file: PoseFile = serde_json::from_str(r#"{"local_rotations": {"index-tip": [0, 0, 0, 1]}}"#)?;
+/// let err = file.resolve(&hand.skeleton).unwrap_err().to_string();
+/// assert!(err.starts_with("unknown node \"index-tip\"") && err.contains("index-finger-tip"), "{err}");
+/// # }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PoseFile {

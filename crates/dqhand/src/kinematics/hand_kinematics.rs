@@ -30,6 +30,30 @@ impl core::fmt::Display for ClampedAngle {
 ///
 /// This is what every loop holds: the gesture loop poses the tracked hand with it, the
 /// contact constraint the rendered hand, and the skin layer reads either's transforms.
+///
+/// ```
+/// # #[cfg(feature = "hand")] {
+/// use dqhand::glam::Vec3;
+/// use dqhand::kinematics::{JointModel, Pose};
+///
+/// let hand = dqhand::hand::build(&dqhand::hand::HandParams { vertices: 2000, ..Default::default() })?;
+/// let mut kinematics = hand.hand_kinematics(JointModel::Paper)?;
+/// let rest = kinematics.world().to_vec();
+/// let mut pose = Pose::rest(JointModel::Paper.dof_count());
+/// pose.angles[JointModel::Paper.dof_index("index-finger-phalanx-proximal.flex")?] = 1.0; // radians
+/// kinematics.pose(&pose);
+/// assert_eq!(kinematics.layer().passes(), 1, "one forward kinematics pass per pose");
+/// let (index, pinky) = (kinematics.skeleton().index_of("index-finger-tip")?, kinematics.skeleton().index_of("pinky-finger-tip")?);
+/// assert!(kinematics.world()[index].translation.distance(rest[index].translation) > 0.02, "the index finger bends");
+/// assert_eq!(kinematics.world()[pinky], rest[pinky], "the little finger stays");
+/// // Each dual quaternion is its skinning transform, rigidly.
+/// let p = Vec3::new(0.01, 0.02, -0.05);
+/// for (q, m) in kinematics.dual_quats().iter().zip(kinematics.skinning()) {
+///     assert!(q.transform_point3(p).abs_diff_eq(m.transform_point3(p), 1e-5));
+/// }
+/// # }
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct HandKinematics {
     rig: HandRig,

@@ -13,6 +13,30 @@ use crate::math::DualQuat;
 /// Any skinned skeleton can be posed this way; [`super::HandKinematics`] poses joint angles
 /// on a hand's anatomical chain through one. Every buffer is allocated here; posing
 /// allocates nothing.
+///
+/// ```
+/// use dqhand::glam::{Affine3A, Quat, Vec3};
+/// use dqhand::kinematics::{Joint, KinematicsLayer, Skeleton, Transform};
+///
+/// // A 10 cm bone along +X: the root at the origin, its child at the bone's end.
+/// let skeleton = Skeleton::new(vec![
+///     Joint { name: "root".into(), parent: None, rest: Transform::IDENTITY },
+///     Joint { name: "tip".into(), parent: Some(0), rest: Transform::from_rotation_translation(Quat::IDENTITY, Vec3::X * 0.1) },
+/// ])?;
+/// let inverse_bind: Vec<Affine3A> = skeleton.rest_world().iter().map(Affine3A::inverse).collect();
+/// let mut layer = KinematicsLayer::new(skeleton.clone(), &inverse_bind);
+/// let mut locals = skeleton.rest_locals();
+/// locals[0].rotation = Quat::from_rotation_z(90f32.to_radians()); // turn the root
+/// layer.pose_locals(&locals);
+/// assert_eq!(layer.passes(), 1, "one forward kinematics pass per pose");
+/// // The child rides on its parent, from +X to +Y; its skinning transform and dual
+/// // quaternion carry its bind position there too.
+/// let tip = Vec3::Y * 0.1;
+/// assert!(Vec3::from(layer.world()[1].translation).abs_diff_eq(tip, 1e-6));
+/// assert!(layer.skinning()[1].transform_point3(Vec3::X * 0.1).abs_diff_eq(tip, 1e-6));
+/// assert!(layer.dual_quats()[1].transform_point3(Vec3::X * 0.1).abs_diff_eq(tip, 1e-6));
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct KinematicsLayer {
     skeleton: Skeleton,

@@ -14,6 +14,21 @@ use super::Screw;
 ///
 /// Conventions: glam's Hamilton quaternions, column vectors, transforms act on points as
 /// `p' = r p r* + t`. The type is plain data; nothing is normalised behind your back.
+///
+/// ```
+/// use dqhand::glam::{Quat, Vec3};
+/// use dqhand::math::DualQuat;
+///
+/// let (r, t) = (Quat::from_rotation_z(90f32.to_radians()), Vec3::new(0.0, 0.0, 0.2));
+/// let q = DualQuat::from_rotation_translation(r, t);
+/// let p = Vec3::new(0.1, 0.0, 0.0);
+/// assert!(q.transform_point3(p).abs_diff_eq(r * p + t, 1e-6), "rotate, then translate");
+/// assert!((q.inverse() * q).transform_point3(p).abs_diff_eq(p, 1e-6), "the product composes");
+/// // ScLERP halfway along this screw (about and along Z): half the turn, half the advance.
+/// let (half_r, half_t) = DualQuat::IDENTITY.sclerp(q, 0.5).to_rotation_translation();
+/// assert!(half_r.abs_diff_eq(Quat::from_rotation_z(45f32.to_radians()), 1e-6));
+/// assert!(half_t.abs_diff_eq(Vec3::new(0.0, 0.0, 0.1), 1e-6));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DualQuat {
     /// Rotation part `q₀` (unit norm for a rigid transform).

@@ -14,6 +14,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 
+use crate::Warning;
 use crate::gltf_file;
 use crate::{Error, Result};
 
@@ -29,8 +30,8 @@ pub struct ObjectMesh {
     pub vertices: Vec<Vec3>,
     /// Triangles, counter-clockwise seen from outside, indexing `vertices`.
     pub triangles: Vec<[u32; 3]>,
-    /// What was repaired or is unusual (dropped triangles, no volume), one line each.
-    pub warnings: Vec<String>,
+    /// What was repaired or is unusual (dropped triangles, no volume).
+    pub warnings: Vec<Warning>,
 }
 
 /// The meshes compiled into the crate, by their path under its `data/` folder (where the
@@ -131,11 +132,11 @@ impl ObjectMesh {
         }
         let mut warnings = Vec::new();
         if dropped > 0 {
-            warnings.push(format!("{dropped} triangles without area dropped"));
+            warnings.push(Warning::DegenerateTriangles { triangles: dropped });
         }
         let (lo, hi) = vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
         if (hi - lo).min_element() < MIN_THICKNESS {
-            warnings.push("flat (no volume): it collides as a surface".into());
+            warnings.push(Warning::FlatMesh);
         }
         Ok(Self { vertices, triangles, warnings })
     }
@@ -171,7 +172,7 @@ fn read_obj(reader: &mut impl BufRead, path: &Path) -> Result<(Vec<Vec3>, Vec<u3
 /// that has no parent): each mesh node's primitives placed by the node's world transform (a
 /// mirroring one reverses their winding, as glTF says). Strips and fans are split into
 /// triangles; points and lines are skipped (a warning says how many).
-fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<String>)> {
+fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<Warning>)> {
     let (gltf, buffers) = gltf_file::open(bytes, path)?;
     let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(Vec::as_slice);
     let mut roots: Vec<(gltf::Node<'_>, Mat4)> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
@@ -229,6 +230,6 @@ fn read_gltf(bytes: &[u8], path: &Path) -> Result<(Vec<Vec3>, Vec<u32>, Vec<Stri
             }
         }
     }
-    let warnings = if skipped > 0 { vec![format!("{skipped} primitives that are not triangles skipped")] } else { Vec::new() };
+    let warnings = if skipped > 0 { vec![Warning::NotTriangles { primitives: skipped }] } else { Vec::new() };
     Ok((vertices, indices, warnings))
 }

@@ -230,6 +230,20 @@ impl Scene {
     /// A built-in scene by name ([`Self::BUILTIN`]; its meshes built in too), else the scene
     /// file at that path.
     ///
+    /// ```
+    /// use dqhand::scene::{ObjectShape, Scene};
+    ///
+    /// let scene = Scene::named("grasp")?; // the paper's Figure 9
+    /// let table = scene.table.expect("the grasp scene has a table").height;
+    /// let ball = scene.object("ball").expect("a ball");
+    /// assert!(matches!(ball.shape, ObjectShape::Sphere { radius } if ball.position.y - radius >= table - 1e-6));
+    /// let teapot = scene.object("teapot").expect("and the Utah teapot");
+    /// let ObjectShape::Mesh { source, .. } = &teapot.shape else { panic!("the teapot is a mesh") };
+    /// assert!(!source.load()?.triangles.is_empty(), "its mesh is compiled in");
+    /// assert!(Scene::named("no-such-scene.json").is_err());
+    /// # Ok::<(), dqhand::Error>(())
+    /// ```
+    ///
     /// # Errors
     /// As [`Self::load`].
     pub fn named(name: &str) -> Result<Self> {

@@ -102,6 +102,27 @@ pub const MIN_VERTICES_PER_THREAD: usize = 2048;
 /// A skinning method with its per-frame scratch: bone parameters, the sign table and the
 /// AVX-512 loop's lookup table of both; the kernel it runs and, optionally, a crew of threads
 /// it splits each deformation across.
+///
+/// ```
+/// use dqhand::glam::{Affine3A, Quat, Vec3};
+/// use dqhand::skin::{Deformed, Deformer, MeshData, Method, SkinnedMesh};
+///
+/// // A triangle in the XY plane: two corners on bone 0, the third on bone 1 alone.
+/// let (mesh, _warnings) = SkinnedMesh::new(MeshData {
+///     positions: vec![[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0]], stride: 1,
+///     joints: vec![0, 0, 1], weights: vec![1.0; 3], indices: vec![0, 1, 2],
+///     inverse_bind: vec![Affine3A::IDENTITY; 2], ..MeshData::default()
+/// })?;
+/// let bone = Affine3A::from_rotation_translation(Quat::from_rotation_x(1.0), Vec3::new(0.0, 0.05, 0.02));
+/// let skinning = vec![Affine3A::IDENTITY, bone]; // world · inverse_bind per joint
+/// let mut out = Deformed::new(&mesh);
+/// Deformer::new(Method::Dqb, &mesh).deform(&mesh, &skinning, &mut out);
+/// // A vertex with one influence moves rigidly with its bone, its normal (+Z) turning with it.
+/// assert!(Vec3::from(out.positions()[2]).abs_diff_eq(bone.transform_point3(Vec3::Y * 0.1), 1e-6));
+/// assert!(Vec3::from(out.normals()[2]).abs_diff_eq(bone.transform_vector3(Vec3::Z), 1e-6));
+/// assert_eq!(out.positions()[1], [0.1, 0.0, 0.0]);
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Deformer {
     method: Method,

@@ -3,6 +3,17 @@
 use core::fmt;
 
 /// A skinning method.
+///
+/// ```
+/// use dqhand::skin::Method;
+///
+/// assert_eq!("DQB".parse::<Method>()?, Method::Dqb);
+/// assert_eq!(Method::Qb.to_string(), "qb");
+/// assert_eq!(Method::ALL.map(Method::index), [0, 1, 2]);
+/// let unknown = "blend".parse::<Method>().unwrap_err().to_string();
+/// assert_eq!(unknown, "unknown skinning method \"blend\"; valid: lb, qb, dqb");
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum Method {

@@ -7,6 +7,19 @@ use crate::{Error, Result};
 ///
 /// A gap or a repeat cannot be represented, so whatever holds one (a viewer's view, a frame
 /// header) always describes 1–3 meshes.
+///
+/// ```
+/// use dqhand::skin::{Method, MethodSet};
+///
+/// let set = MethodSet::parse(&["lb", "DQB"])?; // names in any case, in display order
+/// assert_eq!(set.as_slice(), [Method::Lb, Method::Dqb]);
+/// assert!(set.contains(Method::Dqb) && !set.contains(Method::Qb));
+/// let repeated = MethodSet::new(&[Method::Qb, Method::Lb, Method::Qb]).unwrap_err();
+/// assert!(matches!(repeated, dqhand::Error::Methods(_)));
+/// assert!(repeated.to_string().contains("\"qb\" given twice"), "{repeated}");
+/// assert!(matches!(MethodSet::parse(&["dqs"]), Err(dqhand::Error::UnknownName { .. })));
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug)]
 pub struct MethodSet {
     methods: [Method; 3],

@@ -11,6 +11,29 @@ use super::{Bones, Crew, Deformed, Deformer, Kernel, Method, MethodSet, SkinnedM
 /// It reads only the bones' transforms, so one kinematics layer can feed several skin layers
 /// (one per viewer, one per method set), and a loop that only needs the skeleton (gesture
 /// recognition, collision) holds no skin at all.
+///
+/// ```
+/// use std::sync::Arc;
+/// use dqhand::glam::{Affine3A, Quat, Vec3};
+/// use dqhand::skin::{MeshData, Method, MethodSet, SkinLayer, SkinnedMesh, VertexBuffers};
+///
+/// // One triangle over two bones, its middle corner weighted half and half.
+/// let (mesh, _warnings) = SkinnedMesh::new(MeshData {
+///     positions: vec![[0.0, 0.0, 0.0], [0.01, 0.1, 0.0], [0.0, 0.2, 0.01]], stride: 2,
+///     joints: vec![0, 1, 0, 1, 0, 1], weights: vec![1.0, 0.0, 0.5, 0.5, 0.0, 1.0],
+///     indices: vec![0, 1, 2], inverse_bind: vec![Affine3A::IDENTITY; 2], ..MeshData::default()
+/// })?;
+/// // The bones' skinning transforms (or a `KinematicsLayer`, which carries them).
+/// let skinning = vec![Affine3A::IDENTITY, Affine3A::from_rotation_translation(Quat::from_rotation_z(0.8), Vec3::Y * 0.05)];
+/// let mut skin = SkinLayer::new(Arc::new(mesh), MethodSet::ALL);
+/// skin.deform(&skinning); // into the layer's own buffers, one per method
+/// let mut positions = vec![0.0f32; 3 * 3]; // #V × 3: a renderer's vertex buffer, say
+/// skin.deform_into(Method::Dqb, &skinning, VertexBuffers::Separate { positions: &mut positions, normals: None });
+/// let dqb = skin.deformed(Method::Dqb).expect("DQB is in the set");
+/// assert_eq!(positions.as_slice(), dqb.positions().as_flattened());
+/// assert_ne!(skin.deformed(Method::Lb).expect("so is LB").positions()[1], dqb.positions()[1], "LB and DQB differ where bones blend");
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct SkinLayer {
     mesh: Arc<SkinnedMesh>,

@@ -2,6 +2,7 @@
 
 use glam::{Affine3A, Vec3};
 
+use crate::Warning;
 use crate::{Error, Result};
 
 /// Vertices are processed in chunks of this many; arrays are padded to a multiple of it.
@@ -127,7 +128,7 @@ impl SkinnedMesh {
     /// positive weight or a negative weight, a triangle index out of range, a non-invertible
     /// inverse bind matrix, or inconsistent array lengths. The message names the vertex,
     /// triangle or joint.
-    pub fn new(data: MeshData) -> Result<(Self, Vec<String>)> {
+    pub fn new(data: MeshData) -> Result<(Self, Vec<Warning>)> {
         let n = data.positions.len();
         let joint_count = data.inverse_bind.len();
         let bad = |m: String| Err(Error::Mesh(m));
@@ -207,7 +208,7 @@ impl SkinnedMesh {
             slots.push(inf);
         }
         if renormalised > 0 {
-            warnings.push(format!("weights of {renormalised} vertices did not sum to one and were normalised"));
+            warnings.push(Warning::WeightsRenormalised { vertices: renormalised });
         }
 
         let max_influences = slots.iter().map(Vec::len).max().unwrap_or(1);
@@ -272,7 +273,7 @@ impl SkinnedMesh {
                 .map(|n| n.to_array())
                 .collect();
             if replaced > 0 {
-                warnings.push(format!("{replaced} zero-length normals were replaced by the normals of the surrounding faces"));
+                warnings.push(Warning::NormalsReplaced { normals: replaced });
             }
             normals
         };

@@ -120,7 +120,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         let event = manip.step(record.time);
         score.step_s.push(started.elapsed().as_secs_f64());
         let t = record.time;
-        let held = manip.held().is_some_and(|n| n == manip.names()[object]);
+        let held = manip.held() == Some(object);
         if t < times.carry_start && held {
             grasped_before_carry = true;
         }
@@ -139,7 +139,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
                 score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
             }
         }
-        let held_index = manip.held().and_then(|n| manip.names().iter().position(|m| m == n));
+        let held_index = manip.held();
         // The rendered palm's centre (between the wrist and the middle finger's knuckle) must
         // not cross a surface between frames.
         let world = manip.rendered().world();
