@@ -59,6 +59,14 @@ chromium:
 	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; \
 	  else echo "make: $(CHROMIUM) missing: install Debian's chromium (sudo apt-get install chromium)" >&2; exit 1; fi; }
 
+# The skinning kernels this machine's CPU runs (its /proc/cpuinfo flags, as the kernels'
+# run-time check reads them): the kernel tests must run them, not skip them.
+CPU_FLAGS := $(shell grep -m1 '^flags' /proc/cpuinfo 2>/dev/null)
+has_flags = $(if $(strip $(foreach f,$(1),$(if $(filter $(f),$(CPU_FLAGS)),,missing))),,yes)
+comma := ,
+DQHAND_REQUIRE_KERNELS ?= $(subst $() $(),$(comma),$(strip \
+  $(if $(call has_flags,avx2 fma avx512f avx512vl avx512dq),avx512) $(if $(call has_flags,avx2 fma),avx2)))
+
 # The library's features, each built alone (a feature must not lean on another it does not
 # name), the core first: kinematics and the deformers on glam.
 LIB_FEATURES := gltf hand interaction metrics rayon
@@ -79,7 +87,7 @@ examples: recordings
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
 # browser tests against a real `dqhand demo`.
 test: assets viewer chromium recordings
-	$(CARGO) test --locked --workspace
+	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) $(CARGO) test --locked --workspace
 	$(MAKE) features examples
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run

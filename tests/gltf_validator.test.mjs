@@ -25,17 +25,37 @@ const out = mkdtempSync(path.join(tmpdir(), 'dqhand-gltf-'));
 execFileSync(dqhand, ['demo', '--out', out]);
 
 test('the rigged, skinned hand is valid glTF 2.0 with one skin and 25 joints', async () => {
-  const report = await validate(path.join(out, 'hand.glb'));
-  assert.equal(report.info.skinCount ?? 1, 1);
-  assert.ok(report.info.totalVertexCount === undefined || report.info.totalVertexCount === 8668);
-  const json = JSON.parse(readGlbJson(path.join(out, 'hand.glb')));
-  assert.equal(json.skins[0].joints.length, 25);
+  const file = path.join(out, 'hand.glb');
+  const report = await validate(file);
+  // What the validator counts (its report.info has no skin count: hasSkins and maxInfluences).
+  const { hasSkins, maxInfluences, drawCallCount, totalVertexCount, animationCount } = report.info;
+  assert.deepEqual(
+    { hasSkins, maxInfluences, drawCallCount, totalVertexCount, animationCount },
+    { hasSkins: true, maxInfluences: 4, drawCallCount: 1, totalVertexCount: 8668, animationCount: 0 },
+  );
+  // The skin itself, from the file's JSON: one, on the hand's mesh node, 25 joints that are
+  // nodes of the file, and an inverse bind matrix for each.
+  const json = JSON.parse(readGlbJson(file));
+  assert.equal(json.skins.length, 1);
+  const [skin] = json.skins;
+  assert.equal(skin.joints.length, 25);
+  assert.equal(new Set(skin.joints).size, 25);
+  assert.ok(skin.joints.every((j) => Number.isInteger(j) && j >= 0 && j < json.nodes.length), `joints ${skin.joints}`);
+  const ibm = json.accessors[skin.inverseBindMatrices];
+  assert.deepEqual({ count: ibm.count, type: ibm.type }, { count: 25, type: 'MAT4' });
+  const skinned = json.nodes.filter((n) => n.skin !== undefined);
+  assert.deepEqual(skinned.map((n) => [n.skin, n.mesh]), [[0, 0]]);
+  const { attributes } = json.meshes[0].primitives[0];
+  assert.ok('JOINTS_0' in attributes && 'WEIGHTS_0' in attributes, JSON.stringify(attributes));
 });
 
 test('every posed mesh of the demo is valid glTF 2.0', async () => {
   const files = readdirSync(out).filter((f) => f.endsWith('.glb') && f !== 'hand.glb');
   assert.equal(files.length, 11 * 3); // the 11 library gestures, each with LB, QB, DQB
-  for (const f of files) await validate(path.join(out, f));
+  for (const f of files) {
+    const { info } = await validate(path.join(out, f));
+    assert.deepEqual([info.hasSkins, info.drawCallCount, info.totalVertexCount], [false, 1, 8668], f);
+  }
 });
 
 test('a posed mesh of the WebXR generic hand is valid glTF 2.0', async () => {

@@ -2,11 +2,10 @@
 // controls reach the engine and come back as the right change on screen, and it survives a
 // server restart; and, with a recorded live input, that the Input panel follows it.
 
-import { spawnSync } from 'node:child_process';
 import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, onTestFinished, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
-import { canvasStats, countColour, dqhandBin, launchBrowser, newPage, root, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, launchBrowser, newPage, root, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 let server: Server;
@@ -298,15 +297,11 @@ describe('the Input panel, on input messages put into the real stream', () => {
 const RECORDING = path.join(root, 'crates/dqhand/data/recordings/gestures-joints.jsonl');
 
 describe('the viewer page with a recorded input', () => {
-  /** Whether this dqhand's demo takes `--input` (checked once; the test is skipped, saying so, when not). */
-  let supportsInput = false;
   let inputServer: Server | null = null;
   let inputPage: Page | null = null;
 
   beforeAll(async () => {
-    const help = spawnSync(dqhandBin(), ['demo', '--help'], { encoding: 'utf8' });
-    supportsInput = /--input\b/.test(`${help.stdout}${help.stderr}`);
-    if (!supportsInput) return;
+    // `demo --input` must exist: a renamed or missing option fails here (the demo exits).
     inputServer = await startServer({ args: ['--input', RECORDING] });
     inputPage = await newPage(browser);
     await inputPage.goto(inputServer.url);
@@ -317,8 +312,7 @@ describe('the viewer page with a recorded input', () => {
     await inputServer?.stop();
   });
 
-  test('shows the source, tracking, the recognised gesture and its events, and the sliders follow the hand', async ({ skip }) => {
-    skip(!supportsInput, `${dqhandBin()} demo has no --input option (the server side of live input has not landed)`);
+  test('shows the source, tracking, the recognised gesture and its events, and the sliders follow the hand', async () => {
     const p = inputPage!;
     await waitState(p, 's.connected && s.framesReceived > 3 && s.input !== null');
     expect(await p.locator('#input-panel').isVisible()).toBe(true);

@@ -221,9 +221,10 @@ fn dqb_and_lb_normals_follow_a_smoothly_bent_surface() {
     }
 }
 
-/// On the built-in hand (the reference tests use small random meshes): every kernel agrees
-/// with the portable one; a deformation split across a crew's threads (helpers parked or
-/// spinning), and a batch of poses, give exactly what one thread gives.
+/// On the built-in hand (the reference tests use small random meshes): every kernel this CPU
+/// runs agrees with the portable one (which ran is said, and required with
+/// `DQHAND_REQUIRE_KERNELS`: `support::kernels`); a deformation split across a crew's threads
+/// (helpers parked or spinning), and a batch of poses, give exactly what one thread gives.
 #[test]
 fn kernels_threads_and_batches_agree_on_the_hand() {
     let (model, pinch) = posed_hand("pinch");
@@ -233,13 +234,14 @@ fn kernels_threads_and_batches_agree_on_the_hand() {
     // Helpers that park at once (woken per frame) and helpers that spin between frames.
     let crews = [Duration::ZERO, Crew::SPIN].map(|spin| Arc::new(Crew::new(3, spin).unwrap()));
     assert!(mesh.vertex_count() >= 3 * MIN_VERTICES_PER_THREAD, "the hand is split three ways");
+    let kernels = support::kernels::kernels();
     for method in Method::ALL {
         let mut portable = Deformed::new(mesh);
         Deformer::new(method, mesh).with_kernel(Kernel::Portable).deform(mesh, &pinch, &mut portable);
-        for kernel in Kernel::ALL.into_iter().filter(|k| k.available()) {
+        for &kernel in &kernels.run {
             let single = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &pinch);
             for (a, b) in single.positions().iter().zip(portable.positions()).chain(single.normals().iter().zip(portable.normals())) {
-                assert_close!(*a, *b, 1e-5);
+                assert_close!(*a, *b, 1e-5, "{method} on {kernel:?} against portable; {kernels}");
             }
             let fisted = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &fist);
             for crew in &crews {
@@ -249,16 +251,16 @@ fn kernels_threads_and_batches_agree_on_the_hand() {
                 for i in 0..20 {
                     let (pose, expected) = if i % 2 == 0 { (&pinch, &single) } else { (&fist, &fisted) };
                     split.deform(mesh, pose, &mut out);
-                    assert_eq!(&out, expected, "{method} on {kernel:?}: three threads, {crew:?}, frame {i}");
+                    assert_eq!(&out, expected, "{method} on {kernel:?}: three threads, {crew:?}, frame {i}; {kernels}");
                 }
                 let mut only = Deformed::positions_only(mesh);
                 split.deform(mesh, &pinch, &mut only);
-                assert_eq!(only.positions(), single.positions(), "{method} on {kernel:?}: positions only, three threads");
+                assert_eq!(only.positions(), single.positions(), "{method} on {kernel:?}: positions only, three threads; {kernels}");
             }
             let poses: Vec<Affine3A> = [&pinch, &fist, &pinch].into_iter().flatten().copied().collect();
             let mut batch = vec![Deformed::new(mesh); 3];
             Deformer::new(method, mesh).with_kernel(kernel).deform_batch(&pool, mesh, &poses, &mut batch);
-            assert_eq!(batch, vec![single.clone(), fisted, single.clone()], "{method} on {kernel:?}: a batch");
+            assert_eq!(batch, vec![single.clone(), fisted, single.clone()], "{method} on {kernel:?}: a batch; {kernels}");
         }
     }
 }

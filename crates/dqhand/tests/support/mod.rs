@@ -4,14 +4,21 @@
 use glam::{Quat, Vec3};
 use proptest::prelude::*;
 
+pub mod kernels;
+
 /// Asserts `|a - b| <= tol` for anything with a distance, printing both values, the
-/// tolerance and the difference.
+/// tolerance and the difference (and, after them, a message formatted from the rest).
 #[macro_export]
 macro_rules! assert_close {
     ($a:expr, $b:expr, $tol:expr) => {{
         let (a, b, tol) = ($a, $b, $tol);
         let d = $crate::support::Distance::distance(&a, &b);
         assert!(d <= tol, "assert_close failed:\n  left:  {:?}\n  right: {:?}\n  tolerance {} < difference {}", a, b, tol, d);
+    }};
+    ($a:expr, $b:expr, $tol:expr, $($message:tt)+) => {{
+        let (a, b, tol) = ($a, $b, $tol);
+        let d = $crate::support::Distance::distance(&a, &b);
+        assert!(d <= tol, "assert_close failed:\n  left:  {:?}\n  right: {:?}\n  tolerance {} < difference {}\n  {}", a, b, tol, d, format_args!($($message)+));
     }};
 }
 
