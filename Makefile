@@ -69,7 +69,7 @@ DQHAND_REQUIRE_KERNELS ?= $(subst $() $(),$(comma),$(strip \
 
 # The library's features, each built alone (a feature must not lean on another it does not
 # name), the core first: kinematics and the deformers on glam.
-LIB_FEATURES := gltf hand interaction metrics rayon
+LIB_FEATURES := gltf hand interaction metrics rayon synthetic
 
 features:
 	$(CARGO) check --locked -p dqhand --no-default-features --lib --examples
@@ -81,7 +81,7 @@ examples: recordings
 	$(CARGO) run --locked -q -p dqhand --no-default-features --example skin_into_buffer
 	$(CARGO) run --locked -q -p dqhand --example skin_a_pose -- out/examples/ok.glb
 	$(CARGO) run --locked -q -p dqhand --example gestures_from_a_recording -- $(RECORDINGS)/gestures-joints.jsonl
-	$(CARGO) run --locked -q -p dqhand --example grasp_the_ball
+	$(CARGO) run --locked -q -p dqhand --features synthetic --example grasp_the_ball
 
 # Rust tests (unit, property, golden, CLI, server, doctests), the features alone and the
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and

@@ -1,5 +1,6 @@
 //! Grasp the ball in a scene and print what is held:
-//! `cargo run -p dqhand --example grasp_the_ball`.
+//! `cargo run -p dqhand --features synthetic --example grasp_the_ball` (the scripted grasp
+//! is a generator of the `synthetic` feature; a real hand's records drive the loop the same way).
 //!
 //! The manipulation loop (the paper's Figure 9) on the built-in grasp scene: a table, a ball
 //! and the Utah teapot. A scripted hand (made from the hand's own kinematics) reaches for the

@@ -42,7 +42,10 @@
 //! * `interaction` — [`input`], [`gesture`], [`scene`], [`collision`], [`grasp`], [`physics`]
 //!   and [`interaction`] (turns on `gltf` and `hand`);
 //! * `metrics` — [`metrics`] (turns on `interaction`);
-//! * `rayon` — [`skin::Deformer::deform_batch`], poses deformed across a thread pool.
+//! * `rayon` — [`skin::Deformer::deform_batch`], poses deformed across a thread pool;
+//! * `synthetic` (not a default) — labelled recordings and scripted grasps made from the
+//!   hand's own kinematics, and the loops' benchmarks on them (`interaction::synthetic`,
+//!   `interaction::grasp_script`, `interaction::benchmark`): test fixtures, not input.
 //!
 //! Conventions: metres, seconds and radians; right-handed, +Y up (glTF); quaternions in files
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names. The types are glam's, re-exported

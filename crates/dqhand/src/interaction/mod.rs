@@ -1,12 +1,21 @@
 //! The interaction loops on top of the engine step (paper Figure 1, bottom). Gesture
 //! interaction: records from the user's hand drive the virtual hand (what you see is what you
-//! do) and its gestures, recognised on the virtual hand, act as commands.
+//! do) and its gestures, recognised on the virtual hand, act as commands. 3D manipulation:
+//! the tracked hand drives a contact-constrained rendered hand that grasps the scene's
+//! objects.
+//!
+//! With the `synthetic` feature (not a default one: tests, benchmarks and demos use it), also
+//! the generators of labelled data made from the hand's own kinematics, [`synthetic`]
+//! recordings and [`grasp_script`]s, and the loops' [`benchmark`]s on them.
 
+#[cfg(feature = "synthetic")]
 pub mod benchmark;
 mod command_table;
 mod gesture_loop;
-mod manipulation_loop;
+#[cfg(feature = "synthetic")]
 pub mod grasp_script;
+mod manipulation_loop;
+#[cfg(feature = "synthetic")]
 pub mod synthetic;
 
 pub use command_table::{CommandRow, CommandTable};
