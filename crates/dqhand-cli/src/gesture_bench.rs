@@ -1,4 +1,4 @@
-//! `dqhand gesture-bench`: the gesture loop against the targets, on labelled
+//! `dqhand gesture-bench`: the gesture loop against its stated targets, on labelled
 //! synthetic sequences (`dqhand::interaction::synthetic`, seeded, so a run repeats):
 //! recognition within 150 ms of each pose being reached and the latency, spurious events per
 //! minute of idle motion, the retargeting error against the true angles, and the speed of the

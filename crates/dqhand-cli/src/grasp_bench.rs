@@ -1,4 +1,4 @@
-//! `dqhand grasp-bench`: the manipulation loop against the targets on scripted
+//! `dqhand grasp-bench`: the manipulation loop against its stated targets on scripted
 //! approach–grasp–lift–carry–release sequences (`dqhand::interaction::grasp_script`, made
 //! from our own kinematics, so a run repeats): every object of the built-in `objects` scene,
 //! alone on the table, approached from several directions at several speeds up to 10 m/s

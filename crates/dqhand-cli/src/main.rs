@@ -74,7 +74,7 @@ enum Command {
     /// as fast as it goes; one JSON line per frame, and the rendered hand as PLY if asked.
     Grasp(grasp::Args),
     /// Score the manipulation loop on scripted grasps of every object (success, skin penetration,
-    /// slip, release latency, tunnelling, time per frame) against the targets.
+    /// slip, release latency, tunnelling, time per frame) against their stated targets.
     GraspBench(grasp_bench::Args),
 }
 

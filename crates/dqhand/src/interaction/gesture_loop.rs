@@ -75,10 +75,19 @@ impl GestureLoop {
     /// # Errors
     /// The record's refusal; the hand keeps its pose.
     pub fn push(&mut self, record: &Record) -> Result<Events<'_>, Rejection> {
-        self.pipeline.push(record)?;
+        if let Err(rejection) = self.pipeline.push(record) {
+            // Bringing the hand up to the record's time may have relaxed a lost hand.
+            self.repose();
+            return Err(rejection);
+        }
+        self.repose();
+        Ok(self.recognize(record.time))
+    }
+
+    /// Poses the virtual hand as the pipeline shows it: one forward kinematics pass.
+    fn repose(&mut self) {
         self.kinematics.pose(self.pipeline.pose());
         self.positions = self.joints.read(self.kinematics.world());
-        Ok(self.recognize(record.time))
     }
 
     fn recognize(&mut self, time: f64) -> Events<'_> {
@@ -104,8 +113,7 @@ impl GestureLoop {
     pub fn advance(&mut self, now: f64) -> bool {
         let changed = self.pipeline.advance(now);
         if changed {
-            self.kinematics.pose(self.pipeline.pose());
-            self.positions = self.joints.read(self.kinematics.world());
+            self.repose();
         }
         changed
     }

@@ -5,8 +5,8 @@
 //! objects.
 //!
 //! With the `synthetic` feature (not a default one: tests, benchmarks and demos use it), also
-//! the generators of labelled data made from the hand's own kinematics, [`synthetic`]
-//! recordings and [`grasp_script`]s, and the loops' [`benchmark`]s on them.
+//! the generators of labelled data made from the hand's own kinematics, `synthetic`
+//! recordings and `grasp_script`s, and the loops' `benchmark`s on them.
 
 #[cfg(feature = "synthetic")]
 pub mod benchmark;

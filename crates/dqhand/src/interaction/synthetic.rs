@@ -11,7 +11,6 @@
 //! dropped. Records carry joints (with orientations), MediaPipe landmarks, or glove values
 //! with a wrist tracker.
 
-
 use glam::{Affine3A, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 

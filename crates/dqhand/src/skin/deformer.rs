@@ -201,7 +201,7 @@ impl Deformer {
     pub fn deform<'a>(&mut self, mesh: &SkinnedMesh, bones: impl Into<Bones<'a>>, out: &mut Deformed) {
         assert_eq!(out.vertex_count, mesh.vertex_count(), "output buffers belong to another mesh");
         self.prepare(mesh, bones.into());
-        self.blend(mesh, 0, &mut out.positions, &mut out.normals);
+        self.blend(mesh, &mut out.positions, &mut out.normals);
     }
 
     /// [`Self::deform`] into the caller's own memory (a mapped GPU buffer, a NumPy array),
@@ -227,7 +227,7 @@ impl Deformer {
                 // Whole blocks in place, the rest (fewer than a block, padded) on the stack.
                 let bulk = n / BLOCK * BLOCK;
                 let tail_n = if normals.is_some() { &mut tail_n[..padded - bulk] } else { &mut [][..] };
-                self.blend(mesh, 0, &mut positions[..bulk], normals.as_deref_mut().map_or(&mut [], |b| &mut b[..bulk]));
+                self.blend(mesh, &mut positions[..bulk], normals.as_deref_mut().map_or(&mut [], |b| &mut b[..bulk]));
                 self.run(mesh, bulk / LANES, &mut tail_p[..padded - bulk], tail_n);
                 positions[bulk..].copy_from_slice(&tail_p[..n - bulk]);
                 if let Some(normals) = normals {
@@ -295,12 +295,13 @@ impl Deformer {
         }
     }
 
-    /// Steps 2–6 over whole chunks from chunk `first`, split across the crew if there is one.
-    fn blend(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
+    /// Steps 2–6 over the whole chunks from the first that `positions` holds, split across the
+    /// crew if there is one.
+    fn blend(&self, mesh: &SkinnedMesh, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         let threads = self.crew.as_ref().map_or(1, |c| c.threads()).min(positions.len() / MIN_VERTICES_PER_THREAD).max(1);
         match &self.crew {
             Some(crew) if threads > 1 => self.split(crew, threads, mesh, positions, normals),
-            _ => self.run(mesh, first, positions, normals),
+            _ => self.run(mesh, 0, positions, normals),
         }
     }
 

@@ -38,8 +38,10 @@ use super::{Bones, Crew, Deformed, Deformer, Kernel, Method, MethodSet, SkinnedM
 pub struct SkinLayer {
     mesh: Arc<SkinnedMesh>,
     methods: MethodSet,
-    /// Per method, in [`Method::ALL`] order: its deformer and output, once it has been in the set.
-    slots: [Option<(Deformer, Deformed)>; 3],
+    /// Per method, in [`Method::ALL`] order: its deformer, once it has been used.
+    deformers: [Option<Deformer>; 3],
+    /// Per method: its output, once it has been in the set.
+    outputs: [Option<Deformed>; 3],
     kernel: Kernel,
     crew: Option<Arc<Crew>>,
 }
@@ -49,7 +51,7 @@ impl SkinLayer {
     /// kernel this CPU runs, on the calling thread.
     #[must_use]
     pub fn new(mesh: Arc<SkinnedMesh>, methods: MethodSet) -> Self {
-        let mut layer = Self { mesh, methods, slots: [None, None, None], kernel: Kernel::best(), crew: None };
+        let mut layer = Self { mesh, methods, deformers: [None, None, None], outputs: [None, None, None], kernel: Kernel::best(), crew: None };
         layer.set_methods(methods);
         layer
     }
@@ -58,20 +60,29 @@ impl SkinLayer {
     pub fn set_methods(&mut self, methods: MethodSet) {
         self.methods = methods;
         for &m in methods.as_slice() {
-            if self.slots[m.index()].is_none() {
-                let mut deformer = Deformer::new(m, &self.mesh).with_kernel(self.kernel);
-                if let Some(crew) = &self.crew {
-                    deformer = deformer.with_crew(Arc::clone(crew));
-                }
-                self.slots[m.index()] = Some((deformer, Deformed::new(&self.mesh)));
+            self.deformer(m);
+            if self.outputs[m.index()].is_none() {
+                self.outputs[m.index()] = Some(Deformed::new(&self.mesh));
             }
         }
+    }
+
+    /// `method`'s deformer, made the first time (allocates then only).
+    fn deformer(&mut self, method: Method) -> &mut Deformer {
+        let (mesh, kernel, crew) = (&self.mesh, self.kernel, &self.crew);
+        self.deformers[method.index()].get_or_insert_with(|| {
+            let deformer = Deformer::new(method, mesh).with_kernel(kernel);
+            match crew {
+                Some(crew) => deformer.with_crew(Arc::clone(crew)),
+                None => deformer,
+            }
+        })
     }
 
     /// Runs the skinning on `kernel` (to compare kernels; the fastest this CPU runs by default).
     pub fn use_kernel(&mut self, kernel: Kernel) {
         self.kernel = kernel;
-        for (d, _) in self.slots.iter_mut().flatten() {
+        for d in self.deformers.iter_mut().flatten() {
             *d = d.clone().with_kernel(kernel);
         }
     }
@@ -79,7 +90,7 @@ impl SkinLayer {
     /// Splits each deformation across `crew`'s threads (see [`Deformer::with_crew`]).
     pub fn use_crew(&mut self, crew: &Arc<Crew>) {
         self.crew = Some(Arc::clone(crew));
-        for (d, _) in self.slots.iter_mut().flatten() {
+        for d in self.deformers.iter_mut().flatten() {
             *d = d.clone().with_crew(Arc::clone(crew));
         }
     }
@@ -104,30 +115,27 @@ impl SkinLayer {
     pub fn deform<'a>(&mut self, bones: impl Into<Bones<'a>>) {
         let bones = bones.into();
         for &m in self.methods.as_slice() {
-            let (deformer, out) = self.slots[m.index()].as_mut().expect("every method of the set has its buffers");
+            let (Some(deformer), Some(out)) = (&mut self.deformers[m.index()], &mut self.outputs[m.index()]) else {
+                unreachable!("every method of the set has its deformer and buffers")
+            };
             deformer.deform(&self.mesh, bones, out);
         }
     }
 
     /// Deforms the mesh with `method` alone into the caller's memory (see
-    /// [`Deformer::deform_into`]); `method` joins the layer's buffers if it was never in the set.
+    /// [`Deformer::deform_into`]); the layer's own buffers are neither used nor made.
     ///
     /// # Panics
     /// As [`Self::deform`], and if a buffer's length is not the mesh's (#V × 3, or #V × 6
     /// interleaved).
     pub fn deform_into<'a>(&mut self, method: Method, bones: impl Into<Bones<'a>>, out: VertexBuffers<'_>) {
-        if self.slots[method.index()].is_none() {
-            let methods = self.methods;
-            self.set_methods(MethodSet::new(&[method]).expect("one method is a set"));
-            self.methods = methods;
-        }
-        let (deformer, _) = self.slots[method.index()].as_mut().expect("made above");
-        deformer.deform_into(&self.mesh, bones, out);
+        let mesh = Arc::clone(&self.mesh);
+        self.deformer(method).deform_into(&mesh, bones, out);
     }
 
     /// The mesh as `method` last deformed it: `None` if `method` was never in the set.
     #[must_use]
     pub fn deformed(&self, method: Method) -> Option<&Deformed> {
-        self.slots[method.index()].as_ref().map(|(_, out)| out)
+        self.outputs[method.index()].as_ref()
     }
 }

@@ -1,4 +1,4 @@
-//! How far solved joint angles are from the true ones: the retargeting error of the issue
+//! How far solved joint angles are from the true ones: the retargeting error
 //! (≤ 1° mean on noise-free joints of our own hand).
 
 use crate::kinematics::Pose;

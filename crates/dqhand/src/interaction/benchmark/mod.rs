@@ -1,4 +1,4 @@
-//! Measures of the interaction loops against the targets. The gesture loop, on
+//! Measures of the interaction loops against their stated targets. The gesture loop, on
 //! labelled synthetic sequences ([`super::synthetic`]): whether each held gesture is recognised
 //! and how long after its pose is reached, events during idle motion, and the retargeting error
 //! against the true angles. The manipulation loop, on scripted grasps

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::gesture::{Event, EventKind};
 use crate::interaction::synthetic::Label;
 
-/// Seconds after a pose is reached by which its gesture must have started (the 150 ms).
+/// Seconds after a pose is reached by which its gesture must have started (the gesture loop's target: 150 ms).
 pub const RECOGNITION_DEADLINE_S: f64 = 0.15;
 
 /// Slack on the deadline: label and record times are sums of decimal seconds, and a rounding

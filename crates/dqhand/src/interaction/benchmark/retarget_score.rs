@@ -21,7 +21,7 @@ use crate::model::Model;
 use crate::Result;
 
 /// Tracked thumb–index tip gap at or below which the virtual gap must be as small (the
-/// issue's 5 mm), metres.
+/// target: 5 mm), metres.
 pub const CONTACT_GAP_M: f32 = 0.005;
 
 /// Tracked gaps a near pinch is closed to, metres: touching, to the target's edge.
