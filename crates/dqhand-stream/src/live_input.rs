@@ -215,11 +215,6 @@ impl LiveInput {
         Ok(Self { source, announce, gestures, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
     }
 
-    /// The index of the gesture called `name` in the recognised set.
-    fn index(&self, name: &str) -> Option<usize> {
-        self.gestures.iter().position(|g| g == name)
-    }
-
     /// Seconds since the input was made: the arrival clock of its records.
     fn clock(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
@@ -272,20 +267,19 @@ impl LiveInput {
             log.push_back(entry);
             *logged += 1;
         };
-        let index = |name: &str| self.index(name).expect("events name gestures of the set");
         let events = driver.push(record)?;
         for e in events.clone() {
-            add(Entry::Event { t: e.t, event: e.event, gesture: index(e.gesture) });
+            add(Entry::Event { t: e.t, event: e.event, gesture: e.index });
         }
         let action = actions.as_mut().and_then(|table| table.update(record.time, events));
         taken(record);
         *posed += 1;
-        if let (Some(action), Some(gesture)) = (action, driver.gestures().gesture()) {
-            add(Entry::Action { t: record.time, gesture: index(gesture), action });
+        if let (Some(action), Some(gesture)) = (action, driver.gestures().gesture_index()) {
+            add(Entry::Action { t: record.time, gesture, action });
         }
         if let Driver::Scene(s) = driver {
-            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.input().gesture()) {
-                add(Entry::Scene { t: record.time, gesture: index(gesture), command });
+            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.input().gesture_index()) {
+                add(Entry::Scene { t: record.time, gesture, command });
             }
             s.step(arrival);
         }
@@ -361,7 +355,7 @@ impl LiveInput {
         let (mut events, mut actions) = (Vec::new(), Vec::new());
         for entry in new {
             match *entry {
-                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &self.gestures[gesture] })),
+                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &self.gestures[gesture], index: gesture })),
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
                     actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action }));
@@ -370,7 +364,7 @@ impl LiveInput {
             }
         }
         view.next = state.logged;
-        let gesture = gesture_loop.gesture().and_then(|g| self.index(g));
+        let gesture = gesture_loop.gesture_index();
         let sent = Sent { tracking: pipeline.tracking(), side: pipeline.side(), gesture, accepted, rejected, at: arrival };
         let due = match view.sent {
             None => true,

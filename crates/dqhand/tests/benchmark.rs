@@ -97,9 +97,9 @@ fn idle_events_are_spurious_except_the_end_of_the_last_hold() {
 
 #[test]
 fn logged_events_read_the_json_events_are_written_as() {
-    let json = serde_json::to_string(&Event { t: 1.25, event: EventKind::End, gesture: "fist" }).unwrap();
+    let json = serde_json::to_string(&Event { t: 1.25, event: EventKind::End, gesture: "fist", index: 0 }).unwrap();
     let logged: LoggedEvent = serde_json::from_str(&json).unwrap();
-    assert_eq!(logged, LoggedEvent::from(Event { t: 1.25, event: EventKind::End, gesture: "fist" }));
+    assert_eq!(logged, LoggedEvent::from(Event { t: 1.25, event: EventKind::End, gesture: "fist", index: 0 }));
     assert_eq!(logged, event(1.25, End, "fist"));
 }
 

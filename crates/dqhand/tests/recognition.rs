@@ -268,13 +268,16 @@ fn pinch_starts_and_ends_at_distinct_distances() {
 
 #[test]
 fn events_serialise_as_time_event_and_gesture() {
-    let start = Event { t: 1.25, event: EventKind::Start, gesture: "fist" };
+    let start = Event { t: 1.25, event: EventKind::Start, gesture: "fist", index: 0 };
     assert_eq!(serde_json::to_string(&start).unwrap(), r#"{"t":1.25,"event":"start","gesture":"fist"}"#);
     let mut r = Recognizer::new(set().clone());
     let fist = fist_with_index_curl(0.9);
     r.update(0.0, &fist).for_each(drop);
-    let events: Vec<String> = r.update(0.2, &fist).map(|e| serde_json::to_string(&e).unwrap()).collect();
-    assert_eq!(events, [r#"{"t":0.2,"event":"start","gesture":"fist"}"#]);
+    let events: Vec<(String, usize)> = r.update(0.2, &fist).map(|e| (serde_json::to_string(&e).unwrap(), e.index)).collect();
+    // The index is the gesture's identity in the set (not written: the name is for people).
+    let index = set().gestures().iter().position(|g| g.name() == "fist").unwrap();
+    assert_eq!(events, [(r#"{"t":0.2,"event":"start","gesture":"fist"}"#.to_owned(), index)]);
+    assert_eq!(r.current_index(), Some(index));
 }
 
 fn definition_error(json: &str) -> (String, GestureProblem) {

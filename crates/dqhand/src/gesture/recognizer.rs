@@ -37,6 +37,10 @@ pub struct Event<'a> {
     pub event: EventKind,
     /// The gesture's name.
     pub gesture: &'a str,
+    /// The gesture's index in the recogniser's [`GestureSet`]: its identity, which tables of
+    /// commands and logs keep (the name is that gesture's, for people).
+    #[serde(skip)]
+    pub index: usize,
 }
 
 /// The events of one update: none, one, or an end followed by a start. Allocates nothing.
@@ -117,6 +121,12 @@ impl Recognizer {
         self.current.map(|i| self.set.gestures()[i].name())
     }
 
+    /// The current gesture's index in [`Self::set`], if any.
+    #[must_use]
+    pub fn current_index(&self) -> Option<usize> {
+        self.current
+    }
+
     /// Takes one frame's features at `time_s` (seconds, non-decreasing) and returns what
     /// changed: the end of the previous gesture and/or the start of the next, once the new
     /// state has lasted `min_hold_s` (module docs). Allocates nothing.
@@ -144,7 +154,7 @@ impl Recognizer {
             self.pending = Some((seen, since));
             return events;
         }
-        let event = |i: usize, event| Event { t: time_s, event, gesture: gestures[i].name() };
+        let event = |i: usize, event| Event { t: time_s, event, gesture: gestures[i].name(), index: i };
         events.slots = [self.current.map(|i| event(i, EventKind::End)), seen.map(|i| event(i, EventKind::Start))];
         self.current = seen;
         self.pending = None;

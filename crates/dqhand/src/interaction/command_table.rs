@@ -36,6 +36,8 @@ impl CommandRow for SceneAction {
 #[derive(Clone, Debug)]
 pub struct CommandTable<R> {
     rows: Vec<R>,
+    /// Each row's gesture, as its index in the set (resolved once from its name).
+    gestures: Vec<usize>,
     /// The held gesture's first row, since when, and which rows have fired during this hold
     /// (bit per row); `None` while no gesture with a row is held.
     held: Option<(usize, f64, u64)>,
@@ -51,10 +53,16 @@ impl<R: CommandRow + Clone> CommandTable<R> {
         if actions.len() > 64 {
             return Err(Error::Config(format!("actions: {} rows (at most 64)", actions.len())));
         }
-        if let Some(a) = actions.iter().find(|a| !set.gestures().iter().any(|g| g.name() == a.gesture())) {
-            return Err(Error::Config(format!("actions: {:?} is not a gesture of the definitions in use", a.gesture())));
-        }
-        Ok(Self { rows: actions.to_vec(), held: None })
+        let gestures = actions
+            .iter()
+            .map(|a| {
+                set.gestures()
+                    .iter()
+                    .position(|g| g.name() == a.gesture())
+                    .ok_or_else(|| Error::Config(format!("actions: {:?} is not a gesture of the definitions in use", a.gesture())))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self { rows: actions.to_vec(), gestures, held: None })
     }
 
     /// Takes one update's gesture `events` at `time_s` and returns the action due now, if
@@ -63,17 +71,17 @@ impl<R: CommandRow + Clone> CommandTable<R> {
     pub fn update<'a>(&mut self, time_s: f64, events: impl IntoIterator<Item = Event<'a>>) -> Option<R::Command> {
         for e in events {
             self.held = match e.event {
-                EventKind::Start => self.rows.iter().position(|r| r.gesture() == e.gesture).map(|row| (row, e.t, 0)),
+                EventKind::Start => self.gestures.iter().position(|&g| g == e.index).map(|row| (row, e.t, 0)),
                 EventKind::End => None,
             };
         }
         let (first, since, fired) = self.held.as_mut()?;
-        let gesture = self.rows[*first].gesture();
+        let gesture = self.gestures[*first];
         let (i, row) = self
             .rows
             .iter()
             .enumerate()
-            .find(|(i, r)| r.gesture() == gesture && *fired & (1 << i) == 0 && time_s - *since >= f64::from(r.hold_s()))?;
+            .find(|&(i, r)| self.gestures[i] == gesture && *fired & (1 << i) == 0 && time_s - *since >= f64::from(r.hold_s()))?;
         *fired |= 1 << i;
         Some(row.command())
     }
@@ -104,12 +112,17 @@ mod tests {
         CommandTable::new(rows, &GestureSet::builtin()).unwrap()
     }
 
+    fn event(t: f64, event: EventKind, gesture: &str) -> Event<'_> {
+        let index = GestureSet::builtin().gestures().iter().position(|g| g.name() == gesture).expect("a built-in gesture");
+        Event { t, event, gesture, index }
+    }
+
     fn start(t: f64, gesture: &str) -> [Event<'_>; 1] {
-        [Event { t, event: EventKind::Start, gesture }]
+        [event(t, EventKind::Start, gesture)]
     }
 
     fn end(t: f64, gesture: &str) -> [Event<'_>; 1] {
-        [Event { t, event: EventKind::End, gesture }]
+        [event(t, EventKind::End, gesture)]
     }
 
     #[test]
@@ -128,7 +141,7 @@ mod tests {
     fn another_gesture_restarts_the_hold() {
         let mut t = table(&[Row("rock", 0.8, 3)]);
         assert_eq!(t.update(0.0, start(0.0, "rock")), None);
-        let switch = [Event { t: 0.5, event: EventKind::End, gesture: "rock" }, Event { t: 0.5, event: EventKind::Start, gesture: "fist" }];
+        let switch = [event(0.5, EventKind::End, "rock"), event(0.5, EventKind::Start, "fist")];
         assert_eq!(t.update(0.5, switch), None);
         assert_eq!(t.update(1.0, []), None, "fist has no row");
         assert_eq!(t.update(1.1, start(1.1, "rock")), None);

@@ -124,6 +124,12 @@ impl GestureLoop {
         self.recognizer.as_ref().and_then(Recognizer::current)
     }
 
+    /// The current gesture's index in [`Self::gestures`], with recognition on.
+    #[must_use]
+    pub fn gesture_index(&self) -> Option<usize> {
+        self.recognizer.as_ref().and_then(Recognizer::current_index)
+    }
+
     /// The gestures recognised, with recognition on.
     #[must_use]
     pub fn gestures(&self) -> Option<&GestureSet> {
