@@ -131,7 +131,7 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     for i in 0..25 {
         set.set(i, TrackedJoint { position: Vec3::ZERO, orientation: None, radius: 0.0 });
     }
-    assert_eq!(p.push(&arriving(unusable.clone(), 0.1 + grace + 0.1)).unwrap_err().kind, RejectKind::Unusable);
+    assert_eq!(p.push(&arriving(unusable, 0.1 + grace + 0.1)).unwrap_err().kind, RejectKind::Unusable);
     p.advance(0.1 + grace + rest_after + recover / 2.0);
     let halfway = p.pose().angles.iter().zip(&fist.angles).filter(|(_, f)| f.abs() > 0.1).map(|(a, f)| a / f).collect::<Vec<_>>();
     assert!(halfway.iter().all(|r| (r - 0.5).abs() < 0.01), "half way through the ease, half the bend: {halfway:?}");
@@ -293,7 +293,7 @@ fn a_live_recording_replays_to_the_poses_shown_live() {
             let mut record = Record { time: 0.0, side: Side::Left, hand: None, tracker: None, arrival: None };
             parse_record(line, Side::Right, &[] as &[&str], &mut record).unwrap();
             assert!(record.arrival.is_some(), "{line}");
-            p.push(&Record { arrival: record.arrival.filter(|_| with_arrival), ..record.clone() }).unwrap();
+            p.push(&Record { arrival: record.arrival.filter(|_| with_arrival), ..record }).unwrap();
             out.push(p.pose().clone());
         }
         out
