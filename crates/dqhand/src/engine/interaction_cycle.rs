@@ -104,7 +104,7 @@ impl Engine {
     }
 
     /// The skin stage, to deform on its own (after posing through [`Self::kinematics_mut`]),
-    /// on another kernel or into the caller's buffers.
+    /// or into the caller's buffers.
     pub fn skin_mut(&mut self) -> &mut SkinLayer {
         &mut self.skin
     }

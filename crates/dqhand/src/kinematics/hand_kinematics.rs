@@ -72,17 +72,9 @@ impl HandKinematics {
     /// # Panics
     /// If `inverse_bind` does not have one transform per joint.
     pub fn new(skeleton: &Skeleton, inverse_bind: &[Affine3A], joint_model: JointModel) -> Result<Self> {
-        Ok(Self::from_rig(HandRig::new(skeleton, joint_model)?, inverse_bind))
-    }
-
-    /// A hand posed by an already resolved `rig`.
-    ///
-    /// # Panics
-    /// If `inverse_bind` does not have one transform per joint of the rig's skeleton.
-    #[must_use]
-    pub fn from_rig(rig: HandRig, inverse_bind: &[Affine3A]) -> Self {
+        let rig = HandRig::new(skeleton, joint_model)?;
         let layer = KinematicsLayer::new(rig.skeleton().clone(), inverse_bind);
-        Self { rig, limits: Limits::Anatomical, layer }
+        Ok(Self { rig, limits: Limits::Anatomical, layer })
     }
 
     /// Whether angles are clamped to the joint model's anatomical ranges when posing.

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::{Bones, Crew, Deformed, Deformer, Kernel, Method, MethodSet, SkinnedMesh, VertexBuffers};
+use super::{Bones, Deformed, Deformer, Method, MethodSet, SkinnedMesh, VertexBuffers};
 
 /// A skinned mesh with a deformer and an output per method of a [`MethodSet`], every buffer
 /// allocated when a method joins the set; deforming allocates nothing.
@@ -42,8 +42,6 @@ pub struct SkinLayer {
     deformers: [Option<Deformer>; 3],
     /// Per method: its output, once it has been in the set.
     outputs: [Option<Deformed>; 3],
-    kernel: Kernel,
-    crew: Option<Arc<Crew>>,
 }
 
 impl SkinLayer {
@@ -51,7 +49,7 @@ impl SkinLayer {
     /// kernel this CPU runs, on the calling thread.
     #[must_use]
     pub fn new(mesh: Arc<SkinnedMesh>, methods: MethodSet) -> Self {
-        let mut layer = Self { mesh, methods, deformers: [None, None, None], outputs: [None, None, None], kernel: Kernel::best(), crew: None };
+        let mut layer = Self { mesh, methods, deformers: [None, None, None], outputs: [None, None, None] };
         layer.set_methods(methods);
         layer
     }
@@ -69,30 +67,8 @@ impl SkinLayer {
 
     /// `method`'s deformer, made the first time (allocates then only).
     fn deformer(&mut self, method: Method) -> &mut Deformer {
-        let (mesh, kernel, crew) = (&self.mesh, self.kernel, &self.crew);
-        self.deformers[method.index()].get_or_insert_with(|| {
-            let deformer = Deformer::new(method, mesh).with_kernel(kernel);
-            match crew {
-                Some(crew) => deformer.with_crew(Arc::clone(crew)),
-                None => deformer,
-            }
-        })
-    }
-
-    /// Runs the skinning on `kernel` (to compare kernels; the fastest this CPU runs by default).
-    pub fn use_kernel(&mut self, kernel: Kernel) {
-        self.kernel = kernel;
-        for d in self.deformers.iter_mut().flatten() {
-            *d = d.clone().with_kernel(kernel);
-        }
-    }
-
-    /// Splits each deformation across `crew`'s threads (see [`Deformer::with_crew`]).
-    pub fn use_crew(&mut self, crew: &Arc<Crew>) {
-        self.crew = Some(Arc::clone(crew));
-        for d in self.deformers.iter_mut().flatten() {
-            *d = d.clone().with_crew(Arc::clone(crew));
-        }
+        let mesh = &self.mesh;
+        self.deformers[method.index()].get_or_insert_with(|| Deformer::new(method, mesh))
     }
 
     /// The mesh.
