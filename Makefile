@@ -7,6 +7,8 @@ NPM ?= npm
 CHROMIUM ?= /usr/bin/chromium
 WEBXR_HAND := third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb
 VALIDATOR := third_party/node_modules/gltf-validator/package.json
+# Hand poses others recorded (Quest hand tracking, via handy-work and IWER): the gesture tests' outside data.
+OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_party/node_modules/iwer/lib/device/configs/hand/pinch.js
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
@@ -47,11 +49,11 @@ $(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/ts
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
 # nothing third-party is committed.
-assets: $(WEBXR_HAND) $(VALIDATOR)
+assets: $(WEBXR_HAND) $(VALIDATOR) $(OUTSIDE_POSES)
 
-$(WEBXR_HAND) $(VALIDATOR) &: third_party/package.json third_party/package-lock.json
+$(WEBXR_HAND) $(VALIDATOR) $(OUTSIDE_POSES) &: third_party/package.json third_party/package-lock.json
 	cd third_party && $(NPM) ci --no-audit --no-fund
-	touch $(WEBXR_HAND) $(VALIDATOR)
+	touch $(WEBXR_HAND) $(VALIDATOR) $(OUTSIDE_POSES)
 
 # Debian's Chromium drives the browser tests and the figures (no browser download).
 chromium:
