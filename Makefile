@@ -12,7 +12,7 @@ OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_p
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -165,3 +165,9 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 clean:
 	$(CARGO) clean
 	rm -rf out third_party/node_modules viewer/node_modules viewer/dist $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
+
+# The built-in gesture classifier, trained on the tuning split of varied hands (deterministic;
+# `dqhand gesture-bench --outside third_party/node_modules` reports on the held-out split).
+gestures:
+	cargo build --release --locked -p dqhand-cli
+	target/release/dqhand train-gestures --out crates/dqhand/data/gestures.json

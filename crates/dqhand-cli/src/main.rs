@@ -13,16 +13,19 @@ mod grasp;
 mod grasp_bench;
 mod hand;
 mod info;
+mod learn_gesture;
 mod listen;
 mod live;
 mod loadtest;
 mod metrics;
+mod outside_poses;
 mod peers;
 mod recording;
 mod replay;
 mod server;
 mod skin;
 mod synthesize;
+mod train_gestures;
 
 use clap::{Parser, Subcommand};
 
@@ -67,9 +70,16 @@ enum Command {
     Calibrate(calibrate::Args),
     /// Write a synthetic, labelled recording of the gesture library (from our own kinematics).
     Synthesize(synthesize::Args),
-    /// Measure the gesture loop on synthetic labelled sequences: recognition rate and latency,
-    /// spurious events in idle motion, retargeting error, time per record.
+    /// Measure the gesture loop on varied hands it was not trained on (and, with --outside, on
+    /// poses others recorded): recognition rate and latency, precision, confusions, spurious
+    /// starts, retargeting error, time per record.
     GestureBench(gesture_bench::Args),
+    /// Train the built-in gesture classifier on the tuning split of varied hands (joints and
+    /// landmarks) and write gesture definitions with it.
+    TrainGestures(train_gestures::Args),
+    /// Learn a new gesture from a few seconds of recording (and of poses that must not trigger
+    /// it): add it to gesture definitions and report how separable it is.
+    LearnGesture(learn_gesture::Args),
     /// Play a recording through the manipulation loop (contacts, grasps, physics) in a scene
     /// as fast as it goes; one JSON line per frame, and the rendered hand as PLY if asked.
     Grasp(grasp::Args),
@@ -96,6 +106,8 @@ fn main() {
         Command::Calibrate(a) => calibrate::run(&a),
         Command::Synthesize(a) => synthesize::run(&a),
         Command::GestureBench(a) => gesture_bench::run(&a),
+        Command::TrainGestures(a) => train_gestures::run(&a),
+        Command::LearnGesture(a) => learn_gesture::run(&a),
     };
     if let Err(e) = result {
         eprintln!("dqhand: error: {e:#}");

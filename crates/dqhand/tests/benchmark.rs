@@ -77,9 +77,10 @@ fn a_start_that_flickers_off_or_is_replaced_by_the_deadline_is_not_in_time() {
 #[test]
 fn only_the_gesture_shown_when_idle_begins_may_end_unpunished() {
     let labels = [label("fist", 0.9, 1.9)];
-    // The fist ended before idle began: its start and end in idle are both spurious.
+    // The fist ended before idle began: its start in idle is spurious (ends are no commands).
     let events = [event(1.0, Start, "fist"), event(2.0, End, "fist"), event(3.0, Start, "fist"), event(4.0, End, "fist")];
-    assert_eq!(RecognitionScore::new(&labels, (2.5, 10.0), &events).spurious, 2);
+    let score = RecognitionScore::new(&labels, (2.5, 10.0), &events);
+    assert_eq!((score.spurious, score.starts.clone()), (1, vec![("fist".to_owned(), true), ("fist".to_owned(), false)]));
 }
 
 #[test]

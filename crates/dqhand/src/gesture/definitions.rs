@@ -27,19 +27,26 @@
 //!   the feature's kind (`curl`, `flexion`, `abduction`, `opposition`, `direction`), or up to
 //!   the explicit `release` number when one is given, which must lie on the relaxed side.
 //!
+//! A gesture can also name a `class` of the file's learned [`Classifier`] (the object
+//! `classifier`), or carry a `model` of its own (a classifier learned from a recording by
+//! `dqhand learn-gesture`, with a class of the gesture's name): it then matches when that
+//! class's probability passes the classifier's `start` (`hold` once started) *and* all its
+//! conditions hold. Conditions then only add what a hand's shape cannot tell, such as which
+//! way the thumb points.
+//!
 //! Gestures are tried in file order, the first that matches wins: order is priority.
 //! `min_hold_s` (seconds, ≥ 0) is how long a change must last before it is reported.
 //!
-//! The built-in set has the 11 library gestures plus `thumbs_down`. Its pinch and OK start
-//! when the thumb and index tips are closer than 0.12 hand sizes and end beyond 0.16: 2.1 and
-//! 2.8 cm on the built-in hand (hand size 0.176 m), since its tip joints are the fingertips'
-//! ends, 1.6 cm apart when the pads touch; common SDKs start at 1.5 cm and end at 2.5 cm.
+//! The built-in set is the 11 library gestures plus `thumbs_down`, each a class of
+//! a classifier trained by `dqhand train-gestures` on varied hands (`docs/gestures.md`):
+//! thumbs up and down are one shape, told apart by `thumb.up`.
 
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-use super::{Feature, FeatureKind, HandFeatures};
+use super::classifier::ClassifierJson;
+use super::{Classifier, ClassifierScratch, Feature, FeatureKind, HandFeatures};
 use crate::{Error, GestureProblem, Result};
 
 /// How a condition compares its feature with its thresholds.
@@ -79,11 +86,24 @@ impl Condition {
     }
 }
 
-/// One named gesture: all of its conditions must hold.
+/// The learned part of a gesture: a class of the set's classifier, or its own model's.
+#[derive(Clone, Debug, PartialEq)]
+enum Learned {
+    /// Index of the class in the set's classifier.
+    Class(usize),
+    /// Its own classifier and the index of its class there.
+    Model(Box<Classifier>, usize),
+}
+
+/// One named gesture: its learned class (if any) is probable enough and all of its
+/// conditions hold.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GestureDefinition {
     name: String,
     conditions: Vec<Condition>,
+    /// The conditions as written, for writing the set back.
+    when: Vec<String>,
+    learned: Option<Learned>,
 }
 
 impl GestureDefinition {
@@ -99,10 +119,37 @@ impl GestureDefinition {
         &self.conditions
     }
 
-    /// Whether every condition holds ([`Condition::holds`]). Allocates nothing.
+    /// The class of the set's classifier it needs, if any.
     #[must_use]
-    pub fn matches(&self, features: &HandFeatures, held: bool) -> bool {
-        self.conditions.iter().all(|c| c.holds(features, held))
+    pub fn class(&self) -> Option<usize> {
+        match self.learned {
+            Some(Learned::Class(c)) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// Its own classifier (a gesture learned from a recording), if any.
+    #[must_use]
+    pub fn model(&self) -> Option<&Classifier> {
+        match &self.learned {
+            Some(Learned::Model(m, _)) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// Whether it matches: every condition holds ([`Condition::holds`]) and its class is
+    /// probable enough, by `shared` (the set's classifier's probabilities, empty without
+    /// one, with `thresholds`) or by its own model (evaluated in `own`, a scratch of that
+    /// model). Allocates nothing.
+    #[must_use]
+    pub fn matches(&self, features: &HandFeatures, shared: (&[f32], (f32, f32)), own: &mut ClassifierScratch, held: bool) -> bool {
+        let pick = |(start, hold): (f32, f32)| if held { hold } else { start };
+        let probable = match &self.learned {
+            None => true,
+            Some(Learned::Class(c)) => shared.0.get(*c).is_some_and(|&p| p > pick(shared.1)),
+            Some(Learned::Model(model, c)) => model.classify(features, own)[*c] > pick(model.thresholds()),
+        };
+        probable && self.conditions.iter().all(|c| c.holds(features, held))
     }
 }
 
@@ -111,18 +158,22 @@ impl GestureDefinition {
 pub struct GestureSet {
     gestures: Vec<GestureDefinition>,
     min_hold_s: f64,
+    hysteresis: HysteresisJson,
+    classifier: Option<Classifier>,
 }
 
 /// The file as written.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct FileJson {
     min_hold_s: f64,
     hysteresis: HysteresisJson,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    classifier: Option<ClassifierJson>,
     gestures: Vec<GestureJson>,
 }
 
-#[derive(Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct HysteresisJson {
     curl: f64,
@@ -132,10 +183,15 @@ struct HysteresisJson {
     direction: f64,
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct GestureJson {
     name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    class: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    model: Option<ClassifierJson>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     when: Vec<String>,
 }
 
@@ -165,7 +221,7 @@ impl GestureSet {
     /// condition: JSON that is not of the documented shape, a negative or non-finite setting,
     /// a duplicate gesture name, a gesture without conditions, a condition that does not
     /// parse, names an unknown feature or operator, has a non-numeric threshold or a release
-    /// on the wrong side.
+    /// on the wrong side; a malformed classifier or model, a class the classifier lacks.
     pub fn from_json(text: &str, file: &str) -> Result<Self> {
         let bad = |problem| Error::GestureDefinition { file: file.to_owned(), problem };
         let json: FileJson = serde_json::from_str(text).map_err(|e| bad(GestureProblem::Json(e.to_string())))?;
@@ -177,18 +233,91 @@ impl GestureSet {
             }
         }
         let margin = |kind: FeatureKind| margins.iter().find(|(n, _)| *n == kind.name()).map_or(0.0, |m| m.1 as f32);
+        let classifier = json.classifier.map(|c| Classifier::from_json(c, "classifier")).transpose().map_err(bad)?;
         let mut gestures: Vec<GestureDefinition> = Vec::with_capacity(json.gestures.len());
         for g in json.gestures {
             if gestures.iter().any(|d| d.name == g.name) {
                 return Err(bad(GestureProblem::DuplicateName(g.name)));
             }
-            if g.when.is_empty() {
+            if g.when.is_empty() && g.class.is_none() && g.model.is_none() {
                 return Err(bad(GestureProblem::NoCondition(g.name)));
             }
             let conditions = g.when.iter().map(|c| parse_condition(&g.name, c, margin)).collect::<Result<_, _>>().map_err(bad)?;
-            gestures.push(GestureDefinition { name: g.name, conditions });
+            let learned = match (g.class, g.model) {
+                (Some(_), Some(_)) => return Err(bad(GestureProblem::Classifier { what: format!("gesture {:?}", g.name), problem: "has both a class and a model; give one".into() })),
+                (Some(class), None) => {
+                    let index = classifier.as_ref().and_then(|c| c.class_index(&class));
+                    let valid = classifier.as_ref().map(|c| c.classes().join(", ")).unwrap_or_default();
+                    Some(Learned::Class(index.ok_or_else(|| bad(GestureProblem::UnknownClass { gesture: g.name.clone(), class, valid }))?))
+                }
+                (None, Some(model)) => {
+                    let what = format!("gesture {:?} model", g.name);
+                    let model = Classifier::from_json(model, &what).map_err(bad)?;
+                    let index = model.class_index(&g.name).ok_or_else(|| bad(GestureProblem::Classifier { what, problem: format!("has no class {:?}", g.name) }))?;
+                    Some(Learned::Model(Box::new(model), index))
+                }
+                (None, None) => None,
+            };
+            gestures.push(GestureDefinition { name: g.name, conditions, when: g.when, learned });
         }
-        Ok(Self { gestures, min_hold_s: json.min_hold_s })
+        Ok(Self { gestures, min_hold_s: json.min_hold_s, hysteresis: json.hysteresis, classifier })
+    }
+
+    /// The set as a definitions file ([`Self::from_json`] reads it back equal).
+    #[must_use]
+    pub fn to_json(&self) -> String {
+        let classes = self.classifier.as_ref().map_or(&[][..], Classifier::classes);
+        let gestures = self
+            .gestures
+            .iter()
+            .map(|g| GestureJson {
+                name: g.name.clone(),
+                class: g.class().map(|c| classes[c].clone()),
+                model: g.model().map(Classifier::to_json),
+                when: g.when.clone(),
+            })
+            .collect();
+        let file = FileJson { min_hold_s: self.min_hold_s, hysteresis: self.hysteresis.clone(), classifier: self.classifier.as_ref().map(Classifier::to_json), gestures };
+        serde_json::to_string_pretty(&file).expect("gesture definitions serialise")
+    }
+
+    /// The set's classifier, if it has one.
+    #[must_use]
+    pub fn classifier(&self) -> Option<&Classifier> {
+        self.classifier.as_ref()
+    }
+
+    /// Replaces the set's classifier; gestures keep their classes by name.
+    ///
+    /// # Errors
+    /// [`Error::GestureDefinition`] naming a gesture whose class the new one lacks.
+    pub fn set_classifier(&mut self, classifier: Classifier) -> Result<()> {
+        let old = self.classifier.as_ref().map_or(&[][..], Classifier::classes).to_vec();
+        for g in &mut self.gestures {
+            if let Some(Learned::Class(c)) = &mut g.learned {
+                *c = classifier.class_index(&old[*c]).ok_or_else(|| Error::GestureDefinition {
+                    file: "the new classifier".into(),
+                    problem: GestureProblem::UnknownClass { gesture: g.name.clone(), class: old[*c].clone(), valid: classifier.classes().join(", ") },
+                })?;
+            }
+        }
+        self.classifier = Some(classifier);
+        Ok(())
+    }
+
+    /// Puts a gesture learned from examples first (it is the more specific: it wins over the
+    /// others where both match), replacing any gesture of the same name.
+    ///
+    /// # Errors
+    /// [`Error::GestureDefinition`] when `model` has no class called `name`.
+    pub fn insert_learned(&mut self, name: &str, model: Classifier) -> Result<()> {
+        let index = model.class_index(name).ok_or_else(|| Error::GestureDefinition {
+            file: "the learned model".into(),
+            problem: GestureProblem::Classifier { what: format!("gesture {name:?} model"), problem: format!("has no class {name:?}") },
+        })?;
+        self.gestures.retain(|g| g.name != name);
+        self.gestures.insert(0, GestureDefinition { name: name.to_owned(), conditions: Vec::new(), when: Vec::new(), learned: Some(Learned::Model(Box::new(model), index)) });
+        Ok(())
     }
 
     /// The gestures, in priority (file) order.

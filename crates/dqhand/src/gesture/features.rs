@@ -13,6 +13,9 @@
 //! | `index.flexion` … `pinky.flexion` | flexion | ° | signed angle of the proximal phalanx from the metacarpal about the knuckle's lateral axis, + toward the palm |
 //! | `thumb.abduction` … `ring.abduction` | abduction | ° | angle between the finger's proximal phalanx and the next finger's, both projected on the palm plane (0 if one is perpendicular to the palm) |
 //! | `index.opposition` … `pinky.opposition` | opposition | hand sizes | thumb tip to that fingertip / hand size |
+//! | `thumb.across` | opposition | hand sizes | thumb tip from the index knuckle toward the little finger's, in the palm's frame |
+//! | `thumb.palmar` | opposition | hand sizes | thumb tip from the index knuckle out of the palm (toward what the hand holds) |
+//! | `thumb.along` | opposition | hand sizes | thumb tip from the index knuckle toward the fingertips |
 //! | `palm.up` | direction | ° | angle between the palm normal (out of the back of the hand) and world up (+Y) |
 //! | `thumb.up` | direction | ° | angle between the thumb (proximal phalanx base to tip) and world up (+Y) |
 //!
@@ -24,6 +27,13 @@
 //! The hand size is the middle finger's chain, metacarpal base to tip: the sum of four bone
 //! lengths, so it does not change with the pose, and it scales distances so that one threshold
 //! fits small and large hands (0.16 on the built-in hand of 19 cm length).
+//!
+//! The thumb's position tells where people put it, which its curl does not: tucked over the
+//! fingers (palmar, across), along the index (small across and palmar), across the palm (large
+//! across), or out (negative across, or far along or behind). The palm's frame is orthonormal:
+//! across (index knuckle → little knuckle), the palm normal, and along (wrist → middle knuckle)
+//! made orthogonal to both; it turns with the hand, and it mirrors with a left hand, so the
+//! three are the same for a left hand and its mirror image.
 //!
 //! The palm normal is the dorsal direction, (middle knuckle − wrist) × (index knuckle − pinky
 //! knuckle) for a right hand and the opposite for a left one: the joint frames' +Y.
@@ -96,13 +106,26 @@ pub enum Feature {
     PalmUp,
     /// Angle between the thumb and world up, degrees.
     ThumbUp,
+    /// The thumb tip along one axis of the palm's frame, from the index knuckle, hand sizes.
+    ThumbTip(PalmAxis),
+}
+
+/// An axis of the palm's frame (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PalmAxis {
+    /// Index knuckle toward the little finger's knuckle.
+    Across,
+    /// Out of the palm's front (the opposite of the palm normal).
+    Palmar,
+    /// Toward the fingertips.
+    Along,
 }
 
 use Finger::{Index, Middle, Pinky, Ring, Thumb};
 
 impl Feature {
     /// Every feature, in the order of the module docs.
-    pub const ALL: [Feature; 20] = [
+    pub const ALL: [Feature; 23] = [
         Feature::Curl(Thumb),
         Feature::Curl(Index),
         Feature::Curl(Middle),
@@ -123,6 +146,9 @@ impl Feature {
         Feature::Opposition(Pinky),
         Feature::PalmUp,
         Feature::ThumbUp,
+        Feature::ThumbTip(PalmAxis::Across),
+        Feature::ThumbTip(PalmAxis::Palmar),
+        Feature::ThumbTip(PalmAxis::Along),
     ];
 
     /// The name in gesture definitions, `<finger>.<kind>` or `palm.up` / `thumb.up`.
@@ -135,6 +161,9 @@ impl Feature {
             Feature::Opposition(f) => format!("{}.opposition", f.name()),
             Feature::PalmUp => "palm.up".into(),
             Feature::ThumbUp => "thumb.up".into(),
+            Feature::ThumbTip(PalmAxis::Across) => "thumb.across".into(),
+            Feature::ThumbTip(PalmAxis::Palmar) => "thumb.palmar".into(),
+            Feature::ThumbTip(PalmAxis::Along) => "thumb.along".into(),
         }
     }
 
@@ -151,7 +180,7 @@ impl Feature {
             Feature::Curl(_) => FeatureKind::Curl,
             Feature::Flexion(_) => FeatureKind::Flexion,
             Feature::Abduction(_) => FeatureKind::Abduction,
-            Feature::Opposition(_) => FeatureKind::Opposition,
+            Feature::Opposition(_) | Feature::ThumbTip(_) => FeatureKind::Opposition,
             Feature::PalmUp | Feature::ThumbUp => FeatureKind::Direction,
         }
     }
@@ -174,6 +203,9 @@ pub struct HandFeatures {
     pub palm_normal: Vec3,
     /// Unit direction of the thumb, proximal phalanx base to tip, world frame.
     pub thumb_direction: Vec3,
+    /// The thumb tip from the index knuckle in the palm's frame (across, palmar, along), hand
+    /// sizes.
+    pub thumb_tip: [f32; 3],
 }
 
 /// The first joint of each finger's chain in WebXR order (thumb: its metacarpal).
@@ -223,7 +255,11 @@ impl HandFeatures {
         let hand_size: f32 = (0..4).map(|i| bone(2, i).length()).sum();
         let opposition = core::array::from_fn(|f| p[TIP[0]].distance(p[TIP[f + 1]]) / hand_size);
         let thumb_direction = (p[TIP[0]] - p[CHAIN_START[0] + 1]).normalize();
-        Self { curl, flexion_deg, abduction_deg, opposition, hand_size, palm_normal, thumb_direction }
+        let across_unit = (-across).normalize();
+        let along_unit = along.reject_from_normalized(right_normal).reject_from_normalized(across_unit).normalize();
+        let tip = (p[TIP[0]] - p[INDEX_KNUCKLE]) / hand_size;
+        let thumb_tip = [tip.dot(across_unit), -tip.dot(palm_normal), tip.dot(along_unit)];
+        Self { curl, flexion_deg, abduction_deg, opposition, hand_size, palm_normal, thumb_direction, thumb_tip }
     }
 
     /// The value of one feature, in its unit (module docs).
@@ -236,6 +272,7 @@ impl HandFeatures {
             Feature::Opposition(f) => self.opposition.get((f as usize).wrapping_sub(1)).copied().unwrap_or(f32::NAN),
             Feature::PalmUp => angle(self.palm_normal, Vec3::Y).to_degrees(),
             Feature::ThumbUp => angle(self.thumb_direction, Vec3::Y).to_degrees(),
+            Feature::ThumbTip(axis) => self.thumb_tip[axis as usize],
         }
     }
 }
@@ -250,7 +287,7 @@ fn angle(a: Vec3, b: Vec3) -> f32 {
 mod tests {
     use glam::Vec3;
 
-    use super::{Feature, Finger, HandFeatures};
+    use super::{Feature, Finger, HandFeatures, PalmAxis};
     use crate::kinematics::Side;
 
     /// A flat right hand, palm down (dorsal +Y), fingers along −Z; the index chain turned by
@@ -285,6 +322,11 @@ mod tests {
         assert!((f.get(Feature::ThumbUp) - 90.0).abs() < 1e-3);
         assert!((f.get(Feature::Abduction(Finger::Thumb)) - 45.0).abs() < 1e-3);
         assert!(f.get(Feature::Abduction(Finger::Index)).abs() < 1e-3);
+        // The thumb tip 5.7 cm to the radial side of the index knuckle, 3 mm toward the wrist.
+        let thumb = [-0.0572 / 0.155, 0.0, -0.0028 / 0.155];
+        for (axis, expected) in [PalmAxis::Across, PalmAxis::Palmar, PalmAxis::Along].into_iter().zip(thumb) {
+            assert!((f.get(Feature::ThumbTip(axis)) - expected).abs() < 1e-3, "{axis:?} {f:?}");
+        }
         let tips = (hand(0.0)[4] - hand(0.0)[9]).length();
         assert!((f.get(Feature::Opposition(Finger::Index)) - tips / 0.155).abs() < 1e-6);
     }

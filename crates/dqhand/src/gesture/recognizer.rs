@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{GestureSet, HandFeatures};
+use super::{ClassifierScratch, GestureSet, HandFeatures};
 
 /// Whether a gesture started or ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -96,6 +96,9 @@ impl<'a> Iterator for Events<'a> {
 #[derive(Clone, Debug)]
 pub struct Recognizer {
     set: GestureSet,
+    /// Buffers of the set's classifier, and of each gesture's own model (empty without).
+    shared: ClassifierScratch,
+    own: Vec<ClassifierScratch>,
     /// Index of the current gesture.
     current: Option<usize>,
     /// The state seen instead of the current one (a gesture or none), since when.
@@ -106,7 +109,9 @@ impl Recognizer {
     /// A recogniser of `set`'s gestures, with no current gesture.
     #[must_use]
     pub fn new(set: GestureSet) -> Self {
-        Self { set, current: None, pending: None }
+        let shared = set.classifier().map(super::Classifier::scratch).unwrap_or_default();
+        let own = set.gestures().iter().map(|g| g.model().map(super::Classifier::scratch).unwrap_or_default()).collect();
+        Self { set, shared, own, current: None, pending: None }
     }
 
     /// The definitions it recognises.
@@ -132,13 +137,18 @@ impl Recognizer {
     /// state has lasted `min_hold_s` (module docs). Allocates nothing.
     pub fn update(&mut self, time_s: f64, features: &HandFeatures) -> Events<'_> {
         let gestures = self.set.gestures();
-        let holds = |i: Option<usize>| i.is_some_and(|i| gestures[i].matches(features, true));
+        let shared = match self.set.classifier() {
+            Some(c) => (c.classify(features, &mut self.shared), c.thresholds()),
+            None => (&[][..], (1.0, 1.0)),
+        };
+        let own = &mut self.own;
+        let mut holds = |i: Option<usize>| i.is_some_and(|i| gestures[i].matches(features, shared, &mut own[i], true));
         let seen = if holds(self.current) {
             self.current
         } else {
             match self.pending {
                 Some((p @ Some(_), _)) if holds(p) => p,
-                _ => gestures.iter().position(|g| g.matches(features, false)),
+                _ => gestures.iter().zip(own.iter_mut()).position(|(g, own)| g.matches(features, shared, own, false)),
             }
         };
         let mut events = Events::none();

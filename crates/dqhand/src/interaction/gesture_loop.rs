@@ -91,9 +91,15 @@ impl GestureLoop {
     }
 
     fn recognize(&mut self, time: f64) -> Events<'_> {
-        let features = HandFeatures::from_positions(&self.positions, self.side);
         let Some(recognizer) = &mut self.recognizer else { return Events::none() };
-        recognizer.update(time, &features)
+        recognizer.update(time, &HandFeatures::from_positions(&self.positions, self.side))
+    }
+
+    /// The virtual hand's features after the last record: what the recogniser reads, and
+    /// what a classifier is trained on.
+    #[must_use]
+    pub fn features(&self) -> HandFeatures {
+        HandFeatures::from_positions(&self.positions, self.side)
     }
 
     /// The input pipeline (pose, tracking state, rejections).

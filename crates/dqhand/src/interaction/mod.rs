@@ -6,17 +6,22 @@
 //!
 //! With the `synthetic` feature (not a default one: tests, benchmarks and demos use it), also
 //! the generators of labelled data made from the hand's own kinematics, `synthetic`
-//! recordings and `grasp_script`s, and the loops' `benchmark`s on them.
+//! recordings (of the library's shapes, or of shapes varied as people make them:
+//! `variation`) and `grasp_script`s, and the loops' `benchmark`s on them.
 
 #[cfg(feature = "synthetic")]
 pub mod benchmark;
 mod command_table;
+#[cfg(feature = "synthetic")]
+pub mod gesture_examples;
 mod gesture_loop;
 #[cfg(feature = "synthetic")]
 pub mod grasp_script;
 mod manipulation_loop;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
+#[cfg(feature = "synthetic")]
+pub mod variation;
 
 pub use command_table::{CommandRow, CommandTable};
 pub use gesture_loop::GestureLoop;

@@ -15,10 +15,11 @@ use glam::{Affine3A, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::gesture::{gesture, GESTURES};
+use crate::interaction::variation::{varied_pose, Split, VARIED_GESTURES};
 use crate::hand::{HandParams, Side};
 use crate::input::{mediapipe, Calibration, GloveSample, HandData, JointSet, MappingTable, MountingOffset, Record, RigidPose, TrackedJoint};
 use crate::kinematics::{JointModel, JointPositions, Pose};
-use crate::math::DualQuat;
+use crate::math::{DualQuat, Rng};
 use crate::Result;
 
 /// What the records carry.
@@ -59,6 +60,33 @@ pub struct SyntheticParams {
     pub drop_rate: f64,
     /// What the records carry.
     pub format: SyntheticFormat,
+    /// Varied shapes, hands and tracking errors ([`crate::interaction::variation`]) from this
+    /// split, instead of the library's shapes; `None` for the library's.
+    pub variation: Option<Split>,
+}
+
+/// Tracking errors of varied sequences beyond the joint noise: what a real tracker adds.
+#[derive(Clone, Copy, Debug)]
+pub struct TrackingErrors {
+    /// Extra root-mean-square noise along the camera axis (world Z), metres: monocular depth.
+    pub depth_noise_m: f32,
+    /// Largest depth offset of a whole finger, held for a hold (uniform ±), metres.
+    pub depth_bias_m: f32,
+    /// Fingers dropping out (kept at the angles they had) per second.
+    pub dropouts_per_s: f64,
+    /// How long a dropout lasts, seconds (uniform between).
+    pub dropout_s: (f64, f64),
+    /// Share of records where one finger jumps.
+    pub jump_rate: f64,
+    /// How far it jumps, metres.
+    pub jump_m: f32,
+}
+
+impl TrackingErrors {
+    /// A headset's tracking of the 25 joints: stereo, so no depth error of its own.
+    pub const JOINTS: Self = Self { depth_noise_m: 0.0, depth_bias_m: 0.0, dropouts_per_s: 0.05, dropout_s: (0.1, 0.4), jump_rate: 0.01, jump_m: 0.004 };
+    /// Monocular landmarks (MediaPipe from a webcam): depth is the worst of it.
+    pub const LANDMARKS: Self = Self { depth_noise_m: 0.006, depth_bias_m: 0.008, dropouts_per_s: 0.1, dropout_s: (0.2, 0.5), jump_rate: 0.02, jump_m: 0.008 };
 }
 
 impl Default for SyntheticParams {
@@ -76,7 +104,17 @@ impl Default for SyntheticParams {
             wrist_turn_deg: 25.0,
             drop_rate: 0.02,
             format: SyntheticFormat::Joints,
+            variation: None,
         }
+    }
+}
+
+impl SyntheticParams {
+    /// A varied sequence of `split` ([`crate::interaction::variation`]): wrist turns up to 80°
+    /// (what a webcam or a headset sees), the rest as the defaults.
+    #[must_use]
+    pub fn varied(split: Split, seed: u64, format: SyntheticFormat) -> Self {
+        Self { seed, variation: Some(split), wrist_turn_deg: 80.0, format, ..Self::default() }
     }
 }
 
@@ -107,48 +145,18 @@ pub struct Synthetic {
     pub idle: (f64, f64),
 }
 
-/// A small, seedable generator (xorshift64*), so that sequences do not depend on a crate's
-/// version.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-    fn next_f64(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-    fn normal(&mut self) -> f32 {
-        let (u, v) = (self.next_f64().max(1e-12), self.next_f64());
-        ((-2.0 * u.ln()).sqrt() * (core::f64::consts::TAU * v).cos()) as f32
-    }
-    fn unit(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(self.normal(), self.normal(), self.normal());
-            if let Some(u) = v.try_normalize() {
-                return u;
-            }
-        }
-    }
-}
-
 /// Generates a sequence.
 ///
 /// # Errors
 /// [`crate::Error::HandParameter`] for a hand that cannot be built.
 pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
-    let mut rng = Rng::new(params.seed);
+    let mut rng = Rng::new(params.variation.map_or(params.seed, |s| s.seed(params.seed)));
+    let varied = params.variation.is_some();
     let hand = params.hand.unwrap_or_else(|| {
-        let length = rng.uniform(0.16, 0.21) as f32;
+        let length = if varied { rng.uniform(0.15, 0.22) } else { rng.uniform(0.16, 0.21) } as f32;
         HandParams {
             length,
-            breadth: length * rng.uniform(0.42, 0.50) as f32,
+            breadth: length * if varied { rng.uniform(0.40, 0.50) } else { rng.uniform(0.42, 0.50) } as f32,
             side: if rng.next_f64() < 0.5 { Side::Left } else { Side::Right },
             vertices: *crate::hand::VERTEX_RANGE.start(),
         }
@@ -158,6 +166,8 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
     let rig = posed.rig().clone();
     let joints = JointPositions::new(posed.skeleton())?;
     let rest_wrist = rig.rest_wrist();
+    // A user's own proportions: each bone ±15 % (varied sequences), applied to the joints.
+    let bone_scale: [f32; 25] = core::array::from_fn(|_| if varied { rng.uniform(0.85, 1.15) as f32 } else { 1.0 });
 
     // The shapes: the library and thumbs down, in a shuffled cycle.
     let thumbs_up = gesture("thumbs_up")?.pose(JointModel::Full);
@@ -166,7 +176,7 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
     let thumb_direction = (thumb[4] - thumb[2]).normalize();
     let up_turn = Quat::from_rotation_arc(thumb_direction, Vec3::Y);
     let down_turn = Quat::from_rotation_arc(thumb_direction, -Vec3::Y);
-    let mut names: Vec<&str> = GESTURES.iter().map(|g| g.name).chain(["thumbs_down"]).collect();
+    let mut names: Vec<&str> = if varied { VARIED_GESTURES.to_vec() } else { GESTURES.iter().map(|g| g.name).chain(["thumbs_down"]).collect() };
     let (rest_rotation, rest_translation) = rest_wrist.to_rotation_translation();
     let mut keys = Vec::new(); // (time, pose, label)
     let mut time = 0.0;
@@ -187,11 +197,24 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
             }
         }
         let name = names[k % names.len()];
-        let shape = if name == "thumbs_down" { thumbs_up.clone() } else { gesture(name)?.pose(JointModel::Full) };
+        let shape = if varied {
+            let gap = |pose: &Pose| {
+                posed.pose(pose);
+                let p = proportioned(&joints.read(posed.world()), &bone_scale);
+                p[4].distance(p[9])
+            };
+            varied_pose(name, &mut rng, gap)?.0
+        } else if name == "thumbs_down" {
+            thumbs_up.clone()
+        } else {
+            gesture(name)?.pose(JointModel::Full)
+        };
         let turn = Quat::from_axis_angle(rng.unit(), (rng.uniform(-1.0, 1.0) * f64::from(params.wrist_turn_deg)).to_radians() as f32);
+        // Thumbs up and down keep the thumb within 25° of vertical (turned about it, tilted).
+        let thumb_turn = |rng: &mut Rng| turn_about_y(rng) * if varied { Quat::from_axis_angle(rng.unit(), rng.uniform(-15.0, 15.0).to_radians() as f32) } else { Quat::IDENTITY };
         let rotation = match name {
-            "thumbs_up" => turn_about_y(&mut rng) * up_turn * rest_rotation,
-            "thumbs_down" => turn_about_y(&mut rng) * down_turn * rest_rotation,
+            "thumbs_up" => thumb_turn(&mut rng) * up_turn * rest_rotation,
+            "thumbs_down" => thumb_turn(&mut rng) * down_turn * rest_rotation,
             _ => turn * rest_rotation,
         };
         let pose = Pose { wrist: Some(DualQuat::from_rotation_translation(rotation, rest_translation)), angles: shape.angles };
@@ -221,8 +244,22 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         _ => None,
     };
     let mount = MountingOffset::default();
+    let errors = match (&params.format, varied) {
+        (SyntheticFormat::Joints, true) => Some(TrackingErrors::JOINTS),
+        (SyntheticFormat::Landmarks, true) => Some(TrackingErrors::LANDMARKS),
+        _ => None,
+    };
+    // Each finger's DOFs (thumb first), which a dropout keeps where they were.
+    let finger_dofs: [Vec<usize>; 5] = core::array::from_fn(|f| {
+        let prefix = ["thumb", "index", "middle", "ring", "pinky"][f];
+        JointModel::Full.dofs().enumerate().filter(|(_, d)| d.bone.starts_with(prefix)).map(|(i, _)| i).collect()
+    });
+    let mut dropout: Option<(usize, f64, Vec<f32>)> = None;
+    let mut depth_bias = [0.0f32; 5];
+    let mut bias_key = usize::MAX;
     let (mut records, mut truth) = (Vec::new(), Vec::new());
     let mut pose = Pose::rest(dofs);
+    let mut tracked = Pose::rest(dofs);
     let mut k = 0;
     let end = keys.last().map_or(0.0, |k| k.0);
     let mut frame = 0u64;
@@ -246,11 +283,40 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         if rng.next_f64() < params.drop_rate {
             continue;
         }
-        posed.pose(&pose);
+        tracked.clone_from(&pose);
+        if let Some(e) = errors {
+            if bias_key != k {
+                bias_key = k;
+                depth_bias = core::array::from_fn(|_| rng.uniform(-1.0, 1.0) as f32 * e.depth_bias_m);
+            }
+            if dropout.as_ref().is_some_and(|d| t >= d.1) {
+                dropout = None;
+            }
+            if dropout.is_none() && rng.next_f64() < e.dropouts_per_s / params.rate_hz {
+                let f = rng.below(5);
+                dropout = Some((f, t + rng.uniform(e.dropout_s.0, e.dropout_s.1), finger_dofs[f].iter().map(|&i| pose.angles[i]).collect()));
+            }
+            if let Some((f, _, kept)) = &dropout {
+                for (&i, &a) in finger_dofs[*f].iter().zip(kept) {
+                    tracked.angles[i] = a;
+                }
+            }
+        }
+        posed.pose(&tracked);
         let world = posed.world();
-        let mut positions = joints.read(world);
+        let mut positions = proportioned(&joints.read(world), &bone_scale);
         for p in &mut positions {
             *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+        }
+        if let Some(e) = errors {
+            let jump = (rng.next_f64() < e.jump_rate).then(|| (rng.below(5), rng.unit() * e.jump_m));
+            for (j, p) in positions.iter_mut().enumerate().skip(1) {
+                let finger = if j < 5 { 0 } else { j / 5 };
+                p.z += depth_bias[finger] + rng.normal() * e.depth_noise_m;
+                if let Some((_, by)) = jump.filter(|(f, _)| *f == finger) {
+                    *p += by;
+                }
+            }
         }
         let record_hand = match &params.format {
             SyntheticFormat::Joints => {
@@ -273,6 +339,17 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         truth.push(pose.clone());
     }
     Ok(Synthetic { hand, records, truth, labels, idle: (idle_start, end) })
+}
+
+/// Joint positions (WebXR order) of a hand whose bones are scaled by `scale` (each joint's
+/// entry scales the bone ending at it), the wrist fixed: a user's own proportions.
+fn proportioned(p: &[Vec3; 25], scale: &[f32; 25]) -> [Vec3; 25] {
+    let mut out = *p;
+    for j in 1..25 {
+        let parent = if matches!(j, 1 | 5 | 10 | 15 | 20) { 0 } else { j - 1 };
+        out[j] = out[parent] + (p[j] - p[parent]) * scale[j];
+    }
+    out
 }
 
 /// The tracked joints a hand tracker would report for joint transforms `world`: `positions`

@@ -1,6 +1,10 @@
 //! Gesture events scored against the labels of a sequence: was each held gesture recognised
 //! within [`RECOGNITION_DEADLINE_S`] of its pose being reached, how long it took, what was
-//! shown instead when it was not, and how many events idle motion caused.
+//! shown instead when it was not (the confusion matrix), and every start of a wrong gesture,
+//! in moves, holds and idle motion alike (the spurious starts; each is a command the user did
+//! not give). A hold labelled `none` (a pose that is no gesture) is recognised when nothing is
+//! shown at its deadline; a label `a|b` accepts either (`none|open_palm`: a relaxed hand whose
+//! fingers are straight).
 
 use serde::{Deserialize, Serialize};
 
@@ -9,6 +13,9 @@ use crate::interaction::synthetic::Label;
 
 /// Seconds after a pose is reached by which its gesture must have started (the gesture loop's target: 150 ms).
 pub const RECOGNITION_DEADLINE_S: f64 = 0.15;
+
+/// The label of a held pose that is no gesture.
+pub const NO_GESTURE: &str = "none";
 
 /// Slack on the deadline: label and record times are sums of decimal seconds, and a rounding
 /// error of a nanosecond does not make a start late.
@@ -54,6 +61,9 @@ impl HoldOutcome {
     /// flickered off, or one replaced by another gesture, is not a recognition).
     #[must_use]
     pub fn in_time(&self) -> bool {
+        if self.gesture.contains('|') || self.gesture == NO_GESTURE {
+            return accepts(&self.gesture, self.shown_at_deadline.as_deref().unwrap_or(NO_GESTURE));
+        }
         self.shown_at_deadline.as_deref() == Some(self.gesture.as_str()) && self.latency_s.is_some_and(|l| l <= RECOGNITION_DEADLINE_S + TIME_ROUNDING_S)
     }
 }
@@ -63,11 +73,16 @@ impl HoldOutcome {
 pub struct RecognitionScore {
     /// Each hold, in label order.
     pub holds: Vec<HoldOutcome>,
-    /// Events during the idle motion other than the end of the gesture shown when it began:
-    /// each is a command the user did not give.
+    /// Every start: the gesture, and whether it was right (during the move to or the hold of
+    /// a label of that gesture).
+    pub starts: Vec<(String, bool)>,
+    /// Starts that were not right, anywhere in the sequence.
     pub spurious: usize,
     /// Seconds of idle motion.
     pub idle_s: f64,
+    /// Seconds of the whole sequence (moves, holds, idle): the time spurious starts are
+    /// counted over.
+    pub seconds: f64,
 }
 
 impl RecognitionScore {
@@ -93,16 +108,18 @@ impl RecognitionScore {
                 shown_at_deadline: shown.map(str::to_owned),
             });
         }
-        let mut excused = current_at(events, idle.0);
-        let mut spurious = 0;
-        for e in events.iter().filter(|e| e.t >= idle.0 && e.t <= idle.1) {
-            if e.event == EventKind::End && excused == Some(e.gesture.as_str()) {
-                excused = None;
-            } else {
-                spurious += 1;
-            }
-        }
-        Self { holds, spurious, idle_s: idle.1 - idle.0 }
+        let starts: Vec<(String, bool)> = events
+            .iter()
+            .filter(|e| e.event == EventKind::Start)
+            .map(|e| {
+                // The label whose move or hold the start falls in: moves begin where the
+                // previous hold ends.
+                let label = labels.iter().find(|l| e.t <= l.until);
+                (e.gesture.clone(), label.is_some_and(|l| accepts(&l.gesture, &e.gesture)))
+            })
+            .collect();
+        let spurious = starts.iter().filter(|(_, right)| !right).count();
+        Self { holds, starts, spurious, idle_s: idle.1 - idle.0, seconds: idle.1.max(labels.last().map_or(0.0, |l| l.until)) }
     }
 
     /// Holds whose gesture started by the deadline.
@@ -110,6 +127,11 @@ impl RecognitionScore {
     pub fn in_time(&self) -> usize {
         self.holds.iter().filter(|h| h.in_time()).count()
     }
+}
+
+/// Whether a label (`a` or `a|b`) accepts `gesture` (`none` for nothing shown).
+fn accepts(label: &str, gesture: &str) -> bool {
+    label.split('|').any(|g| g == gesture)
 }
 
 /// The gesture current after the events up to `time`.
