@@ -14,6 +14,7 @@
 import { mkdirSync, openSync, writeSync, closeSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { launchBrowser, startServer, waitState, settle } from './harness.mjs';
+import { readCanvas, toI420 } from './y4m.mjs';
 
 const left = process.argv.includes('--left');
 /** The gestures shown, in order, each held for HOLD_FRAMES after a move of MOVE_FRAMES. */
@@ -76,43 +77,4 @@ try {
   closeSync(fd);
   await browser.close();
   await server.stop();
-}
-
-/** In the page: the canvas scaled to `size`, mirrored left to right if asked, as base64 RGBA. */
-function readCanvas([w, h, mirror]) {
-  const c = document.getElementById('view');
-  const g = Object.assign(document.createElement('canvas'), { width: w, height: h }).getContext('2d');
-  if (mirror) g.setTransform(-1, 0, 0, 1, w, 0);
-  g.drawImage(c, 0, 0, w, h);
-  const bytes = g.getImageData(0, 0, w, h).data;
-  let s = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(s);
-}
-
-/** RGBA to planar Y, U, V at half resolution in both directions (BT.601 full range, JPEG's). */
-function toI420(rgba, w, h) {
-  const out = Buffer.alloc((w * h * 3) / 2);
-  const [cw, ch] = [w / 2, h / 2];
-  for (let y = 0; y < h; y++) {
-    for (let x = 0; x < w; x++) {
-      const i = 4 * (y * w + x);
-      out[y * w + x] = Math.round(0.299 * rgba[i] + 0.587 * rgba[i + 1] + 0.114 * rgba[i + 2]);
-    }
-  }
-  for (let y = 0; y < ch; y++) {
-    for (let x = 0; x < cw; x++) {
-      let [r, g, b] = [0, 0, 0];
-      for (const [dx, dy] of [[0, 0], [1, 0], [0, 1], [1, 1]]) {
-        const i = 4 * ((2 * y + dy) * w + 2 * x + dx);
-        r += rgba[i] / 4;
-        g += rgba[i + 1] / 4;
-        b += rgba[i + 2] / 4;
-      }
-      const clamp = (v) => Math.min(255, Math.max(0, Math.round(v)));
-      out[w * h + y * cw + x] = clamp(128 - 0.168736 * r - 0.331264 * g + 0.5 * b);
-      out[w * h + cw * ch + y * cw + x] = clamp(128 + 0.5 * r - 0.418688 * g - 0.081312 * b);
-    }
-  }
-  return out;
 }
