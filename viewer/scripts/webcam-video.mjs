@@ -8,13 +8,14 @@
 //                                                      a left hand before the camera
 //
 // The frames are the page's canvas read back at SIZE, converted to 4:2:0 (BT.601, full range,
-// as `C420jpeg` says), at FPS. The hand is the built-in one in the page's front view (fingers
-// up, palm to the camera), as a user's right hand before a webcam; mirrored, their left.
+// as `C420jpeg` says), at FPS, each with its number in its top-left corner (y4m.mjs, MARKER).
+// The hand is the built-in one in the page's front view (fingers up, palm to the camera), as a
+// user's right hand before a webcam; mirrored, their left.
 
 import { mkdirSync, openSync, writeSync, closeSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { launchBrowser, startServer, waitState, settle } from './harness.mjs';
-import { readCanvas, toI420 } from './y4m.mjs';
+import { readCanvas, stampFrame, toI420 } from './y4m.mjs';
 
 const left = process.argv.includes('--left');
 /** The gestures shown, in order, each held for HOLD_FRAMES after a move of MOVE_FRAMES. */
@@ -44,12 +45,15 @@ try {
   writeSync(fd, `YUV4MPEG2 W${SIZE[0]} H${SIZE[1]} F${FPS}:1 Ip A1:1 C420jpeg\n`);
   const labels = [];
   let frame = 0;
+  const write = (rgba) => {
+    const stamped = Buffer.from(rgba);
+    stampFrame(stamped, SIZE[0], frame++);
+    writeSync(fd, 'FRAME\n');
+    writeSync(fd, toI420(stamped, SIZE[0], SIZE[1]));
+  };
   const capture = async () => {
     await settle(page, 2);
-    const rgba = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
-    writeSync(fd, 'FRAME\n');
-    writeSync(fd, toI420(rgba, SIZE[0], SIZE[1]));
-    frame++;
+    write(Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64'));
   };
   for (const name of GESTURES) {
     await page.evaluate(([name, seconds]) => window.dqhand.send({ type: 'gesture', name, seconds }), [name, MOVE_S]);
@@ -64,11 +68,7 @@ try {
     await capture();
     // The hand is still: the rest of the hold repeats the frame.
     const still = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
-    for (let k = 1; k < HOLD_FRAMES; k++) {
-      writeSync(fd, 'FRAME\n');
-      writeSync(fd, toI420(still, SIZE[0], SIZE[1]));
-      frame++;
-    }
+    for (let k = 1; k < HOLD_FRAMES; k++) write(still);
     labels.push({ gesture: name, from_s: from / FPS, to_s: frame / FPS });
   }
   writeFileSync(path.join(out, `${NAME}.labels.json`), JSON.stringify({ fps: FPS, size: SIZE, frames: frame, side: left ? 'left' : 'right', gestures: labels }, null, 1));
