@@ -8,12 +8,14 @@
 //                                                      a left hand before the camera
 //
 // The frames are the page's canvas read back at SIZE, converted to 4:2:0 (BT.601, full range,
-// as `C420jpeg` says), at FPS. The hand is the built-in one in the page's front view (fingers
-// up, palm to the camera), as a user's right hand before a webcam; mirrored, their left.
+// as `C420jpeg` says), at FPS, each with its number in its top-left corner (y4m.mjs, MARKER).
+// The hand is the built-in one in the page's front view (fingers up, palm to the camera), as a
+// user's right hand before a webcam; mirrored, their left.
 
 import { mkdirSync, openSync, writeSync, closeSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { launchBrowser, startServer, waitState, settle } from './harness.mjs';
+import { readCanvas, stampFrame, toI420 } from './y4m.mjs';
 
 const left = process.argv.includes('--left');
 /** The gestures shown, in order, each held for HOLD_FRAMES after a move of MOVE_FRAMES. */
@@ -43,12 +45,15 @@ try {
   writeSync(fd, `YUV4MPEG2 W${SIZE[0]} H${SIZE[1]} F${FPS}:1 Ip A1:1 C420jpeg\n`);
   const labels = [];
   let frame = 0;
+  const write = (rgba) => {
+    const stamped = Buffer.from(rgba);
+    stampFrame(stamped, SIZE[0], frame++);
+    writeSync(fd, 'FRAME\n');
+    writeSync(fd, toI420(stamped, SIZE[0], SIZE[1]));
+  };
   const capture = async () => {
     await settle(page, 2);
-    const rgba = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
-    writeSync(fd, 'FRAME\n');
-    writeSync(fd, toI420(rgba, SIZE[0], SIZE[1]));
-    frame++;
+    write(Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64'));
   };
   for (const name of GESTURES) {
     await page.evaluate(([name, seconds]) => window.dqhand.send({ type: 'gesture', name, seconds }), [name, MOVE_S]);
@@ -63,11 +68,7 @@ try {
     await capture();
     // The hand is still: the rest of the hold repeats the frame.
     const still = Buffer.from(await page.evaluate(readCanvas, [...SIZE, left]), 'base64');
-    for (let k = 1; k < HOLD_FRAMES; k++) {
-      writeSync(fd, 'FRAME\n');
-      writeSync(fd, toI420(still, SIZE[0], SIZE[1]));
-      frame++;
-    }
+    for (let k = 1; k < HOLD_FRAMES; k++) write(still);
     labels.push({ gesture: name, from_s: from / FPS, to_s: frame / FPS });
   }
   writeFileSync(path.join(out, `${NAME}.labels.json`), JSON.stringify({ fps: FPS, size: SIZE, frames: frame, side: left ? 'left' : 'right', gestures: labels }, null, 1));
@@ -76,43 +77,4 @@ try {
   closeSync(fd);
   await browser.close();
   await server.stop();
-}
-
-/** In the page: the canvas scaled to `size`, mirrored left to right if asked, as base64 RGBA. */
-function readCanvas([w, h, mirror]) {
-  const c = document.getElementById('view');
-  const g = Object.assign(document.createElement('canvas'), { width: w, height: h }).getContext('2d');
-  if (mirror) g.setTransform(-1, 0, 0, 1, w, 0);
-  g.drawImage(c, 0, 0, w, h);
-  const bytes = g.getImageData(0, 0, w, h).data;
-  let s = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(s);
-}
-
-/** RGBA to planar Y, U, V at half resolution in both directions (BT.601 full range, JPEG's). */
-function toI420(rgba, w, h) {
-  const out = Buffer.alloc((w * h * 3) / 2);
-  const [cw, ch] = [w / 2, h / 2];
-  for (let y = 0; y < h; y++) {
-    for (let x = 0; x < w; x++) {
-      const i = 4 * (y * w + x);
-      out[y * w + x] = Math.round(0.299 * rgba[i] + 0.587 * rgba[i + 1] + 0.114 * rgba[i + 2]);
-    }
-  }
-  for (let y = 0; y < ch; y++) {
-    for (let x = 0; x < cw; x++) {
-      let [r, g, b] = [0, 0, 0];
-      for (const [dx, dy] of [[0, 0], [1, 0], [0, 1], [1, 1]]) {
-        const i = 4 * ((2 * y + dy) * w + 2 * x + dx);
-        r += rgba[i] / 4;
-        g += rgba[i + 1] / 4;
-        b += rgba[i + 2] / 4;
-      }
-      const clamp = (v) => Math.min(255, Math.max(0, Math.round(v)));
-      out[w * h + y * cw + x] = clamp(128 - 0.168736 * r - 0.331264 * g + 0.5 * b);
-      out[w * h + cw * ch + y * cw + x] = clamp(128 + 0.5 * r - 0.418688 * g - 0.081312 * b);
-    }
-  }
-  return out;
 }

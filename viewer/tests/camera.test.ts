@@ -1,9 +1,15 @@
-// The camera path end to end: a video of our own hand in known gestures (rendered by the real
-// page, scripts/webcam-video.mjs) played to headless Chromium as its webcam; the Camera button
-// runs MediaPipe Hands in the page on it, the landmarks go to a real `dqhand demo`, and the
-// engine's recognised gestures and retargeted angles are compared with the rendered ones. Then
-// the Record button records the same input through the engine, and `dqhand replay` of that
-// file gives the gesture events the engine gave live.
+// The camera path end to end: a video of a hand in known gestures played to headless Chromium
+// as its webcam; the Camera button runs MediaPipe Hands in the page on it, the landmarks go to
+// a real `dqhand demo`, and the engine's recognised gestures and retargeted angles are compared
+// with the video's. First our own hand (rendered by the real page, scripts/webcam-video.mjs),
+// whose input the Record button records and `dqhand replay` replays to the same gesture events;
+// then a hand that is not ours, the WebXR generic hand posed from a synthetic recording
+// (scripts/generic-hand-video.mjs), against which MediaPipe's own tracking error is measured.
+//
+// Every video frame carries its number (scripts/y4m.mjs, MARKER); the page is given a hook that
+// reads it off each frame handed to MediaPipe. The frames taken give the video's clock
+// (`videoClock`), so every sample of the page's state knows where in the (looping) video it was
+// taken; and every recorded record which frame it came from.
 
 import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
@@ -12,17 +18,26 @@ import path from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import { dqhandBin, launchBrowser, newPage, root, startServer, waitState } from '../scripts/harness.mjs';
+import { MARKER } from '../scripts/y4m.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
+interface Hold {
+  gesture: string;
+  from_s: number;
+  to_s: number;
+}
 interface Labels {
   fps: number;
   frames: number;
+  size: [number, number];
   side: 'left' | 'right';
-  gestures: { gesture: string; from_s: number; to_s: number }[];
+  gestures: Hold[];
 }
 interface Sample {
   /** When it was taken (ms, the test's clock). */
   at: number;
+  /** Where the video was then (s from its first frame, by `videoClock`); null if the page took no frame. */
+  video: number | null;
   gesture: string | null;
   tracking: string;
   side: string | null;
@@ -36,11 +51,30 @@ interface Sample {
 const CONFIG = { grace_s: 1.5 };
 /**
  * Largest median error of the retargeted angles against the rendered gesture's (degrees, over
- * the DOFs each gesture bends, per gesture). Measured on a 2-core VM: 7° (open palm) to 25°
- * (victory: the ring and little fingers curled under the thumb, which MediaPipe sees less
- * curled from one camera); the README's camera section has the numbers.
+ * the DOFs each gesture bends, per hold, on every sample of the hold). Measured on a 2-core VM:
+ * 6–14° (open palm) to 25° (victory: the ring and little fingers curled under the thumb, which
+ * MediaPipe sees less curled from one camera); docs/performance.md has the numbers.
  */
 const MEDIAN_TOLERANCE_DEG = 30;
+
+/**
+ * How long after a hold begins in the video the engine may still show the move into it (s):
+ * MediaPipe sees a new frame only when done with the last (2–6 frames a second on a loaded
+ * 2-core machine, so a frame may wait up to 0.5 s and take as long), the engine's filters
+ * follow, and a gesture must hold `min_hold_s` (0.1 s) before it is recognised. Measured on a
+ * 2-core VM (`latencies`: the angles reaching the hold's): 0.1–1.0 s on our hand's video; on
+ * the generic hand's 0–3.8 s, half of the holds within 1.2–1.8 s (MediaPipe at 1.3–2.9 frames
+ * a second, the machine loaded by builds): some of those holds are judged on the move into
+ * them, which the per-hold report shows as the previous gesture.
+ */
+const LATENCY_S = 1.5;
+/**
+ * A hold is "named" when its gesture is shown on at least this share of the samples taken in
+ * it (from its start plus LATENCY_S to its end): most of the hold, not a glimpse.
+ */
+const NAMED_SHARE = 0.8;
+/** Fewest samples a hold is judged on (the page samples itself less often than every 100 ms when loaded). */
+const MIN_HOLD_SAMPLES = 3;
 
 const dir = mkdtempSync(path.join(tmpdir(), 'dqhand-camera-'));
 let labels: Labels;
@@ -57,10 +91,34 @@ function renderVideo(...flags: string[]): Labels {
   return JSON.parse(readFileSync(path.join(dir, flags.includes('--left') ? 'hand-left.labels.json' : 'hand.labels.json'), 'utf8'));
 }
 
-/** A browser whose camera plays `video` (in `dir`), and a page of it on the server, connected. */
-async function cameraPage(video: string): Promise<{ browser: Browser; page: Page }> {
+/**
+ * In the page, before its scripts: each frame the page takes from a video (its next frame for
+ * MediaPipe, requestVideoFrameCallback) is read for its number (MARKER's blocks), logged in
+ * `window.videoFrames` with the page's time.
+ */
+function watchFrames([marker, size]: [typeof MARKER, [number, number]]): void {
+  const log: { at: number; frame: number }[] = [];
+  (window as unknown as { videoFrames: typeof log }).videoFrames = log;
+  const g = Object.assign(document.createElement('canvas'), { width: marker.bits * marker.block[0], height: marker.block[1] }).getContext('2d', { willReadFrequently: true })!;
+  const requestFrame = HTMLVideoElement.prototype.requestVideoFrameCallback;
+  HTMLVideoElement.prototype.requestVideoFrameCallback = function (callback) {
+    return requestFrame.call(this, (now, metadata) => {
+      const scale = this.videoWidth / size[0];
+      g.drawImage(this, 0, 0, g.canvas.width * scale, g.canvas.height * scale, 0, 0, g.canvas.width, g.canvas.height);
+      const row = g.getImageData(0, marker.block[1] / 2, g.canvas.width, 1).data;
+      let frame = 0;
+      for (let b = 0; b < marker.bits; b++) frame = 2 * frame + (row[4 * (b * marker.block[0] + marker.block[0] / 2)] > 127 ? 1 : 0);
+      log.push({ at: performance.now(), frame });
+      callback(now, metadata);
+    });
+  };
+}
+
+/** A browser whose camera plays `video` (in `dir`, of `size`), and a page of it on the server, connected. */
+async function cameraPage(video: string, size: [number, number]): Promise<{ browser: Browser; page: Page }> {
   const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
   const p = await newPage(b, { width: 1100, height: 700 });
+  await p.addInitScript(watchFrames, [MARKER, size] as [typeof MARKER, [number, number]]);
   await p.goto(server.url);
   await waitState(p, 's.connected && s.frame !== null');
   return { browser: b, page: p };
@@ -76,7 +134,7 @@ beforeAll(async () => {
   }
   writeFileSync(path.join(dir, 'config.json'), JSON.stringify(CONFIG));
   server = await startServer({ args: ['--config', path.join(dir, 'config.json'), '--recordings', path.join(dir, 'recordings')] });
-  ({ browser, page } = await cameraPage('hand.y4m'));
+  ({ browser, page } = await cameraPage('hand.y4m', labels.size));
 });
 
 afterAll(async () => {
@@ -86,19 +144,107 @@ afterAll(async () => {
 });
 
 /** The page's state (`window.dqhand.state()`), as the test expects it. */
-const read = <T>(): Promise<T> => page.evaluate(() => (window as unknown as { dqhand: { state(): T } }).dqhand.state());
+const read = <T>(p: Page = page): Promise<T> => p.evaluate(() => (window as unknown as { dqhand: { state(): T } }).dqhand.state());
 
-/** Samples the page's state every 100 ms for `seconds`. */
-async function sample(seconds: number): Promise<Sample[]> {
-  const samples: Sample[] = [];
-  const end = Date.now() + seconds * 1000;
-  while (Date.now() < end) {
-    const s = await read<{ input: { gesture: string | null; tracking: string; side: string | null } | null; frame: { anglesDeg: number[] } | null }>();
-    samples.push({ at: Date.now(), gesture: s.input?.gesture ?? null, tracking: s.input?.tracking ?? 'none', side: s.input?.side ?? null, anglesDeg: s.frame?.anglesDeg ?? [] });
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  return samples;
+/** The frames the page has taken from its camera for MediaPipe (its time, ms; the frame's number). */
+const framesTaken = (p: Page) => p.evaluate(() => (window as unknown as { videoFrames: { at: number; frame: number }[] }).videoFrames);
+
+/** Frames taken this close to a time (ms) set the video's clock there. */
+const CLOCK_WINDOW_MS = 2000;
+
+/**
+ * The video's clock: where the looping video is (s from its first frame) at a page time (ms),
+ * from the frames the page took: the median of their phases (page time less video time)
+ * within CLOCK_WINDOW_MS. A frame alone is not trusted (it is read up to a few hundred ms late
+ * when the page is busy with MediaPipe), nor one phase for the whole run (Chromium's fake
+ * camera falls behind on a loaded machine and does not catch up: 1.0–1.5 s in a minute at load 12).
+ * `residuals`: each frame's phase against the clock's there (s); `drift`: the clock's phase at
+ * the last frame less at the first (s).
+ */
+function videoClock(taken: { at: number; frame: number }[], v: Labels): { at(pageMs: number): number | null; residuals: number[]; drift: number } {
+  const loop = v.frames / v.fps;
+  const wrap = (x: number) => ((x % loop) + loop) % loop;
+  /** `x` less `from`, in (−loop/2, loop/2]. */
+  const less = (x: number, from: number) => wrap(x - from + loop / 2) - loop / 2;
+  const phases = taken.map((f) => wrap(f.at / 1000 - f.frame / v.fps));
+  const phaseAt = (pageMs: number): number | null => {
+    const near = taken.map((f, i) => [Math.abs(f.at - pageMs), phases[i]]).filter(([d]) => d <= CLOCK_WINDOW_MS).map(([, p]) => p);
+    return near.length === 0 ? null : near[0] + median(near.map((p) => less(p, near[0])));
+  };
+  const at = (pageMs: number) => {
+    const phase = phaseAt(pageMs);
+    return phase === null ? null : wrap(pageMs / 1000 - phase);
+  };
+  const residuals = taken.map((f, i) => less(phases[i], phaseAt(f.at)!));
+  const drift = taken.length > 0 ? less(phaseAt(taken[taken.length - 1].at)!, phaseAt(taken[0].at)!) : 0;
+  return { at, residuals, drift };
 }
+
+/**
+ * Samples the page's state every 100 ms for `seconds`, each sample placed in the video of `v`.
+ * The page samples itself (a round trip from the test per sample takes longer than 100 ms on a
+ * loaded machine).
+ */
+async function sample(p: Page, seconds: number, v: Labels): Promise<Sample[]> {
+  const raw = await p.evaluate(
+    (seconds) =>
+      new Promise<(Omit<Sample, 'video'> & { pageAt: number })[]>((done) => {
+        const w = window as unknown as { dqhand: { state(): { input: { gesture: string | null; tracking: string; side: string | null } | null; frame: { anglesDeg: number[] } | null } } };
+        const samples: (Omit<Sample, 'video'> & { pageAt: number })[] = [];
+        const timer = setInterval(() => {
+          const s = w.dqhand.state();
+          samples.push({ at: Date.now(), pageAt: performance.now(), gesture: s.input?.gesture ?? null, tracking: s.input?.tracking ?? 'none', side: s.input?.side ?? null, anglesDeg: s.frame?.anglesDeg ?? [] });
+        }, 100);
+        setTimeout(() => {
+          clearInterval(timer);
+          done(samples);
+        }, seconds * 1000);
+      }),
+    seconds,
+  );
+  const clock = videoClock(await framesTaken(p), v);
+  return raw.map(({ pageAt, ...s }) => ({ ...s, video: clock.at(pageAt) }));
+}
+
+/** The samples taken in `hold`: from its start plus LATENCY_S to its end, in any pass of the video. */
+const inHold = (samples: Sample[], hold: Hold) => samples.filter((s) => s.video !== null && s.video >= hold.from_s + LATENCY_S && s.video < hold.to_s);
+
+/** How many samples showed each gesture ('none' for none). */
+function shown(samples: Sample[]): Record<string, number> {
+  const counts: Record<string, number> = {};
+  for (const s of samples) counts[s.gesture ?? 'none'] = (counts[s.gesture ?? 'none'] ?? 0) + 1;
+  return counts;
+}
+
+/** Mean difference of two poses' angles (degrees) under which a pose has reached the other. */
+const REACHED_DEG = 10;
+
+/**
+ * How long after a hold's start the retargeted angles reached the hold's (s): the first sample
+ * within REACHED_DEG of the median angles of the hold's last second, in each pass of the video
+ * whose hold start the sampling saw (a sample in the second before it). The pipeline's
+ * latency, whatever the recogniser makes of the pose: LATENCY_S's measure.
+ */
+function latencies(samples: Sample[], v: Labels): number[] {
+  const out: number[] = [];
+  for (const hold of v.gestures) {
+    for (let i = 1; i < samples.length; i++) {
+      const [a, b] = [samples[i - 1].video, samples[i].video];
+      if (a === null || b === null || !(a < hold.from_s && b >= hold.from_s && hold.from_s - a < 1)) continue;
+      const end = samples.findIndex((s, k) => k >= i && (s.video! < hold.from_s || s.video! >= hold.to_s));
+      const pass = samples.slice(i, end < 0 ? samples.length : end).filter((s) => s.anglesDeg.length > 0);
+      const last = pass.filter((s) => s.video! >= hold.to_s - 1);
+      if (last.length === 0) continue;
+      const reached = last[0].anglesDeg.map((_, d) => median(last.map((s) => s.anglesDeg[d])));
+      const first = pass.find((s) => s.anglesDeg.reduce((e, x, d) => e + Math.abs(x - reached[d]), 0) / reached.length < REACHED_DEG);
+      if (first) out.push(first.video! - hold.from_s);
+    }
+  }
+  return out.sort((x, y) => x - y);
+}
+
+const median = (v: number[]) => [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)];
+const quantile = (v: number[], q: number) => [...v].sort((a, b) => a - b)[Math.floor(q * (v.length - 1))];
 
 /** The gestures recognised in turn, each with how long it lasted (s, from its first sample to the next run's). */
 function runs(samples: Sample[]): { gesture: string; seconds: number }[] {
@@ -162,7 +308,7 @@ describe('the Camera button on a video of our own hand', () => {
     expect(await page.locator('#camera-preview').isVisible()).toBe(true);
 
     const loop = labels.frames / labels.fps;
-    const samples = await sample(1.4 * loop);
+    const samples = await sample(page, 1.4 * loop, labels);
     const tracked = samples.filter((s) => s.tracking === 'tracking');
     expect(tracked.length / samples.length).toBeGreaterThan(0.8);
     expect(new Set(samples.map((s) => s.side).filter(Boolean))).toEqual(new Set([labels.side]));
@@ -179,23 +325,24 @@ describe('the Camera button on a video of our own hand', () => {
     const follows = (a: string, b: string) => rendered.some((g, i) => g === a && [1, 2].some((d) => rendered[(i + d) % rendered.length] === b));
     for (let i = 1; i < seen.length; i++) expect(follows(seen[i - 1], seen[i]), `${seen[i - 1]} → ${seen[i]} in ${JSON.stringify(all)}`).toBe(true);
 
-    // The retargeted angles once a gesture has been recognised for 0.3 s (3 samples: not in a
-    // move between two), against the rendered gesture's, over the DOFs it bends (all for the open palm).
+    // The retargeted angles on every sample of each hold (recognised or not), against the
+    // rendered gesture's, over the DOFs it bends (all for the open palm).
     const { dofs } = await read<{ dofs: string[] }>();
-    const settled = samples.filter((s, i) => i >= 2 && s.anglesDeg.length === dofs.length && samples[i - 1].gesture === s.gesture && samples[i - 2].gesture === s.gesture);
-    const median = (v: number[]) => [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)];
-    const errors: Record<string, { median: number; p90: number; worst: string }> = {};
-    for (const name of new Set(rendered)) {
-      const pose = poses.get(name)!;
-      const bent = dofs.map((d, i) => [d, i] as const).filter(([d]) => Math.abs(pose[d] ?? 0) >= 20 || name === 'open_palm');
-      const held = settled.filter((s) => s.gesture === name);
+    const errors: Record<string, { samples: number; recognised: number; median: number; p90: number; worst: string }> = {};
+    labels.gestures.forEach((hold, h) => {
+      const pose = poses.get(hold.gesture)!;
+      const bent = dofs.map((d, i) => [d, i] as const).filter(([d]) => Math.abs(pose[d] ?? 0) >= 20 || hold.gesture === 'open_palm');
+      const held = inHold(samples, hold).filter((s) => s.anglesDeg.length === dofs.length);
       const perDof = bent.map(([d, i]) => ({ d, e: held.map((s) => Math.abs(s.anglesDeg[i] - (pose[d] ?? 0))) }));
-      const all = perDof.flatMap((x) => x.e).sort((a, b) => a - b);
+      const all = perDof.flatMap((x) => x.e);
       const worst = perDof.map(({ d, e }) => `${d} ${median(e).toFixed(0)}`).sort((a, b) => Number(b.split(' ')[1]) - Number(a.split(' ')[1]));
-      errors[name] = { median: median(all), p90: all[Math.floor(0.9 * all.length)], worst: worst.slice(0, 3).join(', ') };
+      errors[`${h} ${hold.gesture}`] = { samples: held.length, recognised: held.filter((s) => s.gesture === hold.gesture).length, median: median(all), p90: quantile(all, 0.9), worst: worst.slice(0, 3).join(', ') };
+    });
+    console.log(`camera: retargeted angle error against the rendered gestures on every sample of each hold (degrees): ${JSON.stringify(errors, null, 1)}; latency (s, the angles reaching a hold's) ${latencies(samples, labels).map((l) => l.toFixed(1)).join(' ')}`);
+    for (const [name, e] of Object.entries(errors)) {
+      expect(e.samples, name).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
+      expect(e.median, name).toBeLessThan(MEDIAN_TOLERANCE_DEG);
     }
-    console.log(`camera: retargeted angle error against the rendered gestures (degrees): ${JSON.stringify(errors, null, 1)}`);
-    for (const [name, e] of Object.entries(errors)) expect(e.median, name).toBeLessThan(MEDIAN_TOLERANCE_DEG);
     const speed = await read<{ camera: { detectMs: number; fps: number; frames: number; detected: number }; pageFps: number; frame: { engineUs: number } }>();
     const { detectMs, fps, frames, detected } = speed.camera;
     console.log(`camera: MediaPipe ${detectMs.toFixed(0)} ms/frame, ${fps.toFixed(1)} frames/s, a hand in ${detected}/${frames}; page ${speed.pageFps.toFixed(1)} fps; engine ${speed.frame.engineUs.toFixed(0)} µs/frame`);
@@ -255,32 +402,254 @@ describe('the Camera button on a video of our own hand, mirrored: a left hand', 
 
   beforeAll(async () => {
     leftLabels = renderVideo('--left');
-    ({ browser: leftBrowser, page: leftPage } = await cameraPage('hand-left.y4m'));
+    ({ browser: leftBrowser, page: leftPage } = await cameraPage('hand-left.y4m', leftLabels.size));
   });
 
   afterAll(async () => {
     await leftBrowser?.close();
   });
 
-  test('MediaPipe\'s label is swapped to the left hand, the engine mirrors it, and the hand opens and closes', async () => {
+  test('MediaPipe\'s label is swapped to the left hand, the engine mirrors it, and the open palm and the fist are named', async () => {
     await leftPage.click('#camera');
     await waitState(leftPage, 's.camera.detected > 3 && s.input !== null && s.input.side === "left"', 90_000);
-    const { dofs } = await leftPage.evaluate(() => (window as unknown as { dqhand: { state(): { dofs: string[] } } }).dqhand.state());
+    const { dofs } = await read<{ dofs: string[] }>(leftPage);
     const fingers = ['index', 'middle', 'ring'].map((f) => dofs.indexOf(`${f}-finger-phalanx-proximal.flex`));
-    const seen = new Set<string>();
-    const sides = new Set<string>();
-    let curled = 0;
-    for (const end = Date.now() + (1000 * leftLabels.frames) / leftLabels.fps; Date.now() < end; await new Promise((r) => setTimeout(r, 100))) {
-      const s = await leftPage.evaluate(() => (window as unknown as { dqhand: { state(): { camera: { hands: string[] }; input: { gesture: string | null; side: string; mirrored: boolean }; frame: { anglesDeg: number[] } } } }).dqhand.state());
-      if (s.input.gesture) seen.add(s.input.gesture);
-      sides.add(`${s.camera.hands[0] ?? 'none'} ${s.input.side} ${s.input.mirrored}`);
-      curled = Math.max(curled, Math.min(...fingers.map((i) => s.frame.anglesDeg[i])));
-    }
-    expect([...sides].filter((x) => !x.startsWith('none'))).toEqual(['left left true']);
-    // The open palm is recognised, and the fist and point curl the fingers. (MediaPipe reads
-    // the mirrored thumb less curled than the original's: the fist is taken for thumbs_up.)
-    expect(seen.has('open_palm'), [...seen].join(', ')).toBe(true);
+    // Three passes of the video: enough samples of each hold on a loaded machine.
+    const samples = await sample(leftPage, (3 * leftLabels.frames) / leftLabels.fps, leftLabels);
+    const { camera, input } = await read<{ camera: { hands: string[] }; input: { side: string; mirrored: boolean } }>(leftPage);
+    expect([camera.hands[0], input.side, input.mirrored]).toEqual(['left', 'left', true]);
+    expect(new Set(samples.map((s) => s.side).filter(Boolean))).toEqual(new Set(['left']));
+    const curled = Math.max(...samples.filter((s) => s.anglesDeg.length === dofs.length).map((s) => Math.min(...fingers.map((i) => s.anglesDeg[i]))));
     expect(curled).toBeGreaterThan(45);
+    // The open palm is recognised, and the fist is named (fist on NAMED_SHARE of its samples).
+    // MediaPipe reads the mirrored thumb less curled than the original's, and the engine's
+    // recogniser then takes the fist for thumbs_up or nothing: this fails until it tells them apart.
+    const report = leftLabels.gestures.map((hold) => ({ ...hold, shown: shown(inHold(samples, hold)) }));
+    console.log(`camera, left: shown in each hold: ${JSON.stringify(report)}`);
+    expect(samples.some((s) => s.gesture === 'open_palm'), JSON.stringify(report)).toBe(true);
+    for (const { gesture, shown: counts } of report.filter((r) => r.gesture === 'fist')) {
+      const n = Object.values(counts).reduce((a, b) => a + b, 0);
+      expect(n, gesture).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
+      expect((counts.fist ?? 0) / n, `${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
+    }
     await leftPage.click('#camera');
+  });
+});
+
+/**
+ * The generic hand's recording: `dqhand synthesize` arguments, but for `--out`. A right hand
+ * (the page's camera test takes one), every built-in gesture once (13 holds: the 12 and one
+ * again), no idle motion after them.
+ */
+const GENERIC_RECORDING = ['synthesize', '--format', 'joints', '--seed', '3', '--holds', '13', '--idle', '0', '--side', 'right'];
+/**
+ * The share of holds named the project aims for (docs/testing.md): the new recogniser's target;
+ * the test fails until it is met.
+ */
+const NAMED_HOLDS = 0.9;
+/** Largest median retargeted angle error over every DOF and sample of the holds (degrees). */
+const GENERIC_MEDIAN_TOLERANCE_DEG = 20;
+/** MediaPipe's landmarks are compared with frames from this far into a hold (s): MediaPipe tracks from frame to frame, and the pose has settled. */
+const SETTLED_S = 0.5;
+/** A finger whose 4 landmarks lie this far from the truth on average (m) is "dropped". */
+const DROPPED_M = 0.02;
+/** The WebXR joint at each of MediaPipe's 21 landmarks (crates/dqhand/src/input/mediapipe.rs, WEBXR_INDEX). */
+const WEBXR_INDEX = [0, 1, 2, 3, 4, 6, 7, 8, 9, 11, 12, 13, 14, 16, 17, 18, 19, 21, 22, 23, 24];
+/** MediaPipe's landmarks of each finger. */
+const FINGERS: Record<string, number[]> = { thumb: [1, 2, 3, 4], index: [5, 6, 7, 8], middle: [9, 10, 11, 12], ring: [13, 14, 15, 16], pinky: [17, 18, 19, 20] };
+
+type Vec = [number, number, number];
+
+/**
+ * The similarity (scale, rotation, translation) that best maps `from` onto `to` in the least-
+ * squares sense (Umeyama; the rotation by Horn's quaternion method), and each point's residual
+ * `to − (s R from + t)`.
+ */
+function align(from: Vec[], to: Vec[]): { scale: number; residuals: Vec[] } {
+  const mean = (p: Vec[]) => [0, 1, 2].map((k) => p.reduce((s, q) => s + q[k], 0) / p.length) as Vec;
+  const [mf, mt] = [mean(from), mean(to)];
+  const x = from.map((p) => p.map((v, k) => v - mf[k]) as Vec);
+  const y = to.map((p) => p.map((v, k) => v - mt[k]) as Vec);
+  const S = [0, 1, 2].map((a) => [0, 1, 2].map((b) => x.reduce((s, p, i) => s + p[a] * y[i][b], 0)));
+  const [[xx, xy, xz], [yx, yy, yz], [zx, zy, zz]] = S;
+  const [w, qx, qy, qz] = topEigenvector([
+    [xx + yy + zz, yz - zy, zx - xz, xy - yx],
+    [yz - zy, xx - yy - zz, xy + yx, zx + xz],
+    [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
+    [xy - yx, zx + xz, yz + zy, -xx - yy + zz],
+  ]);
+  const R = [
+    [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - w * qz), 2 * (qx * qz + w * qy)],
+    [2 * (qx * qy + w * qz), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - w * qx)],
+    [2 * (qx * qz - w * qy), 2 * (qy * qz + w * qx), 1 - 2 * (qx * qx + qy * qy)],
+  ];
+  const turned = x.map((p) => R.map((r) => r[0] * p[0] + r[1] * p[1] + r[2] * p[2]) as Vec);
+  const scale = turned.reduce((s, p, i) => s + p[0] * y[i][0] + p[1] * y[i][1] + p[2] * y[i][2], 0) / x.reduce((s, p) => s + p[0] ** 2 + p[1] ** 2 + p[2] ** 2, 0);
+  return { scale, residuals: y.map((q, i) => q.map((v, k) => v - scale * turned[i][k]) as Vec) };
+}
+
+/** The eigenvector of the largest eigenvalue of a symmetric matrix (cyclic Jacobi rotations). */
+function topEigenvector(m: number[][]): number[] {
+  const n = m.length;
+  const a = m.map((r) => [...r]);
+  const v = a.map((_, i) => a.map((_, j) => (i === j ? 1 : 0)));
+  for (let sweep = 0; sweep < 50; sweep++) {
+    let off = 0;
+    for (let p = 0; p < n; p++) for (let q = p + 1; q < n; q++) off += a[p][q] ** 2;
+    if (off < 1e-24) break;
+    for (let p = 0; p < n; p++) {
+      for (let q = p + 1; q < n; q++) {
+        if (a[p][q] === 0) continue;
+        const theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+        const t = (theta >= 0 ? 1 : -1) / (Math.abs(theta) + Math.sqrt(theta * theta + 1));
+        const c = 1 / Math.sqrt(t * t + 1);
+        const s = t * c;
+        for (const r of [a, v]) {
+          for (let k = 0; k < n; k++) [r[k][p], r[k][q]] = [c * r[k][p] - s * r[k][q], s * r[k][p] + c * r[k][q]];
+        }
+        for (let k = 0; k < n; k++) [a[p][k], a[q][k]] = [c * a[p][k] - s * a[q][k], s * a[p][k] + c * a[q][k]];
+      }
+    }
+  }
+  const top = a.reduce((best, r, i) => (r[i] > a[best][best] ? i : best), 0);
+  return v.map((r) => r[top]);
+}
+
+describe('the Camera button on a video of a hand not ours: the WebXR generic hand', () => {
+  let generic: Labels;
+  /** Each frame's record time and the 25 joints in the camera's frame (MediaPipe's axes, m). */
+  let truth: { frames: { t: number; joints: Vec[] }[] };
+  /** The recording's true angles: `dqhand replay --out` of it, by record time. */
+  const trueAngles = new Map<number, Record<string, number>>();
+  let genericBrowser: Browser;
+  let genericPage: Page;
+  let samples: Sample[];
+  let dofs: string[];
+  /** The camera input the engine took (the Record button), each record with the frame it came from. */
+  let recorded: { landmarks: Vec[]; frame: number }[];
+  /** The frames the page took for MediaPipe, with the page's time (ms). */
+  let taken: { at: number; frame: number }[];
+
+  beforeAll(async () => {
+    const rec = path.join(dir, 'generic.jsonl');
+    const synthesized = spawnSync(dqhandBin(), [...GENERIC_RECORDING, '--out', rec], { encoding: 'utf8' });
+    if (synthesized.status !== 0) throw new Error(`dqhand ${GENERIC_RECORDING.join(' ')} failed: ${synthesized.stderr}`);
+    const video = spawnSync('node', [path.join(root, 'viewer/scripts/generic-hand-video.mjs'), dir, '--input', rec], { encoding: 'utf8' });
+    if (video.status !== 0) throw new Error(`generic-hand-video.mjs failed: ${video.stderr}`);
+    generic = JSON.parse(readFileSync(path.join(dir, 'generic-hand.labels.json'), 'utf8'));
+    truth = JSON.parse(readFileSync(path.join(dir, 'generic-hand.truth.json'), 'utf8'));
+    const replayed = spawnSync(dqhandBin(), ['replay', '--input', rec, '--out', path.join(dir, 'generic.poses.jsonl')], { encoding: 'utf8' });
+    if (replayed.status !== 0) throw new Error(`dqhand replay failed: ${replayed.stderr}`);
+    for (const line of readFileSync(path.join(dir, 'generic.poses.jsonl'), 'utf8').split('\n').filter(Boolean)) {
+      const { t, angles_deg } = JSON.parse(line);
+      trueAngles.set(t, angles_deg);
+    }
+
+    ({ browser: genericBrowser, page: genericPage } = await cameraPage('generic-hand.y4m', generic.size));
+    // A new page is told of the latest recording (off) when it connects: the last message counts.
+    const last = 's.recordings[s.recordings.length - 1]';
+    await genericPage.click('#record');
+    await waitState(genericPage, `s.recordings.length > 0 && ${last}.on`);
+    await genericPage.click('#camera');
+    await waitState(genericPage, 's.camera.detected > 3 && s.input !== null && s.input.accepted > 3', 90_000);
+    ({ dofs } = await read<{ dofs: string[] }>(genericPage));
+    // Two passes of the video: every hold sampled twice.
+    samples = await sample(genericPage, (2 * generic.frames) / generic.fps, generic);
+    await genericPage.click('#record');
+    await waitState(genericPage, `!${last}.on`);
+    const file = (await read<{ recordings: { path: string }[] }>(genericPage)).recordings.pop()!.path;
+    taken = await framesTaken(genericPage);
+    // A record's time is the page's when MediaPipe gave the hand: its frame is the last one taken before.
+    recorded = readFileSync(file, 'utf8')
+      .split('\n')
+      .filter(Boolean)
+      .map((l) => JSON.parse(l) as { t: number; landmarks: Vec[] })
+      .map(({ t, landmarks }) => ({ landmarks, frame: taken.filter((f) => f.at <= t * 1000).pop()?.frame ?? -1 }));
+    await genericPage.click('#camera');
+    const speed = await read<{ camera: { detectMs: number; fps: number; frames: number; detected: number } }>(genericPage);
+    console.log(`camera, generic hand: MediaPipe ${speed.camera.detectMs.toFixed(0)} ms/frame, ${speed.camera.fps.toFixed(1)} frames/s, a hand in ${speed.camera.detected}/${speed.camera.frames}; ${samples.length} samples, ${recorded.length} records`);
+  }, 300_000);
+
+  afterAll(async () => {
+    await genericBrowser?.close();
+  });
+
+  test('the video clock holds: the frames MediaPipe takes fit it', () => {
+    const { residuals, drift } = videoClock(taken, generic);
+    const off = residuals.map(Math.abs);
+    console.log(`camera, generic hand: ${taken.length} frames taken; their phase against the clock's: median |Δ| ${median(off).toFixed(2)} s, 90th percentile ${quantile(off, 0.9).toFixed(2)} s; the fake camera fell behind by ${drift.toFixed(2)} s over the run`);
+    expect(taken.length).toBeGreaterThan(50);
+    // Most frames sit on the clock to a frame or two: the samples' places are as good.
+    expect(median(off)).toBeLessThan(0.2);
+  });
+
+  test('the engine names the held gestures (the gesture shown on 80 % of a hold\'s samples) in 90 % of the holds', () => {
+    const report = generic.gestures.map((hold) => {
+      const held = inHold(samples, hold);
+      const counts = shown(held);
+      const tracking = held.filter((s) => s.tracking === 'tracking').length;
+      return { gesture: hold.gesture, from_s: hold.from_s, samples: held.length, tracking, named: (counts[hold.gesture] ?? 0) >= NAMED_SHARE * held.length, shown: counts };
+    });
+    const wrong = report.reduce((n, r) => n + Object.entries(r.shown).filter(([g]) => g !== r.gesture && g !== 'none').reduce((a, [, c]) => a + c, 0), 0);
+    const all = report.reduce((n, r) => n + r.samples, 0);
+    const share = report.filter((r) => r.named).length / report.length;
+    const lat = latencies(samples, generic);
+    console.log(`camera, generic hand: shown in each hold (from its start + ${LATENCY_S} s; samples, of them tracking, gestures shown): ${report.map((r) => `\n  ${r.gesture} at ${r.from_s} s: ${r.samples}, ${r.tracking}, ${JSON.stringify(r.shown)}${r.named ? ' named' : ''}`).join('')}\nnamed ${report.filter((r) => r.named).length}/${report.length} holds; a wrong gesture on ${wrong}/${all} samples; latency (s, the angles reaching a hold's) ${lat.map((l) => l.toFixed(1)).join(' ')}`);
+    for (const r of report) expect(r.samples, `${r.gesture} at ${r.from_s} s`).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
+    expect(share, JSON.stringify(report.map((r) => [r.gesture, r.shown]))).toBeGreaterThanOrEqual(NAMED_HOLDS);
+  });
+
+  test('the retargeted angles follow the recording\'s, on every sample of every hold', () => {
+    const perHold = generic.gestures.map((hold) => {
+      // The hold shows one record throughout: its middle frame's.
+      const angles = trueAngles.get(truth.frames[Math.floor(((hold.from_s + hold.to_s) / 2) * generic.fps)].t)!;
+      const held = inHold(samples, hold).filter((s) => s.anglesDeg.length === dofs.length);
+      return { gesture: hold.gesture, errors: held.flatMap((s) => dofs.filter((d) => d in angles).map((d) => Math.abs(s.anglesDeg[dofs.indexOf(d)] - angles[d]))) };
+    });
+    const all = perHold.flatMap((h) => h.errors);
+    const summary = (e: number[]) => (e.length ? `${median(e).toFixed(1)} / ${quantile(e, 0.9).toFixed(1)}` : 'no samples');
+    console.log(`camera, generic hand: retargeted angle error against the recording's (degrees, median / 90th percentile, every DOF, every sample of each hold): ${perHold.map(({ gesture, errors }) => `${gesture} ${summary(errors)}`).join(', ')}; all ${summary(all)}`);
+    expect(all.length).toBeGreaterThan(100);
+    expect(median(all)).toBeLessThan(GENERIC_MEDIAN_TOLERANCE_DEG);
+  });
+
+  test('MediaPipe\'s tracking error: its landmarks against the true joints, in the camera\'s frame', () => {
+    // The records are in the engine's world: the camera's axes turned a half turn about z
+    // (src/landmarks.ts, cameraToWorld), undone here; the translation goes in the alignment.
+    const frames = recorded.filter(({ frame }) => generic.gestures.some((h) => frame >= (h.from_s + SETTLED_S) * generic.fps && frame < h.to_s * generic.fps));
+    const joints = truth.frames[0].joints;
+    const chain = [0, 10, 11, 12, 13, 14]; // the wrist, the middle finger's joints to its tip
+    const size = chain.slice(1).reduce((s, j, i) => s + Math.hypot(...(joints[j].map((v, k) => v - joints[chain[i]][k]) as Vec)), 0);
+    const groups: Record<string, number[]> = { wrist: [0], ...FINGERS, all: [...Array(21).keys()] };
+    const sums = Object.fromEntries(Object.keys(groups).map((g) => [g, { xy: 0, z: 0, n: 0 }]));
+    const dropped = Object.fromEntries(Object.keys(FINGERS).map((f) => [f, 0]));
+    const scales: number[] = [];
+    for (const { landmarks, frame } of frames) {
+      const { scale, residuals } = align(
+        landmarks.map(([x, y, z]) => [-x, -y, z] as Vec),
+        WEBXR_INDEX.map((j) => truth.frames[frame].joints[j]),
+      );
+      scales.push(scale);
+      for (const [g, idx] of Object.entries(groups)) {
+        for (const i of idx) {
+          sums[g].xy += residuals[i][0] ** 2 + residuals[i][1] ** 2;
+          sums[g].z += residuals[i][2] ** 2;
+          sums[g].n++;
+        }
+      }
+      for (const [f, idx] of Object.entries(FINGERS)) if (idx.reduce((s, i) => s + Math.hypot(...residuals[i]), 0) / idx.length > DROPPED_M) dropped[f]++;
+    }
+    const rms = Object.fromEntries(
+      Object.entries(sums).map(([g, { xy, z, n }]) => [g, { xy_mm: Number(((1000 * Math.sqrt(xy / n)) as number).toFixed(1)), z_mm: Number((1000 * Math.sqrt(z / n)).toFixed(1)), xy_share: Number((Math.sqrt(xy / n) / size).toFixed(3)), z_share: Number((Math.sqrt(z / n) / size).toFixed(3)) }]),
+    );
+    const droppedShare = Object.fromEntries(Object.entries(dropped).map(([f, n]) => [f, Number((n / frames.length).toFixed(3))]));
+    console.log(
+      `camera, generic hand: MediaPipe's landmarks against the true joints on ${frames.length} frames from ${SETTLED_S} s into a hold, each aligned by the best similarity ` +
+        `(hand size: wrist to middle fingertip along the bones, ${(1000 * size).toFixed(0)} mm; MediaPipe's scale fitted ${median(scales).toFixed(2)} median, ${Math.min(...scales).toFixed(2)}–${Math.max(...scales).toFixed(2)}): ` +
+        `RMS residual in the image plane (xy, per point) and in depth (z): ${JSON.stringify(rms, null, 1)}; fingers dropped (mean residual > ${DROPPED_M * 100} cm), share of frames: ${JSON.stringify(droppedShare)}`,
+    );
+    expect(frames.length).toBeGreaterThan(50);
+    // A gross bound: landmarks matched to the wrong joints, or in other axes, are off by the hand's size.
+    expect(rms.all.xy_share + rms.all.z_share).toBeLessThan(0.3);
   });
 });
