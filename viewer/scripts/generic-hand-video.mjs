@@ -61,7 +61,7 @@ if (!['left', 'right'].includes(side) || records.some((r) => r.hand !== side || 
 const name = side === 'left' ? 'generic-hand-left' : 'generic-hand';
 
 /** The gestures that name a direction in the world, shown as recorded (not turned). */
-const DIRECTED = new Set(JSON.parse(readFileSync(path.join(root, 'crates/dqhand/data/gestures.json'), 'utf8')).gestures.filter((g) => g.when.some((c) => /\b(palm|thumb)\.up\b/.test(c))).map((g) => g.name));
+const DIRECTED = new Set(JSON.parse(readFileSync(path.join(root, 'crates/dqhand/data/gestures.json'), 'utf8')).gestures.filter((g) => (g.when ?? []).some((c) => /\b(palm|thumb)\.up\b/.test(c))).map((g) => g.name));
 const RAISED = new Quaternion().setFromAxisAngle(new Vector3(1, 0, 0), Math.PI / 2);
 /** Where the camera looks (m): the centre of the hand in each hold. */
 const TARGET = new Vector3(0, 0, 0);

@@ -23,7 +23,7 @@ const GESTURES = left ? ['open_palm', 'fist', 'point'] : ['open_palm', 'fist', '
 const NAME = left ? 'hand-left' : 'hand';
 const SIZE = [320, 240];
 const FPS = 10;
-const HOLD_FRAMES = 30;
+const HOLD_FRAMES = 40;
 const MOVE_FRAMES = 3;
 /** How long the engine takes to move to a gesture (s) — the frames of the move sample it. */
 const MOVE_S = 0.5;

@@ -90,7 +90,7 @@ pub struct Args {
     gestures: Option<std::path::PathBuf>,
 }
 
-fn parse_split(s: &str) -> Result<Split, String> {
+pub fn parse_split(s: &str) -> Result<Split, String> {
     match s {
         "held-out" => Ok(Split::HeldOut),
         "tune" => Ok(Split::Tune),
