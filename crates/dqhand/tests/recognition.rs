@@ -363,3 +363,21 @@ fn the_builtin_set_defines_every_library_gesture_and_thumbs_down() {
     expected.insert(expected.iter().position(|&n| n == "thumbs_up").unwrap() + 1, "thumbs_down");
     assert_eq!(names, expected);
 }
+
+/// Learned definitions: the built-in set written back reads back equal; a file with a
+/// classifier and a gesture's own model (the settings fuzz target's seed) loads; a class the
+/// classifier lacks is named.
+#[test]
+fn learned_definitions_write_back_equal_and_a_missing_class_is_named() {
+    let set = GestureSet::builtin();
+    assert_eq!(GestureSet::from_json(&set.to_json(), "written").unwrap(), set);
+    let json = include_str!("../../../fuzz/seeds/settings/gestures-learned.json");
+    let learned = GestureSet::from_json(json, "learned.json").unwrap();
+    assert_eq!(learned.gestures()[0].model().unwrap().classes(), ["other", "gun"]);
+    assert_eq!(learned.gestures()[1].class(), Some(1));
+    let (message, problem) = definition_error(&json.replace(r#""class": "fist""#, r#""class": "fists""#));
+    assert!(matches!(problem, GestureProblem::UnknownClass { .. }), "{message}");
+    assert_eq!(message, "mine.json: gesture \"fist\": class \"fists\" is not one of the classifier's (none, fist, thumbs)");
+    let (message, _) = definition_error(&json.replace(r#""start": 0.6, "hold": 0.35 } },"#, r#""start": 0.6, "hold": 0.7 } },"#));
+    assert!(message.starts_with("mine.json: gesture \"gun\" model: start 0.6 and hold 0.7"), "{message}");
+}
