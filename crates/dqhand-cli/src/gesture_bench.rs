@@ -79,7 +79,7 @@ pub struct Args {
     #[arg(long, default_value_t = 8)]
     sequences: usize,
     /// The split of the varied sequences: `held-out` (never trained or tuned on) or `tune`.
-    #[arg(long, default_value = "held-out", value_parser = parse_split)]
+    #[arg(long, default_value = "held-out")]
     split: Split,
     /// Also score hand poses other people recorded (handy-work's and IWER's), read from this
     /// `node_modules` folder (`third_party/node_modules` after `make assets`).
@@ -90,13 +90,6 @@ pub struct Args {
     gestures: Option<std::path::PathBuf>,
 }
 
-pub fn parse_split(s: &str) -> Result<Split, String> {
-    match s {
-        "held-out" => Ok(Split::HeldOut),
-        "tune" => Ok(Split::Tune),
-        _ => Err(format!("{s:?}: expected held-out or tune")),
-    }
-}
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.sequences > 0, "--sequences must be at least 1");
@@ -163,31 +156,26 @@ impl SourceRun {
         let mut run = Self { source: &OUTSIDE, undriven: Vec::new(), scores: Vec::new(), push_us: Vec::new(), records: 0, loop_s: 0.0 };
         for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
             let s = crate::outside_poses::sequence(&poses, side, OUTSIDE_REPEATS, args.seed.wrapping_add(k as u64));
-            let mut gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, None, dqhand::input::InputConfig::default(), Some(gestures.clone()))?;
-            let mut events = Vec::new();
-            let start = Instant::now();
-            for record in &s.records {
-                run.records += 1;
-                let t0 = Instant::now();
-                let pushed = gesture_loop.push(record);
-                run.push_us.push(t0.elapsed().as_secs_f64() * 1e6);
-                if let Ok(new) = pushed {
-                    events.extend(new.map(LoggedEvent::from));
-                }
-            }
-            run.loop_s += start.elapsed().as_secs_f64();
+            let gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, None, dqhand::input::InputConfig::default(), Some(gestures.clone()))?;
+            let events = run.play(RecordingReader::Records(s.records.into(), 0), gesture_loop, side)?;
             run.scores.push(RecognitionScore::new(&s.labels, s.idle, &events));
         }
         Ok(run)
     }
 
     /// Replays the recording at `path` through a fresh gesture loop as `dqhand replay
-    /// --gestures` does, timing each push and the whole loop; returns the events.
+    /// --gestures` does ([`Self::play`]).
     fn replay(&mut self, path: &Path, input: &InputArgs, model: &Arc<Model>, gestures: &GestureSet) -> anyhow::Result<Vec<LoggedEvent>> {
-        let mut reader = RecordingReader::open(path, Some(self.source.format), input)?;
+        let reader = RecordingReader::open(path, Some(self.source.format), input)?;
         let mapper = input.mapper(JointModel::Full)?;
-        let mut gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, Some(mapper), input.config()?, Some(gestures.clone()))?;
-        let mut record = Record { time: 0.0, side: input.hand, hand: None, tracker: None, arrival: None };
+        let gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, Some(mapper), input.config()?, Some(gestures.clone()))?;
+        self.play(reader, gesture_loop, input.hand)
+    }
+
+    /// Plays `reader` through `gesture_loop` (records of hand `side` unless they say), timing
+    /// each push and the whole loop; returns the events.
+    fn play(&mut self, mut reader: RecordingReader, mut gesture_loop: GestureLoop, side: Side) -> anyhow::Result<Vec<LoggedEvent>> {
+        let mut record = Record { time: 0.0, side, hand: None, tracker: None, arrival: None };
         let mut events = Vec::new();
         let start = Instant::now();
         while let Some(read) = reader.next(&mut record)? {

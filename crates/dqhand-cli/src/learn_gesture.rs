@@ -12,17 +12,17 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use dqhand::engine::ModelSource;
-use dqhand::gesture::{train, Example, Feature, GestureSet, HandFeatures, TrainingParams};
+use dqhand::gesture::{train, Example, GestureSet, HandFeatures, TrainingParams};
 use dqhand::hand::HandParams;
 use dqhand::input::Record;
-use dqhand::interaction::gesture_examples::{examples, BUILTIN_CLASSES};
-use dqhand::interaction::synthetic::{generate, SyntheticFormat, SyntheticParams};
+use dqhand::interaction::gesture_examples::{shape_features, BUILTIN_CLASSES};
 use dqhand::interaction::variation::Split;
 use dqhand::interaction::GestureLoop;
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 
 use crate::recording::{Format, InputArgs, RecordingReader};
+use crate::train_gestures::varied_examples;
 
 /// Seconds cut from each end of a recording of the gesture: the hand moving into and out of it.
 const EDGE_S: f64 = 0.3;
@@ -74,22 +74,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         train_set.extend(fit.into_iter().map(|features| Example { features, class: 0 }));
         check_not.extend(check);
     }
-    let generated = |split: Split| -> anyhow::Result<Vec<Example>> {
-        let mut out = Vec::new();
-        for seed in 1..=GENERATED_SEQUENCES {
-            for format in [SyntheticFormat::Joints, SyntheticFormat::Landmarks] {
-                let sequence = generate(&SyntheticParams::varied(split, seed, format))?;
-                let mut hands = GestureLoop::new(model.clone(), JointModel::Full, None, args.common.config()?, None)?;
-                out.extend(examples(&mut hands, &sequence, &BUILTIN_CLASSES, 3));
-            }
-        }
-        Ok(out)
-    };
+    let config = args.common.config()?;
+    let generated = |split: Split| varied_examples(&model, &config, split, &BUILTIN_CLASSES, GENERATED_SEQUENCES, 3);
     let tune = generated(Split::Tune)?;
     let gesture_examples = train_set.iter().filter(|e| e.class == 1).count();
     train_set.extend(tune.iter().map(|e| Example { features: e.features, class: 0 }));
-    let inputs: Vec<Feature> = Feature::ALL.into_iter().filter(|f| !matches!(f, Feature::PalmUp | Feature::ThumbUp)).collect();
-    let classifier = train(vec!["other".into(), args.name.clone()], inputs, &train_set, &TrainingParams { hidden: 16, ..TrainingParams::default() })?;
+    let classifier = train(vec!["other".into(), args.name.clone()], shape_features(), &train_set, &TrainingParams { hidden: 16, ..TrainingParams::default() })?;
 
     // Separability: how often the held-back frames are taken for the new gesture.
     let (start, _) = classifier.thresholds();

@@ -53,7 +53,7 @@ pub struct Args {
     side: Option<Side>,
     /// Hands and shapes varied as people make gestures, from this split (`held-out` or
     /// `tune`; docs/gestures.md), instead of the library's shapes.
-    #[arg(long, value_parser = crate::gesture_bench::parse_split)]
+    #[arg(long)]
     variation: Option<dqhand::interaction::variation::Split>,
     /// A scripted manipulation recording of this scene (built-in `grasp`, `objects`, or a
     /// scene file) instead, made with the built-in hand (joints only).

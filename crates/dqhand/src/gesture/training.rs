@@ -141,14 +141,13 @@ pub fn train(classes: Vec<String>, inputs: Vec<Feature>, examples: &[Example], p
             }
             let rate = params.learning_rate * (1.0 - 0.9 * step as f32 / steps as f32);
             step += 1;
-            adam.step(&mut net, &grad, rate, params.weight_decay);
+            adam.step(&mut net, &mut grad, rate, params.weight_decay);
         }
     }
     Ok(Classifier { classes, inputs, mean, scale, hidden: net.hidden, output: net.output, start: params.start, hold: params.hold })
 }
 
 /// The two layers being trained (and, with the same shapes, their gradients and moments).
-#[derive(Clone)]
 struct Net {
     hidden: Layer,
     output: Layer,
@@ -187,10 +186,10 @@ impl Adam {
         Self { m: net.zeros(), v: net.zeros(), t: 0 }
     }
 
-    fn step(&mut self, net: &mut Net, grad: &Net, rate: f32, decay: f32) {
+    /// One step along `grad` (borrowed mutably only to walk it beside the parameters).
+    fn step(&mut self, net: &mut Net, grad: &mut Net, rate: f32, decay: f32) {
         self.t += 1;
         let (c1, c2) = (1.0 - Self::BETA1.powi(self.t), 1.0 - Self::BETA2.powi(self.t));
-        let mut grad = grad.clone();
         let params = net.values_mut();
         let (ms, vs, gs) = (self.m.values_mut(), self.v.values_mut(), grad.values_mut());
         for (k, (((p, m), v), g)) in params.into_iter().zip(ms).zip(vs).zip(gs).enumerate() {

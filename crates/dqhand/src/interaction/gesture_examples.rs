@@ -2,8 +2,7 @@
 //! the gesture loop sees them (after the input pipeline and retargeting, as it recognises),
 //! frame by frame through generated sequences, with the class of the hold each frame is in.
 
-use crate::gesture::Example;
-use crate::input::Record;
+use crate::gesture::{Example, Feature, FeatureKind};
 use crate::interaction::synthetic::Synthetic;
 use crate::interaction::GestureLoop;
 
@@ -18,6 +17,14 @@ pub fn class_of(gesture: &str) -> &str {
         "thumbs_up" | "thumbs_down" => "thumbs",
         other => other,
     }
+}
+
+/// The features a classifier of shapes reads: all but the two directions to world up (a
+/// shape is the same however the hand is turned; conditions on `thumb.up` tell thumbs up from
+/// down).
+#[must_use]
+pub fn shape_features() -> Vec<Feature> {
+    Feature::ALL.into_iter().filter(|f| f.kind() != FeatureKind::Direction).collect()
 }
 
 /// Seconds after a pose is reached before its frames are examples of it (the tremor of
@@ -35,7 +42,6 @@ pub fn examples(hands: &mut GestureLoop, sequence: &Synthetic, classes: &[&str],
     let mut move_start = 0.0;
     let mut label = 0;
     for (k, record) in sequence.records.iter().enumerate() {
-        let record: &Record = record;
         if hands.push(record).is_err() || k % every.max(1) != 0 {
             continue;
         }

@@ -14,8 +14,7 @@
 //! are told apart by what the definitions say (`docs/gestures.md`): a point is a point wherever
 //! its thumb is (tucked, or out to the side as the Quest poses others recorded hold it), so
 //! there is no built-in gun (learn one: `dqhand learn-gesture`); a three's little finger is
-//! curled, a four's thumb
-//! is folded across the palm (an open palm's is out or alongside the index). OK and pinch
+//! curled, a four's thumb is folded across the palm (an open palm's is out or alongside the index). OK and pinch
 //! both touch the thumb and index tips: in an OK the index curls round (a ring: MCP 40–55°,
 //! PIP 65–80°, DIP 30–45°) and the other three stand extended; in a pinch the index stays
 //! flatter (MCP 25–50°, PIP 25–50°, DIP 5–25°) and the others are extended or half curled, as
@@ -55,6 +54,15 @@ impl Split {
             Split::Tune => "tune",
             Split::HeldOut => "held-out",
         }
+    }
+}
+
+impl core::str::FromStr for Split {
+    type Err = String;
+
+    /// The split [`Split::name`] names.
+    fn from_str(s: &str) -> Result<Self, String> {
+        [Split::Tune, Split::HeldOut].into_iter().find(|split| split.name() == s).ok_or_else(|| format!("{s:?}: expected held-out or tune"))
     }
 }
 
