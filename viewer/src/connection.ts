@@ -3,7 +3,7 @@
 
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand,
-  type Command, type Frame, type Hello, type InputMessage, type RecordingMessage, type SceneMessage, type Topology,
+  type Command, type Frame, type Hello, type InputMessage, type LearningMessage, type RecordingMessage, type SceneMessage, type Topology,
 } from './protocol';
 
 export interface ConnectionEvents {
@@ -16,6 +16,8 @@ export interface ConnectionEvents {
   scene(message: SceneMessage): void;
   /** A recording of the live input started or ended (the answer to a `record` command). */
   recording(message: RecordingMessage): void;
+  /** How learning a gesture stands (the answer to a `learn` command). */
+  learning(message: LearningMessage): void;
   error(message: string): void;
   status(connected: boolean): void;
 }
@@ -60,6 +62,7 @@ export class Connection {
         else if (message.type === 'input') this.events.input(message);
         else if (message.type === 'scene') this.events.scene(message);
         else if (message.type === 'recording') this.events.recording(message);
+        else if (message.type === 'learning') this.events.learning(message);
         else this.events.error(message.message);
         return;
       }

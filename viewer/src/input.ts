@@ -2,7 +2,7 @@
 // tracking, the gesture recognised now, record counters and a log of gesture events and the
 // actions they triggered. `InputLog` holds no DOM, so the tests run it in Node.
 
-import type { HelloInput, InputMessage, Side, Tracking } from './protocol';
+import type { HelloInput, InputMessage, LearningMessage, Side, Tracking } from './protocol';
 
 /** Entries the event log keeps. */
 export const LOG_LENGTH = 30;
@@ -35,6 +35,33 @@ export class InputLog {
   }
 }
 
+const percent = (share: number) => `${(share * 100).toFixed(share > 0 && share < 0.1 ? 1 : 0)} %`;
+
+/** What the Input panel says of a gesture being learned (a `learning` message). */
+export function learningText(m: LearningMessage): string {
+  const name = m.name ?? '';
+  switch (m.state) {
+    case 'idle':
+      return '';
+    case 'recording':
+      return m.not ? `show what is not ${name}, for ${m.seconds} s…` : `hold ${name}, for ${m.seconds} s…`;
+    case 'training':
+      return `learning ${name}… (the first time takes about half a minute)`;
+    case 'noted':
+      return `kept as not ${name}; now hold ${name} and press Learn`;
+    case 'failed':
+      return m.error ?? `learning ${name} failed`;
+    case 'learned': {
+      const r = m.report;
+      if (!r) return `learned ${name}`;
+      const not = r.notRate === null ? '' : `, on ${percent(r.notRate)} of what is not it`;
+      const overlap = r.overlap.slice(0, 2).map((o) => `${o.gesture} ${percent(o.rate)}`).join(', ');
+      const saved = m.path ? `; saved to ${m.path}` : '';
+      return `learned ${name}: recognised on ${percent(r.recall)} of its frames held back${not}; other gestures taken for it: ${overlap}; ${r.verdict}${saved}`;
+    }
+  }
+}
+
 /** The page's Input panel (hidden unless the hello announces an input) and the stage's "tracking lost" banner. */
 export class InputPanel {
   /** The hello's input, or null when the demo has none. */
@@ -58,6 +85,14 @@ export class InputPanel {
     this.$('input-source').textContent = input?.source ?? '';
     this.$('input-gestures').textContent = input ? `recognises ${input.gestures.join(', ')}` : '';
     this.render();
+  }
+
+  /** Shows how learning a gesture stands; the Learn buttons wait while it records or trains. */
+  setLearning(message: LearningMessage): void {
+    const busy = message.state === 'recording' || message.state === 'training';
+    for (const id of ['learn-go', 'learn-not']) (this.$(id) as HTMLButtonElement).disabled = busy;
+    this.$('learn-status').textContent = learningText(message);
+    this.$('learn-status').className = message.state;
   }
 
   /** Shows the "holding" line when the hand manipulates a scene. */

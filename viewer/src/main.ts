@@ -4,7 +4,7 @@ import './style.css';
 import { Vector3 } from 'three';
 import { Connection } from './connection';
 import { InputPanel } from './input';
-import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type RecordingMessage } from './protocol';
+import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
 import { InputSender } from './sender';
 import { Webcam } from './webcam';
@@ -89,6 +89,10 @@ const connection = new Connection(`${wsOrigin}/stream`, {
       : message.path ? `saved ${message.records.toLocaleString()} records to ${message.path}${failed}` : '';
     recordings.push(message);
   },
+  learning(message) {
+    inputPanel.setLearning(message);
+    learnings.push(message);
+  },
   error(message) {
     errors.push(message);
     status(`engine: ${message}`, 'error');
@@ -107,6 +111,8 @@ const connection = new Connection(`${wsOrigin}/stream`, {
 let recording = false;
 /** The `recording` messages received, oldest first (for the tests). */
 const recordings: RecordingMessage[] = [];
+/** The `learning` messages received, oldest first (for the tests). */
+const learnings: LearningMessage[] = [];
 /** Shows the Record button for a recording on or off. */
 function showRecording(on: boolean): void {
   recording = on;
@@ -128,6 +134,14 @@ $('camera').addEventListener('click', () => {
 });
 $('insecure').hidden = window.isSecureContext;
 $('record').addEventListener('click', () => connection.send({ type: 'record', on: !recording }));
+/** Learn (or record what is not) the gesture named in the Input panel, from the live hand. */
+function learn(not: boolean): void {
+  const name = $<HTMLInputElement>('learn-name').value.trim();
+  if (!$<HTMLInputElement>('learn-name').reportValidity() || !name) return;
+  connection.send({ type: 'learn', name, not });
+}
+$('learn-go').addEventListener('click', () => learn(false));
+$('learn-not').addEventListener('click', () => learn(true));
 
 /** Whether the engine shows the tracked hand as our hand's mirror image (a hand of the other side). */
 let mirrored = false;
@@ -352,6 +366,8 @@ window.dqhand = {
     camera: { ...webcam.state, hands: [...webcam.state.hands] },
     /** The `recording` messages received, oldest first. */
     recordings: [...recordings],
+    /** The `learning` messages received, oldest first. */
+    learnings: [...learnings],
     frame: frame && {
       sequence: frame.header.sequence,
       methods: frame.header.methods,

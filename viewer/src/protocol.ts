@@ -201,7 +201,46 @@ export interface RecordingMessage {
   failed: boolean;
 }
 
-export type ServerText = Hello | InputMessage | SceneMessage | RecordingMessage | { type: 'error'; message: string };
+/** How learning a gesture stands (crates/dqhand-cli/src/live_learning.rs). */
+export const LEARNING_STATES = ['idle', 'recording', 'training', 'noted', 'learned', 'failed'] as const;
+export type LearningState = (typeof LEARNING_STATES)[number];
+
+/** How separable a learned gesture is: shares of frames held back that were taken for it. */
+export interface LearningReport {
+  /** Frames of the gesture trained on, and of what must not trigger it. */
+  frames: number;
+  notFrames: number;
+  /** Share of the gesture's own held-back frames taken for it, and how many were checked. */
+  recall: number;
+  checked: number;
+  /** Share of the held-back counter-example frames taken for it; null without any. */
+  notRate: number | null;
+  /** The built-in gestures most often taken for it, most first (share of their held-out frames). */
+  overlap: { gesture: string; rate: number }[];
+  /** The gesture the gestures recognised now show most on its frames (share of them); null: none. */
+  already: { gesture: string; rate: number } | null;
+  separable: boolean;
+  /** What to do about it, or that it stands apart, in words. */
+  verdict: string;
+}
+
+/**
+ * The viewers' gesture learning (a `learn` command), sent to every viewer when it changes:
+ * recording the hand, training, `noted` (counter-examples kept), `learned` (with the report
+ * and where the definitions were saved) or `failed` (with the error).
+ */
+export interface LearningMessage {
+  type: 'learning';
+  state: LearningState;
+  name: string | null;
+  not: boolean;
+  seconds: number | null;
+  report: LearningReport | null;
+  path: string | null;
+  error: string | null;
+}
+
+export type ServerText = Hello | InputMessage | SceneMessage | RecordingMessage | LearningMessage | { type: 'error'; message: string };
 
 /** Which binary message this is, from its magic; null if neither. */
 export function binaryKind(buffer: ArrayBuffer): 'frame' | 'topology' | null {
@@ -314,6 +353,7 @@ export function decodeText(text: string): ServerText {
   if (type === 'input') return checkInput(value as Record<string, unknown>);
   if (type === 'scene') return checkSceneMessage(value as Record<string, unknown>);
   if (type === 'recording') return checkRecording(value as Record<string, unknown>);
+  if (type === 'learning') return checkLearning(value as Record<string, unknown>);
   if (type !== 'error') throw new ProtocolError(`unknown text message type ${JSON.stringify(type)}`);
   return value as ServerText;
 }
@@ -444,6 +484,42 @@ function checkRecording(v: Record<string, unknown>): RecordingMessage {
   return { type: 'recording', on: v.on, path: v.path, records: v.records, failed };
 }
 
+/** Checks a learning message; the message names the first bad field. */
+function checkLearning(v: Record<string, unknown>): LearningMessage {
+  const bad = (field: string, value: unknown) => new ProtocolError(`learning message: ${field} ${show(value)}`);
+  const share = (x: unknown): x is number => isTime(x) && x >= 0 && x <= 1;
+  const nullOr = <T>(x: unknown, is: (x: unknown) => x is T): x is T | null => x === null || is(x);
+  if (!oneOf(LEARNING_STATES, v.state)) throw bad('state', v.state);
+  if (!nullOr(v.name, isName)) throw bad('name', v.name);
+  if (typeof v.not !== 'boolean') throw bad('not', v.not);
+  if (!nullOr(v.seconds, isSize)) throw bad('seconds', v.seconds);
+  if (!nullOr(v.path, isString)) throw bad('path', v.path);
+  if (!nullOr(v.error, isString)) throw bad('error', v.error);
+  let report: LearningReport | null = null;
+  if (v.report !== null) {
+    const r = v.report;
+    if (!isObject(r)) throw bad('report', r);
+    if (!isCount(r.frames)) throw bad('report.frames', r.frames);
+    if (!isCount(r.not_frames)) throw bad('report.not_frames', r.not_frames);
+    if (!isCount(r.checked)) throw bad('report.checked', r.checked);
+    // An empty check gives no share (NaN, sent as null).
+    const recall = r.recall ?? Number.NaN;
+    if (!(share(recall) || Number.isNaN(recall))) throw bad('report.recall', r.recall);
+    if (!nullOr(r.not_rate, share)) throw bad('report.not_rate', r.not_rate);
+    if (typeof r.separable !== 'boolean') throw bad('report.separable', r.separable);
+    if (!Array.isArray(r.overlap) || !r.overlap.every((o) => isObject(o) && isName(o.gesture) && share(o.rate))) throw bad('report.overlap', r.overlap);
+    const overlap = (r.overlap as { gesture: string; rate: number }[]).map(({ gesture, rate }) => ({ gesture, rate }));
+    const already = r.already ?? null;
+    if (!(already === null || (isObject(already) && isName(already.gesture) && share(already.rate)))) throw bad('report.already', r.already);
+    if (!isString(r.verdict)) throw bad('report.verdict', r.verdict);
+    report = {
+      frames: r.frames, notFrames: r.not_frames, recall: recall as number, checked: r.checked, notRate: r.not_rate, overlap,
+      already: already && { gesture: already.gesture as string, rate: already.rate as number }, separable: r.separable, verdict: r.verdict,
+    };
+  }
+  return { type: 'learning', state: v.state, name: v.name, not: v.not, seconds: v.seconds, report, path: v.path, error: v.error };
+}
+
 /** The commands the engine accepts (crates/dqhand-stream/src/command.rs). */
 export type Command =
   | { type: 'ack'; seq: number }
@@ -458,7 +534,8 @@ export type Command =
   | { type: 'heatmap'; on: boolean }
   | { type: 'limits'; on: boolean }
   | { type: 'rest' }
-  | { type: 'record'; on: boolean };
+  | { type: 'record'; on: boolean }
+  | { type: 'learn'; name: string; seconds?: number; not?: boolean };
 
 export function encodeCommand(command: Command): string {
   return JSON.stringify(command);

@@ -2,6 +2,8 @@
 // controls reach the engine and come back as the right change on screen, and it survives a
 // server restart; and, with a recorded live input, that the Input panel follows it.
 
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, onTestFinished, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
@@ -398,5 +400,77 @@ describe('the viewer page with a scene', () => {
     // Back on the scene: the table and the objects again.
     await settle(p, 3);
     await expect.poll(drawn, { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
+  });
+});
+
+describe('the Input panel learns a gesture from the live hand', () => {
+  let learnServer: Server | null = null;
+  let learnPage: Page | null = null;
+  let dir = '';
+
+  beforeAll(async () => {
+    // The live input holds one gesture of the library (the recording's "three", played back
+    // and forth, over and over): learned under a new name, the report must find it is a three.
+    dir = mkdtempSync(path.join(tmpdir(), 'dqhand-learn-'));
+    const labels = JSON.parse(readFileSync(RECORDING.replace(/\.jsonl$/, '.labels.json'), 'utf8')) as { holds: { gesture: string; reached: number; until: number }[] };
+    const hold = labels.holds.find((h) => h.gesture === 'three')!;
+    const records = readFileSync(RECORDING, 'utf8').split('\n').filter(Boolean).map((l) => JSON.parse(l) as { t: number });
+    const held = records.filter((r) => r.t > hold.reached + 0.1 && r.t < hold.until - 0.1);
+    const played = [...held, ...held.slice().reverse()];
+    const lines = Array.from({ length: 60 * 12 }, (_, k) => JSON.stringify({ ...played[k % played.length], t: k / 60 }));
+    const input = path.join(dir, 'three.jsonl');
+    writeFileSync(input, lines.join('\n') + '\n');
+    learnServer = await startServer({ args: ['--input', input, '--recordings', path.join(dir, 'recordings')] });
+    learnPage = await newPage(browser);
+    await learnPage.goto(learnServer.url);
+    await waitState(learnPage, 's.connected && s.input !== null && s.input.gesture === "three"', 60_000);
+  });
+
+  afterAll(async () => {
+    await learnPage?.close();
+    await learnServer?.stop();
+    if (dir) rmSync(dir, { recursive: true, force: true });
+  });
+
+  test('Not it keeps a counter-example; Learn records, trains, recognises the new gesture first, saves it and reports what it overlaps', async () => {
+    const p = learnPage!;
+    const learnings = () => p.evaluate(() => (window as unknown as { dqhand: { state(): { learnings: { state: string; name: string; report: { recall: number; overlap: { gesture: string; rate: number }[]; already: { gesture: string; rate: number } | null; separable: boolean } | null; path: string | null; error: string | null }[] } } }).dqhand.state().learnings);
+    // A name the engine refuses is answered with the reason.
+    await p.evaluate(() => (window as unknown as { dqhand: { send(c: object): void } }).dqhand.send({ type: 'learn', name: 'two words' }));
+    await waitState(p, 's.errors.some((e) => e.includes("is not a gesture name"))');
+
+    await p.fill('#learn-name', 'spare');
+    await p.click('#learn-not');
+    await waitState(p, 's.learnings.length > 0 && s.learnings.at(-1).state === "recording"');
+    expect(await p.locator('#learn-go').isDisabled()).toBe(true);
+    expect(await p.locator('#learn-status').textContent()).toBe('show what is not spare, for 4 s…');
+    await waitState(p, 's.learnings.at(-1).state === "noted"', 30_000);
+    expect(await p.locator('#learn-status').textContent()).toBe('kept as not spare; now hold spare and press Learn');
+
+    await p.fill('#learn-name', 'mine');
+    await p.click('#learn-go');
+    await waitState(p, 's.learnings.at(-1).state === "learned" || s.learnings.at(-1).state === "failed"', 110_000);
+    const last = (await learnings()).at(-1)!;
+    expect(last.error).toBeNull();
+    expect(last.state).toBe('learned');
+    expect(last.name).toBe('mine');
+    expect((await learnings()).map((m) => m.state)).toEqual(['recording', 'noted', 'recording', 'training', 'learned']);
+    // Its own held-back frames are taken for it, and the report finds what it is: a three
+    // (the gestures recognised now show three on its frames; of the varied held-out
+    // gestures, threes are the ones most often taken for it).
+    expect(last.report!.recall).toBeGreaterThanOrEqual(0.9);
+    expect(last.report!.overlap[0].gesture).toBe('three');
+    expect(last.report!.already!.gesture).toBe('three');
+    expect(last.report!.already!.rate).toBeGreaterThan(0.9);
+    expect(last.report!.separable).toBe(false);
+    expect(await p.locator('#learn-status').textContent()).toMatch(/^learned mine: .*other gestures taken for it: three \d.*NOT well separable: the gestures recognised now show it as three .*saved to /);
+    // Recognised from now on, first in the list, in the panel as in the engine.
+    await waitState(p, 's.input.gestures[0] === "mine" && s.input.gesture === "mine"', 20_000);
+    expect(await p.locator('#gesture-now').textContent()).toBe('mine');
+    // Saved where the demo's recordings go, the new gesture first (`demo --gestures-file` takes it).
+    const saved = JSON.parse(readFileSync(last.path!, 'utf8')) as { gestures: { name: string }[] };
+    expect(path.dirname(last.path!)).toBe(path.join(dir, 'recordings'));
+    expect(saved.gestures[0].name).toBe('mine');
+    expect(saved.gestures.map((g) => g.name)).toContain('three');
   });
 });

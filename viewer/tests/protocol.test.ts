@@ -3,10 +3,10 @@
 
 import { readFileSync } from 'node:fs';
 import { describe, expect, test } from 'vitest';
-import { InputLog, LOG_LENGTH } from '../src/input';
+import { InputLog, learningText, LOG_LENGTH } from '../src/input';
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, type Hello, type InputMessage, MAX_SCENE_CONTACTS,
-  MAX_SCENE_TRIANGLES, ProtocolError, type SceneMessage,
+  MAX_SCENE_TRIANGLES, type LearningMessage, ProtocolError, type SceneMessage,
 } from '../src/protocol';
 
 const fixture = (name: string): ArrayBuffer => {
@@ -118,6 +118,34 @@ describe('live input', () => {
       expect(() => decodeText(JSON.stringify({ ...recording, ...edit }))).toThrow(message);
     }
     expect(JSON.parse(encodeCommand({ type: 'record', on: true }))).toEqual({ type: 'record', on: true });
+  });
+
+  test('a learning message is parsed with its report, a malformed one refused naming the field, and the panel words it', () => {
+    // As crates/dqhand-cli/src/live_learning.rs writes it.
+    const wire = {
+      type: 'learning', state: 'learned', name: 'gun', not: false, seconds: 4, path: 'recordings/gestures-learned.json', error: null,
+      report: { frames: 160, not_frames: 0, recall: 0.98, checked: 70, not_rate: null, overlap: [{ gesture: 'point', rate: 0.012 }, { gesture: 'none', rate: 0 }],
+        already: null, separable: true, verdict: 'separable from the others' },
+    };
+    const parsed = decodeText(JSON.stringify(wire)) as LearningMessage;
+    expect(parsed.report).toEqual({ frames: 160, notFrames: 0, recall: 0.98, checked: 70, notRate: null, overlap: wire.report.overlap, already: null, separable: true, verdict: 'separable from the others' });
+    expect(learningText(parsed)).toBe('learned gun: recognised on 98 % of its frames held back; other gestures taken for it: point 1.2 %, none 0 %; separable from the others; saved to recordings/gestures-learned.json');
+    const recording = { type: 'learning', state: 'recording', name: 'gun', not: true, seconds: 4, report: null, path: null, error: null };
+    expect(learningText(decodeText(JSON.stringify(recording)) as LearningMessage)).toBe('show what is not gun, for 4 s…');
+    const idle = { ...recording, state: 'idle', name: null, not: false, seconds: null };
+    expect(learningText(decodeText(JSON.stringify(idle)) as LearningMessage)).toBe('');
+    const cases: [object, RegExp][] = [
+      [{ state: 'thinking' }, /state "thinking"/],
+      [{ name: 7 }, /name 7/],
+      [{ seconds: -1 }, /seconds -1/],
+      [{ report: { ...wire.report, recall: 1.5 } }, /report.recall 1.5/],
+      [{ report: { ...wire.report, overlap: [{ gesture: 'point' }] } }, /report.overlap/],
+      [{ report: { ...wire.report, separable: 'yes' } }, /report.separable "yes"/],
+      [{ report: { ...wire.report, already: { gesture: 'point', rate: 2 } } }, /report.already/],
+      [{ report: { ...wire.report, verdict: undefined } }, /report.verdict undefined/],
+    ];
+    for (const [edit, message] of cases) expect(() => decodeText(JSON.stringify({ ...wire, ...edit }))).toThrow(message);
+    expect(JSON.parse(encodeCommand({ type: 'learn', name: 'gun', not: true }))).toEqual({ type: 'learn', name: 'gun', not: true });
   });
 
   test('a malformed input message is refused, naming the field', () => {

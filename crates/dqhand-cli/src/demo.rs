@@ -22,6 +22,7 @@ use dqhand_stream::LiveInput;
 
 use crate::feed::Feed;
 use crate::live::LiveRecords;
+use crate::live_learning::LiveLearning;
 use crate::recording::{gesture_set, Format, InputArgs, RecordingReader};
 use crate::server;
 
@@ -188,7 +189,8 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
             LiveInput::with_scene(manip, source.clone(), announce).with_context(|| name.to_owned())?
         }
     };
-    let feed = Arc::new(Feed { input, records, clients: AtomicUsize::new(0) });
+    let learning = LiveLearning::new(Arc::clone(model), args.common.config()?, Some(args.recordings.clone()));
+    let feed = Arc::new(Feed { input, records, learning, clients: AtomicUsize::new(0) });
     let reporter = Arc::clone(&feed);
     std::thread::spawn(move || reporter.report());
     let played_now = played.is_some();

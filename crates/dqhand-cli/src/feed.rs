@@ -10,12 +10,15 @@ use dqhand::input::{Record, Rejection};
 use dqhand_stream::LiveInput;
 
 use crate::live::{LiveRecords, MAX_DATAGRAM_BYTES};
+use crate::live_learning::LiveLearning;
 use crate::recording::RecordingReader;
 
 /// The demo's live input and how bytes reach it.
 pub struct Feed {
     pub input: LiveInput,
     pub records: LiveRecords,
+    /// Gestures learned from the viewers' Input panel.
+    pub learning: LiveLearning,
     /// `/input` connections open now (each holds a thread; see [`MAX_INPUT_CLIENTS`]).
     pub clients: AtomicUsize,
 }

@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use dqhand::engine::ModelSource;
-use dqhand::gesture::{train, Example, GestureSet, HandFeatures, TrainingParams};
+use dqhand::gesture::{train, Classifier, Example, GestureSet, HandFeatures, Recognizer, TrainingParams};
 use dqhand::hand::HandParams;
-use dqhand::input::Record;
+use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::gesture_examples::{shape_features, BUILTIN_CLASSES};
 use dqhand::interaction::variation::Split;
 use dqhand::interaction::GestureLoop;
@@ -25,9 +25,12 @@ use crate::recording::{Format, InputArgs, RecordingReader};
 use crate::train_gestures::varied_examples;
 
 /// Seconds cut from each end of a recording of the gesture: the hand moving into and out of it.
-const EDGE_S: f64 = 0.3;
+pub const EDGE_S: f64 = 0.3;
 /// Share of each recording held back to measure the result.
 const CHECK_SHARE: f64 = 0.3;
+/// Above this share of its frames shown as a gesture of the set in use, a gesture learned
+/// duplicates that one.
+const ALREADY_SHOWN: f64 = 0.5;
 /// Generated sequences per source (joints, landmarks) as the gesture's counter-examples.
 const GENERATED_SEQUENCES: u64 = 12;
 
@@ -63,64 +66,174 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => GestureSet::builtin(),
     };
     let model = Arc::new(ModelSource::Builtin(HandParams::default()).load()?);
-    let (mut train_set, mut check_gesture, mut check_not) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut gesture, mut not) = (Frames::default(), Frames::default());
     for path in &args.input {
-        let (fit, check) = split(recorded(path, args, &model)?, EDGE_S, path)?;
-        train_set.extend(fit.into_iter().map(|features| Example { features, class: 1 }));
-        check_gesture.extend(check);
+        gesture.add(recorded(path, args, &model)?, EDGE_S, &set).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     }
     for path in &args.not {
-        let (fit, check) = split(recorded(path, args, &model)?, 0.0, path)?;
-        train_set.extend(fit.into_iter().map(|features| Example { features, class: 0 }));
-        check_not.extend(check);
+        not.add(recorded(path, args, &model)?, 0.0, &set).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     }
-    let config = args.common.config()?;
-    let generated = |split: Split| varied_examples(&model, &config, split, &BUILTIN_CLASSES, GENERATED_SEQUENCES, 3);
-    let tune = generated(Split::Tune)?;
-    let gesture_examples = train_set.iter().filter(|e| e.class == 1).count();
-    train_set.extend(tune.iter().map(|e| Example { features: e.features, class: 0 }));
-    let classifier = train(vec!["other".into(), args.name.clone()], shape_features(), &train_set, &TrainingParams { hidden: 16, ..TrainingParams::default() })?;
-
-    // Separability: how often the held-back frames are taken for the new gesture.
-    let (start, _) = classifier.thresholds();
-    let mut scratch = classifier.scratch();
-    let mut taken = |features: &[HandFeatures]| -> f64 {
-        let n = features.iter().filter(|f| classifier.classify(f, &mut scratch)[1] > start).count();
-        if features.is_empty() { f64::NAN } else { n as f64 / features.len() as f64 }
-    };
-    let recall = taken(&check_gesture);
-    let not_rate = taken(&check_not);
-    let held_out = generated(Split::HeldOut)?;
-    let mut by_class: BTreeMap<&str, Vec<HandFeatures>> = BTreeMap::new();
-    for e in &held_out {
-        by_class.entry(BUILTIN_CLASSES[e.class]).or_default().push(e.features);
-    }
-    let mut overlap: Vec<(f64, &str)> = by_class.iter().map(|(c, f)| (taken(f), *c)).collect();
-    overlap.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let generated = Generated::new(&model, &args.common.config()?)?;
+    let (classifier, report) = learn(&args.name, &gesture, &not, &generated)?;
     set.insert_learned(&args.name, classifier)?;
     std::fs::write(&args.out, set.to_json() + "\n").map_err(|e| anyhow::anyhow!("{}: {e}", args.out.display()))?;
-
-    println!(
-        "learn-gesture: {:?} from {} frames of {} recording(s), {} of --not, {} generated frames of the built-in gestures and idle motion (tuning split)",
-        args.name,
-        gesture_examples,
-        args.input.len(),
-        train_set.len() - gesture_examples - tune.len(),
-        tune.len()
-    );
-    println!("recognised on {:.1} % of the {} frames held back (the last {:.0} % of each recording)", recall * 100.0, check_gesture.len(), CHECK_SHARE * 100.0);
-    if !check_not.is_empty() {
-        println!("taken for it on {:.1} % of the {} --not frames held back", not_rate * 100.0, check_not.len());
-    }
-    let shown: Vec<String> = overlap.iter().take(4).map(|(r, c)| format!("{c} {:.1} %", r * 100.0)).collect();
-    println!("taken for it on the built-in gestures' held-out frames (most first): {}", shown.join(", "));
-    let separable = recall >= 0.9 && (not_rate.is_nan() || not_rate <= 0.05) && overlap.first().is_none_or(|(r, _)| *r <= 0.05);
-    println!(
-        "{}; written first in {} (it wins where a built-in gesture also matches)",
-        if separable { "separable from the others" } else { "NOT well separable: record it longer, hold it steadier, or add what it is confused with to --not" },
-        args.out.display()
-    );
+    println!("learn-gesture: {:?} from {} recording(s); {report}", args.name, args.input.len());
+    println!("{}; written first in {} (it wins where a built-in gesture also matches)", report.verdict(), args.out.display());
     Ok(())
+}
+
+/// Frames of the hand to learn from: the first 70 % of each recording to train on, the rest
+/// held back to check; and what the gestures recognised now show over them.
+#[derive(Default)]
+pub struct Frames {
+    fit: Vec<HandFeatures>,
+    check: Vec<HandFeatures>,
+    /// Frames each gesture of the set in use was shown on (a gesture learned again is
+    /// already there; so is a shape a built-in gesture covers).
+    shown: BTreeMap<String, usize>,
+}
+
+impl Frames {
+    /// Adds one recording's frames (times and features): `edge_s` cut from both ends (the
+    /// hand moving into and out of the gesture), then split by time; `set` recognises them
+    /// as the live input would.
+    ///
+    /// # Errors
+    /// Less than a second left after the cut.
+    pub fn add(&mut self, frames: Vec<(f64, HandFeatures)>, edge_s: f64, set: &GestureSet) -> anyhow::Result<()> {
+        let (Some(first), Some(last)) = (frames.first().map(|f| f.0), frames.last().map(|f| f.0)) else {
+            anyhow::bail!("no record was accepted");
+        };
+        let (from, to) = (first + edge_s, last - edge_s);
+        anyhow::ensure!(to - from >= 1.0, "{:.1} s of records; record at least {:.1} s", last - first, 1.0 + 2.0 * edge_s);
+        let cut = from + (to - from) * (1.0 - CHECK_SHARE);
+        let mut recognizer = Recognizer::new(set.clone());
+        for &(t, f) in &frames {
+            recognizer.update(t, &f);
+            if let Some(g) = recognizer.current().filter(|_| t >= from && t <= to) {
+                *self.shown.entry(g.to_owned()).or_default() += 1;
+            }
+        }
+        for (t, f) in frames.into_iter().filter(|(t, _)| *t >= from && *t <= to) {
+            if t < cut { &mut self.fit } else { &mut self.check }.push(f);
+        }
+        Ok(())
+    }
+}
+
+/// The generated counter-examples: the built-in gestures and idle motion on varied hands,
+/// the tuning split to train on and the held-out split to report overlaps. The same for
+/// every gesture learned: a server makes them once.
+pub struct Generated {
+    tune: Vec<Example>,
+    held_out: BTreeMap<&'static str, Vec<HandFeatures>>,
+}
+
+impl Generated {
+    /// Generates them for `model` seen through `config`, on the cores.
+    ///
+    /// # Errors
+    /// As [`varied_examples`].
+    pub fn new(model: &Arc<Model>, config: &InputConfig) -> anyhow::Result<Self> {
+        let generated = |split: Split| varied_examples(model, config, split, &BUILTIN_CLASSES, GENERATED_SEQUENCES, 3);
+        let tune = generated(Split::Tune)?;
+        let mut held_out: BTreeMap<&str, Vec<HandFeatures>> = BTreeMap::new();
+        for e in generated(Split::HeldOut)? {
+            held_out.entry(BUILTIN_CLASSES[e.class]).or_default().push(e.features);
+        }
+        Ok(Self { tune, held_out })
+    }
+}
+
+/// What learning a gesture measured: how separable it is.
+pub struct Report {
+    /// Frames trained on: of the gesture, of `--not`, generated.
+    trained: (usize, usize, usize),
+    /// Share of the gesture's held-back frames taken for it, and their count.
+    recall: (f64, usize),
+    /// Share of the held-back `--not` frames taken for it, and their count.
+    not_rate: (f64, usize),
+    /// Share of each built-in gesture's held-out frames taken for it, most first.
+    overlap: Vec<(f64, &'static str)>,
+    /// The gesture the set in use shows most on its frames, and on what share of them.
+    already: Option<(f64, String)>,
+}
+
+impl Report {
+    /// Whether it stands apart: ≥ 90 % of its own frames, ≤ 5 % of any other's, and not a
+    /// gesture the set in use already shows on most of its frames.
+    pub fn separable(&self) -> bool {
+        self.recall.0 >= 0.9
+            && (self.not_rate.1 == 0 || self.not_rate.0 <= 0.05)
+            && self.overlap.first().is_none_or(|(r, _)| *r <= 0.05)
+            && self.already.as_ref().is_none_or(|(r, _)| *r <= ALREADY_SHOWN)
+    }
+
+    /// What to do about it, or that it stands apart.
+    pub fn verdict(&self) -> String {
+        match &self.already {
+            Some((r, g)) if *r > ALREADY_SHOWN => format!("NOT well separable: the gestures recognised now show it as {g} ({:.0} % of its frames); learned first, it will be shown instead of {g}", r * 100.0),
+            _ if self.separable() => "separable from the others".into(),
+            _ => "NOT well separable: record it longer, hold it steadier, or record what it is confused with as what it is not".into(),
+        }
+    }
+
+    /// The report as a viewer's `learning` message shows it.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "frames": self.trained.0,
+            "not_frames": self.trained.1,
+            "recall": self.recall.0,
+            "checked": self.recall.1,
+            "not_rate": (self.not_rate.1 > 0).then_some(self.not_rate.0),
+            "overlap": self.overlap.iter().take(4).map(|(r, c)| serde_json::json!({ "gesture": c, "rate": r })).collect::<Vec<_>>(),
+            "already": self.already.as_ref().map(|(r, g)| serde_json::json!({ "gesture": g, "rate": r })),
+            "verdict": self.verdict(),
+            "separable": self.separable(),
+        })
+    }
+}
+
+impl std::fmt::Display for Report {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (gesture, not, generated) = self.trained;
+        writeln!(f, "{gesture} frames of the gesture, {not} of --not, {generated} generated frames of the built-in gestures and idle motion (tuning split)")?;
+        writeln!(f, "recognised on {:.1} % of the {} frames held back (the last {:.0} % of each recording)", self.recall.0 * 100.0, self.recall.1, CHECK_SHARE * 100.0)?;
+        if self.not_rate.1 > 0 {
+            writeln!(f, "taken for it on {:.1} % of the {} --not frames held back", self.not_rate.0 * 100.0, self.not_rate.1)?;
+        }
+        let shown: Vec<String> = self.overlap.iter().take(4).map(|(r, c)| format!("{c} {:.1} %", r * 100.0)).collect();
+        writeln!(f, "taken for it on the built-in gestures' held-out frames (most first): {}", shown.join(", "))?;
+        match &self.already {
+            Some((r, g)) => write!(f, "the gestures recognised now show {g} on {:.1} % of its frames", r * 100.0),
+            None => write!(f, "the gestures recognised now show none of theirs on its frames"),
+        }
+    }
+}
+
+/// Trains `name` against everything else (the `not` frames and the generated ones) and
+/// measures it on the frames held back.
+///
+/// # Errors
+/// As [`train`]: no frame of the gesture.
+pub fn learn(name: &str, gesture: &Frames, not: &Frames, generated: &Generated) -> anyhow::Result<(Classifier, Report)> {
+    let example = |class| move |f: &HandFeatures| Example { features: *f, class };
+    let mut examples: Vec<Example> = gesture.fit.iter().map(example(1)).chain(not.fit.iter().map(example(0))).collect();
+    examples.extend(generated.tune.iter().map(|e| Example { features: e.features, class: 0 }));
+    let classifier = train(vec!["other".into(), name.to_owned()], shape_features(), &examples, &TrainingParams { hidden: 16, ..TrainingParams::default() })?;
+    let (start, _) = classifier.thresholds();
+    let mut scratch = classifier.scratch();
+    let mut taken = |features: &[HandFeatures]| -> (f64, usize) {
+        let n = features.iter().filter(|f| classifier.classify(f, &mut scratch)[1] > start).count();
+        (if features.is_empty() { f64::NAN } else { n as f64 / features.len() as f64 }, features.len())
+    };
+    let (recall, not_rate) = (taken(&gesture.check), taken(&not.check));
+    let mut overlap: Vec<(f64, &str)> = generated.held_out.iter().map(|(c, f)| (taken(f).0, *c)).collect();
+    overlap.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let frames = (gesture.fit.len() + gesture.check.len()).max(1) as f64;
+    let already = gesture.shown.iter().max_by_key(|(_, n)| **n).map(|(g, n)| (*n as f64 / frames, g.clone()));
+    let report = Report { trained: (gesture.fit.len(), not.fit.len(), generated.tune.len()), recall, not_rate, overlap, already };
+    Ok((classifier, report))
 }
 
 /// The features of every accepted record of `path`, with their times.
@@ -136,18 +249,4 @@ fn recorded(path: &Path, args: &Args, model: &Arc<Model>) -> anyhow::Result<Vec<
         }
     }
     Ok(out)
-}
-
-/// Cuts `edge_s` from both ends, then splits by time: the first 70 % to train on, the rest
-/// to check.
-fn split(frames: Vec<(f64, HandFeatures)>, edge_s: f64, path: &Path) -> anyhow::Result<(Vec<HandFeatures>, Vec<HandFeatures>)> {
-    let (Some(first), Some(last)) = (frames.first().map(|f| f.0), frames.last().map(|f| f.0)) else {
-        anyhow::bail!("{}: no record was accepted", path.display());
-    };
-    let (from, to) = (first + edge_s, last - edge_s);
-    anyhow::ensure!(to - from >= 1.0, "{}: {:.1} s of records; record at least {:.1} s", path.display(), last - first, 1.0 + 2.0 * edge_s);
-    let cut = from + (to - from) * (1.0 - CHECK_SHARE);
-    let inside = frames.into_iter().filter(|(t, _)| *t >= from && *t <= to);
-    let (fit, check): (Vec<_>, Vec<_>) = inside.partition(|(t, _)| *t < cut);
-    Ok((fit.into_iter().map(|f| f.1).collect(), check.into_iter().map(|f| f.1).collect()))
 }

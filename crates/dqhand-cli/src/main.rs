@@ -16,6 +16,7 @@ mod info;
 mod learn_gesture;
 mod listen;
 mod live;
+mod live_learning;
 mod loadtest;
 mod metrics;
 mod outside_poses;

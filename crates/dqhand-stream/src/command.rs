@@ -77,6 +77,53 @@ pub enum Command {
         /// Start (a new file) or stop.
         on: bool,
     },
+    /// Learn a new gesture from the live input: record the hand for `seconds` (4 when
+    /// absent, 2 to 10), then train it against the recognised gestures and recognise it from
+    /// then on; with `not`, what is recorded is a pose that must not trigger `name` (kept
+    /// for its learning). The transport owns the job ([`super::Applied::Learn`]).
+    Learn {
+        /// The new gesture's name: 1 to 32 letters, digits, `_` or `-`.
+        name: String,
+        /// Seconds to record.
+        #[serde(default)]
+        seconds: Option<f32>,
+        /// Record a counter-example instead.
+        #[serde(default)]
+        not: bool,
+    },
+}
+
+/// A checked [`Command::Learn`], for the transport.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LearnRequest {
+    /// The gesture's name.
+    pub name: String,
+    /// Seconds to record, 2 to 10.
+    pub seconds: f32,
+    /// A counter-example.
+    pub not: bool,
+}
+
+impl LearnRequest {
+    /// Seconds recorded when the command gives none.
+    pub const SECONDS: f32 = 4.0;
+    /// Longest name.
+    const MAX_NAME: usize = 32;
+
+    /// Checks a learn command's fields.
+    ///
+    /// # Errors
+    /// A name that is empty, too long or not of letters, digits, `_` and `-`; seconds outside 2 to 10.
+    pub fn new(name: &str, seconds: Option<f32>, not: bool) -> Result<Self, String> {
+        if name.is_empty() || name.len() > Self::MAX_NAME || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err(format!("learn: {name:?} is not a gesture name (1 to {} letters, digits, _ or -)", Self::MAX_NAME));
+        }
+        let seconds = seconds.unwrap_or(Self::SECONDS);
+        if !(2.0..=10.0).contains(&seconds) {
+            return Err(format!("learn: {seconds} seconds (2 to 10)"));
+        }
+        Ok(Self { name: name.to_owned(), seconds, not })
+    }
 }
 
 impl Command {

@@ -34,13 +34,13 @@ use serde_json::{json, Value};
 
 use crate::frame::{check_scene, scene_hello, scene_message};
 use crate::{Action, Session, ViewerAction};
-use dqhand::gesture::{Event, EventKind, Events};
+use dqhand::gesture::{Event, EventKind, Events, GestureSet, HandFeatures};
 use dqhand::hand::Side;
 use dqhand::input::{Record, Rejection, Tracking};
 use dqhand::interaction::{CommandTable, GestureLoop, ManipulationLoop};
 use dqhand::kinematics::{JointModel, Pose};
 use dqhand::scene::SceneCommand;
-use crate::Result;
+use crate::{Error, Result};
 
 /// Log entries kept for viewers that have not read them yet; a viewer further behind misses
 /// the oldest (its pose and state are still current).
@@ -56,7 +56,6 @@ pub const SCENE_PERIOD: f64 = 1.0 / 30.0;
 pub struct LiveInput {
     source: String,
     announce: bool,
-    gestures: Vec<String>,
     joint_model: JointModel,
     /// The hello's `scene` (built once: a mesh's triangles are many).
     scene: Option<Value>,
@@ -73,7 +72,23 @@ struct State {
     log: VecDeque<Entry>,
     /// Entries ever logged: the sequence number of the next one.
     logged: u64,
+    /// The names of the gestures recognised, in the set's order.
+    gestures: Vec<String>,
+    /// Changes of the gestures recognised so far: a viewer told of fewer is sent a hello.
+    gesture_changes: u64,
+    /// The hand's features being recorded for learning a gesture ([`LiveInput::capture`]).
+    capture: Option<Capture>,
 }
+
+/// The virtual hand's features over a stretch of live input, with their record times.
+struct Capture {
+    /// The input's clock when the recording ends.
+    until: f64,
+    frames: Vec<(f64, HandFeatures)>,
+}
+
+/// Records kept per second of a capture, at most (a faster source's excess is not kept).
+const CAPTURE_RATE: f64 = 240.0;
 
 /// What the records drive.
 enum Driver {
@@ -127,6 +142,14 @@ impl Driver {
         }
     }
 
+    fn set_gestures(&mut self, set: GestureSet) -> Result<()> {
+        match self {
+            Driver::Gestures(g) => g.set_gestures(set),
+            Driver::Scene(s) => s.manip.set_gestures(set)?,
+        }
+        Ok(())
+    }
+
     /// The pose viewers show: the tracked one, or with a scene the rendered one.
     fn pose(&self) -> &Pose {
         match self {
@@ -147,6 +170,8 @@ enum Entry {
 #[derive(Debug)]
 pub struct InputView {
     announced: bool,
+    /// The input's gesture changes this viewer's hello knows of.
+    gesture_changes: u64,
     /// The input's accepted-record count when the viewer last took its pose.
     version: u64,
     /// The next log entry to read.
@@ -205,14 +230,64 @@ impl LiveInput {
 
     fn driving(driver: Driver, scene: Option<Value>, source: String, announce: bool) -> Result<Self> {
         let gesture_loop = driver.gestures();
-        let gestures = gesture_loop.gestures().map_or_else(Vec::new, |set| set.gestures().iter().map(|g| g.name().to_owned()).collect());
+        let gestures = gesture_loop.gestures().map_or_else(Vec::new, names);
         let actions = match gesture_loop.gestures() {
             Some(set) => Some(CommandTable::new(&ViewerAction::resolve(&gesture_loop.pipeline().config().actions)?, set)?),
             None => None,
         };
         let joint_model = gesture_loop.pipeline().retargeter().rig().model();
-        let state = State { driver, actions, posed: 0, log: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
-        Ok(Self { source, announce, gestures, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
+        let log = VecDeque::with_capacity(LOG_CAPACITY);
+        let state = State { driver, actions, posed: 0, log, logged: 0, gestures, gesture_changes: 0, capture: None };
+        Ok(Self { source, announce, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
+    }
+
+    /// The gestures recognised now (`None`: recognition is off).
+    #[must_use]
+    pub fn gesture_set(&self) -> Option<GestureSet> {
+        self.lock().driver.gestures().gestures().cloned()
+    }
+
+    /// Recognises `set` from now on (a gesture learned live): the viewers' actions and a
+    /// scene's are bound to its gestures by name, and every viewer is sent a new hello (its
+    /// Input panel lists the gestures). Log entries not yet read by a viewer are dropped:
+    /// they name gestures by their place in the old set.
+    ///
+    /// # Errors
+    /// An action of the viewers or the scene naming a gesture `set` lacks; nothing changes then.
+    pub fn set_gestures(&self, set: GestureSet) -> Result<()> {
+        let mut state = self.lock();
+        let actions = state.actions.as_ref().map(|t| t.rebind(&set)).transpose()?;
+        let gestures = names(&set);
+        state.driver.set_gestures(set)?;
+        state.actions = actions;
+        state.gestures = gestures;
+        state.gesture_changes += 1;
+        state.log.clear();
+        Ok(())
+    }
+
+    /// Starts recording the virtual hand's features for `seconds` from now, for learning a
+    /// gesture; [`Self::captured`] hands them over once the time is up.
+    ///
+    /// # Errors
+    /// A recording already going on.
+    pub fn capture(&self, seconds: f64) -> Result<()> {
+        let mut state = self.lock();
+        if state.capture.is_some() {
+            return Err(Error::Command("learn: the hand is already being recorded for learning".into()));
+        }
+        let until = self.clock() + seconds;
+        state.capture = Some(Capture { until, frames: Vec::with_capacity((seconds * CAPTURE_RATE) as usize) });
+        Ok(())
+    }
+
+    /// The features recorded since [`Self::capture`], with their record times, once its time
+    /// is up (`None` before then, or with no recording).
+    #[must_use]
+    pub fn captured(&self) -> Option<Vec<(f64, HandFeatures)>> {
+        let mut state = self.lock();
+        let done = state.capture.as_ref().is_some_and(|c| self.clock() >= c.until);
+        done.then(|| state.capture.take().map(|c| c.frames)).flatten()
     }
 
     /// Seconds since the input was made: the arrival clock of its records.
@@ -230,7 +305,7 @@ impl LiveInput {
     /// to show.
     #[must_use]
     pub fn describe(&self) -> Option<Value> {
-        self.active().then(|| json!({ "source": self.source, "gestures": self.gestures }))
+        self.active().then(|| json!({ "source": self.source, "gestures": self.lock().gestures }))
     }
 
     /// The hello's `scene`: the table and the objects' shapes; `None` without a scene.
@@ -259,7 +334,7 @@ impl LiveInput {
         // Read under the lock, so that the records taken have increasing arrival times.
         let arrival = self.clock();
         let record = &Record { arrival: Some(arrival), ..*record };
-        let State { driver, actions, posed, log, logged } = &mut *guard;
+        let State { driver, actions, posed, log, logged, capture, .. } = &mut *guard;
         let mut add = |entry| {
             if log.len() == LOG_CAPACITY {
                 log.pop_front();
@@ -274,6 +349,9 @@ impl LiveInput {
         let action = actions.as_mut().and_then(|table| table.update(record.time, events));
         taken(record);
         *posed += 1;
+        if let Some(c) = capture.as_mut().filter(|c| arrival <= c.until && c.frames.len() < c.frames.capacity()) {
+            c.frames.push((record.time, driver.gestures().features()));
+        }
         if let (Some(action), Some(gesture)) = (action, driver.gestures().gesture_index()) {
             add(Entry::Action { t: record.time, gesture, action });
         }
@@ -313,7 +391,9 @@ impl LiveInput {
     /// A viewer's view of the input, from now on (earlier events are not replayed to it).
     #[must_use]
     pub fn view(&self) -> InputView {
-        InputView { announced: self.active(), version: 0, next: self.lock().logged, sent: None, scene: None }
+        let announced = self.active();
+        let state = self.lock();
+        InputView { announced, gesture_changes: state.gesture_changes, version: 0, next: state.logged, sent: None, scene: None }
     }
 
     /// Brings one viewer up to date, once per frame: marks the hand lost after the grace
@@ -346,6 +426,10 @@ impl LiveInput {
             view.announced = true;
             update.hello = true;
         }
+        if view.gesture_changes != state.gesture_changes {
+            view.gesture_changes = state.gesture_changes;
+            update.hello = true;
+        }
         if state.posed != view.version {
             session.follow(state.driver.pose(), self.joint_model);
             view.version = state.posed;
@@ -355,12 +439,12 @@ impl LiveInput {
         let (mut events, mut actions) = (Vec::new(), Vec::new());
         for entry in new {
             match *entry {
-                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &self.gestures[gesture], index: gesture })),
+                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &state.gestures[gesture], index: gesture })),
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
-                    actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": action }));
+                    actions.push(json!({ "t": t, "gesture": state.gestures[gesture], "action": action }));
                 }
-                Entry::Scene { t, gesture, command } => actions.push(json!({ "t": t, "gesture": self.gestures[gesture], "action": command })),
+                Entry::Scene { t, gesture, command } => actions.push(json!({ "t": t, "gesture": state.gestures[gesture], "action": command })),
             }
         }
         view.next = state.logged;
@@ -380,7 +464,7 @@ impl LiveInput {
                 json!({
                     "type": "input",
                     "tracking": sent.tracking.as_str(),
-                    "gesture": gesture.map(|g| &self.gestures[g]),
+                    "gesture": gesture.map(|g| &state.gestures[g]),
                     "side": sent.side.map(Side::name),
                     "mirrored": sent.side.is_some_and(|s| s != pipeline.retargeter().side()),
                     "events": events,
@@ -407,4 +491,9 @@ impl LiveInput {
         }
         update
     }
+}
+
+/// The names of `set`'s gestures, in its order.
+fn names(set: &GestureSet) -> Vec<String> {
+    set.gestures().iter().map(|g| g.name().to_owned()).collect()
 }

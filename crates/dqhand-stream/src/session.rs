@@ -11,7 +11,7 @@ use glam::{EulerRot, Quat, Vec3};
 use serde_json::json;
 
 use crate::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYING, VERSION};
-use crate::{Action, Command, LiveInput};
+use crate::{Action, Command, LearnRequest, LiveInput};
 use dqhand::engine::Engine;
 use dqhand::gesture::{gesture, Sequence, GESTURES};
 use dqhand::kinematics::{HandRig, JointModel, Limits, Pose};
@@ -25,7 +25,7 @@ use crate::{Error, Result};
 pub const GESTURE_SECONDS: f32 = 0.6;
 
 /// What applying a command changed, for the transport.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Applied {
     /// The pose or view changed; the next frame shows it.
     Frame,
@@ -33,6 +33,8 @@ pub enum Applied {
     Hello,
     /// Start (true) or stop recording the live input: the transport's to do.
     Record(bool),
+    /// Learn a gesture from the live input: the transport's to do.
+    Learn(LearnRequest),
 }
 
 /// The state of one connected viewer: the pose source (edits, the timeline, a move to a
@@ -221,6 +223,7 @@ impl Session {
                 self.pose = Pose::rest(self.joint_model().dof_count());
             }
             Command::Record { on } => return Ok(Applied::Record(*on)),
+            Command::Learn { name, seconds, not } => return LearnRequest::new(name, *seconds, *not).map(Applied::Learn).map_err(Error::Command),
         }
         Ok(Applied::Frame)
     }

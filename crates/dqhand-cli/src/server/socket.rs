@@ -14,6 +14,7 @@ use tungstenite::{Message, WebSocket};
 use super::messages::{server_socket, Incoming, MAX_COMMAND_BYTES};
 use super::request::{linger, Request};
 use super::Shared;
+use crate::live_learning;
 
 /// The path of the stream.
 pub const PATH: &str = "/stream";
@@ -56,8 +57,8 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     let mut rate = Rate::new();
     let mut frame = Vec::new();
     let (mut heard, mut pinged) = (Instant::now(), false);
-    // The version of the viewers' recording this viewer was last told of.
-    let mut recording_seen = 0;
+    // The versions of the viewers' recording and learning this viewer was last told of.
+    let (mut recording_seen, mut learning_seen) = (0, 0);
     loop {
         // Read edits until the next frame is due (or, with the window full, until an ack).
         loop {
@@ -89,6 +90,15 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                             send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
                         }
                     }
+                    Ok(Applied::Learn(request)) => {
+                        let started = match &shared.feed {
+                            Some(feed) => live_learning::start(feed, request),
+                            None => Err(anyhow::anyhow!("learn: this server has no live input")),
+                        };
+                        if let Err(e) = started {
+                            send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
+                        }
+                    }
                     Err(e) => send_error(&mut ws, &e.to_string()).map_err(io)?,
                 },
                 Ok(Incoming::Refused(e)) => send_error(&mut ws, &e).map_err(io)?,
@@ -107,6 +117,10 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
         if let Some(records) = shared.feed.as_deref().map(|f| &f.records).filter(|r| r.version() != recording_seen) {
             recording_seen = records.version();
             ws.send(Message::text(records.recording_message())).map_err(io)?;
+        }
+        if let Some(learning) = shared.feed.as_deref().map(|f| &f.learning).filter(|l| l.version() != learning_seen) {
+            learning_seen = learning.version();
+            ws.send(Message::text(learning.message())).map_err(io)?;
         }
         if let (Some(input), Some(view)) = (input, &mut view) {
             let update = input.update(&mut session, view);

@@ -21,7 +21,7 @@ mod weights;
 
 use glam::{Affine3A, Vec3};
 
-use crate::kinematics::webxr;
+use crate::kinematics::{webxr, HandKinematics, JointModel};
 use crate::model::Model;
 use crate::skin::{MeshData, SkinnedMesh};
 use crate::{Error, Result};
@@ -87,16 +87,37 @@ impl HandParams {
     }
 }
 
+/// The kinematics layer of the hand [`build`] makes, without meshing its surface (the
+/// bulk of `build`'s time): what generates poses and joint positions needs, e.g. a synthetic
+/// recording of a user's hand.
+///
+/// # Errors
+/// As [`build`]: parameters out of range.
+pub fn hand_kinematics(params: &HandParams, joint_model: JointModel) -> Result<HandKinematics> {
+    let (anatomy, _) = anatomy(params)?;
+    HandKinematics::new(&anatomy.skeleton()?, &inverse_bind(&anatomy), joint_model)
+}
+
+/// The checked parameters' anatomy, and the direction of the thumb side (radial).
+fn anatomy(params: &HandParams) -> Result<(Anatomy, Vec3)> {
+    params.validate()?;
+    let radial = Vec3::X * if params.side == Side::Right { -1.0 } else { 1.0 };
+    Ok((Anatomy::new(params.length, params.breadth, radial), radial))
+}
+
+/// The inverse of each joint's bind frame.
+fn inverse_bind(anatomy: &Anatomy) -> Vec<Affine3A> {
+    anatomy.frames.iter().map(Affine3A::inverse).collect()
+}
+
 /// Builds the hand: skeleton, skin mesh with normals and UVs, skin weights.
 ///
 /// # Errors
 /// [`Error::HandParameter`] for parameters [`HandParams::validate`] rejects, or [`Error::Tessellation`] (not expected at
 /// supported densities) a surface that fails to mesh as a closed surface of that many vertices.
 pub fn build(params: &HandParams) -> Result<Model> {
-    params.validate()?;
     let HandParams { length: l, breadth: b, side, vertices } = *params;
-    let radial = Vec3::X * if side == Side::Right { -1.0 } else { 1.0 };
-    let anatomy = Anatomy::new(l, b, radial);
+    let (anatomy, radial) = anatomy(params)?;
     let skeleton = anatomy.skeleton()?;
     let shape = HandShape::new(&anatomy);
     let surface = tessellation::tessellate(&shape, vertices)?;
@@ -117,7 +138,7 @@ pub fn build(params: &HandParams) -> Result<Model> {
         weights,
         indices: surface.indices,
         parts: Vec::new(),
-        inverse_bind: anatomy.frames.iter().map(Affine3A::inverse).collect(),
+        inverse_bind: inverse_bind(&anatomy),
     };
     data.sort_by_influence_count();
     let (mesh, warnings) = SkinnedMesh::new(data)?;

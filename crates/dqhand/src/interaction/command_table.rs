@@ -65,6 +65,14 @@ impl<R: CommandRow + Clone> CommandTable<R> {
         Ok(Self { rows: actions.to_vec(), gestures, held: None })
     }
 
+    /// The same rows over another set (gestures added or reordered), nothing held.
+    ///
+    /// # Errors
+    /// As [`Self::new`]: a row whose gesture `set` does not define.
+    pub fn rebind(&self, set: &GestureSet) -> Result<Self> {
+        Self::new(&self.rows, set)
+    }
+
     /// Takes one update's gesture `events` at `time_s` and returns the action due now, if
     /// any (the first due row; another due at the same time follows on the next update).
     /// Allocates nothing.

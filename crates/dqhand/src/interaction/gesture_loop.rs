@@ -142,6 +142,12 @@ impl GestureLoop {
         self.recognizer.as_ref().map(Recognizer::set)
     }
 
+    /// Recognises `gestures` from now on (a gesture learned while the loop runs), starting
+    /// with no gesture held; the hand and its input are unchanged.
+    pub fn set_gestures(&mut self, gestures: GestureSet) {
+        self.recognizer = Some(Recognizer::new(gestures));
+    }
+
     /// The virtual hand's 25 WebXR joint positions after the last record.
     #[must_use]
     pub fn joint_positions(&self) -> &[Vec3; 25] {

@@ -98,6 +98,18 @@ impl ManipulationLoop {
         Ok(events)
     }
 
+    /// Recognises `gestures` from now on ([`GestureLoop::set_gestures`]); the scene's actions
+    /// are bound to them by name.
+    ///
+    /// # Errors
+    /// A scene action naming a gesture `gestures` lacks; the loop is then unchanged.
+    pub fn set_gestures(&mut self, gestures: GestureSet) -> Result<()> {
+        let scene_commands = self.scene_commands.as_ref().map(|t| t.rebind(&gestures)).transpose()?;
+        self.input.set_gestures(gestures);
+        self.scene_commands = scene_commands;
+        Ok(())
+    }
+
     /// The scene command (a row of the scene's `actions`) that the last record triggered.
     #[must_use]
     pub fn command(&self) -> Option<SceneCommand> {

@@ -161,8 +161,7 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
             vertices: *crate::hand::VERTEX_RANGE.start(),
         }
     });
-    let model = crate::hand::build(&HandParams { vertices: *crate::hand::VERTEX_RANGE.start(), ..hand })?;
-    let mut posed = model.hand_kinematics(JointModel::Full)?;
+    let mut posed = crate::hand::hand_kinematics(&hand, JointModel::Full)?;
     let rig = posed.rig().clone();
     let joints = JointPositions::new(posed.skeleton())?;
     let rest_wrist = rig.rest_wrist();
