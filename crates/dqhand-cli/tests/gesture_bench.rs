@@ -26,8 +26,8 @@ fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
     assert!(["debug", "release"].contains(&r["build"].as_str().unwrap()));
     let sources = r["sources"].as_array().unwrap();
     let names: Vec<&str> = sources.iter().map(|s| s["source"].as_str().unwrap()).collect();
-    assert_eq!(names, ["joints", "landmarks", "glove 5dt-14", "glove cyberglove-18", "outside poses"]);
-    for s in &sources[..4] {
+    assert_eq!(names, ["joints", "landmarks", "landmarks, light", "glove 5dt-14", "glove cyberglove-18", "outside poses"]);
+    for s in &sources[..5] {
         let name = s["source"].as_str().unwrap();
         assert_eq!(s["holds"], 26, "{name}: 2 sequences of 13 holds");
         for key in ["rate", "minutes", "spurious_per_minute", "records_per_s"] {
@@ -44,12 +44,20 @@ fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
         assert_eq!(s["glove_dofs_not_driven"].as_array().unwrap().is_empty(), !name.starts_with("glove"));
     }
     // Hand tracking on held-out hands, and other people's poses: the targets, and quiet.
-    for s in [&sources[0], &sources[1], &sources[4]] {
+    for s in [&sources[0], &sources[5]] {
         let name = s["source"].as_str().unwrap();
         assert!(number(&s["rate"], name) >= number(&s["target"], name) && s["rate_pass"] == true, "{name}: {s}");
         assert!(number(&s["spurious_per_minute"], name) <= 1.0 && s["spurious_pass"] == true, "{name}: {s}");
     }
-    assert!(sources[4]["holds"].as_u64().unwrap() >= 48, "every outside pose, three times per hand");
+    // Landmarks with MediaPipe's measured errors do NOT meet the 95 % target (docs/gestures.md
+    // says so: about 85–88 %); the bench must say so, and the figure must not fall further.
+    // With the lighter errors the classifier is trained on, they would (no target: reported).
+    let measured = &sources[1];
+    assert_eq!(number(&measured["target"], "landmarks target"), 0.95);
+    assert_eq!(measured["rate_pass"], number(&measured["rate"], "landmarks") >= 0.95, "{measured}");
+    assert!(number(&measured["rate"], "landmarks") >= 0.8, "{measured}");
+    assert!(number(&sources[2]["rate"], "landmarks, light") >= 0.95, "{}", sources[2]);
+    assert!(sources[5]["holds"].as_u64().unwrap() >= 48, "every outside pose, three times per hand");
     // Our own hand's noise-free joints come back within the 1° (much better, in fact).
     let own = &r["retarget"]["own_hand"];
     assert!(number(&own["scores"]["mean_deg"], "mean") <= 1.0 && own["mean_pass"] == true, "{own}");
