@@ -12,7 +12,7 @@ use dqhand::engine::ModelSource;
 use dqhand::grasp::GraspParams;
 use dqhand::hand::{HandParams, Side};
 use dqhand::input::InputConfig;
-use dqhand::interaction::benchmark::{score, Distribution, RunScore};
+use dqhand::interaction::benchmark::{lag, score, Distribution, LagScore, RunScore};
 use dqhand::interaction::grasp_script::{self, GraspTask};
 use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
@@ -29,6 +29,13 @@ const PENETRATION_TARGET_M: f32 = 0.001;
 const SLIP_TARGET_M: f32 = 0.003;
 /// Longest median time of a frame's collision, grasp and physics against the teapot, µs.
 const STEP_TARGET_US: f64 = 250.0;
+
+/// Speeds a free hand is swept at for the lag, m/s.
+const LAG_SPEEDS: [f32; 5] = [0.1, 0.25, 0.5, 1.0, 2.0];
+/// Farthest the rendered wrist may trail the true one at 0.5 m/s, m.
+const LAG_TARGET_M: f32 = 0.005;
+/// Largest RMS tremble of the rendered wrist of a still hand, m.
+const JITTER_TARGET_M: f32 = 0.0005;
 
 /// Where each object is put, alone on the table, and how far it is carried (a 0.5 m carry
 /// stays on the table).
@@ -86,6 +93,9 @@ pub struct Args {
     /// Only these approaches: above, side, front (comma-separated; default all).
     #[arg(long, value_delimiter = ',')]
     approaches: Vec<String>,
+    /// Input configuration (filters, grace times) to measure instead of the default one.
+    #[arg(long)]
+    config: Option<std::path::PathBuf>,
 }
 
 /// One run: what was done and what it measured.
@@ -109,6 +119,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         anyhow::ensure!(all.object(o).is_some(), "--objects {o}: the objects scene has no such object");
     }
     let model = Arc::new(ModelSource::Builtin(HandParams::default()).load()?);
+    let config = args.config.as_deref().map(InputConfig::load).transpose()?.unwrap_or_default();
     let mut runs = Vec::new();
     for object in all.objects.iter().filter(|o| args.objects.is_empty() || args.objects.contains(&o.name)) {
         let kind = kind(&object.name);
@@ -117,12 +128,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         for approach in APPROACHES.iter().filter(|a| (kind == Kind::Grasp || a.name == "above") && (args.approaches.is_empty() || args.approaches.iter().any(|n| n == a.name))) {
             for &speed in &args.speeds {
                 let task = GraspTask { object: object.name.clone(), approach: approach.palm, fingers: approach.fingers, speed, lift: LIFT_M, carry: CARRY, pinch: kind == Kind::Pinch };
-                let score = measure(&model, &scene, &task)?;
+                let score = measure(&model, &scene, &task, &config)?;
                 runs.push(Run { object: object.name.clone(), kind, approach: approach.name, speed, score });
             }
         }
     }
-    let report = report(&runs);
+    let lags = LAG_SPEEDS.iter().enumerate().map(|(k, &speed)| measure_lag(&model, &all, speed, k as u64 + 1, &config)).collect::<anyhow::Result<Vec<_>>>()?;
+    let report = report(&runs, &lags);
     if args.json {
         println!("{report}");
     } else {
@@ -131,11 +143,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask) -> anyhow::Result<RunScore> {
+fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask, config: &InputConfig) -> anyhow::Result<RunScore> {
     let objects = ObjectColliders::new(scene)?;
     let script = grasp_script::grasp(model.clone(), "objects", &objects, task, Side::Right)?;
-    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, InputConfig::default(), None, scene, GraspParams::default())?;
+    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, config.clone(), None, scene, GraspParams::default())?;
     Ok(score(&mut manip, &script, 0, scene.objects[0].position + task.carry))
+}
+
+/// A free hand swept at `speed` 35 cm above the table, nothing near it.
+fn measure_lag(model: &Arc<Model>, all: &Scene, speed: f32, seed: u64, config: &InputConfig) -> anyhow::Result<LagScore> {
+    let scene = Scene { table: all.table, objects: Vec::new(), actions: Vec::new() };
+    let height = all.table.map_or(0.0, |t| t.height);
+    let sweep = grasp_script::sweep(model, Vec3::new(-0.8, height + 0.35, 0.0), Vec3::X, speed, Side::Right, seed)?;
+    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, config.clone(), None, &scene, GraspParams::default())?;
+    Ok(lag(&mut manip, &sweep))
 }
 
 fn mm(m: f32) -> f64 {
@@ -146,7 +167,7 @@ fn us(d: Option<Distribution>) -> Value {
     d.map_or(Value::Null, |d| json!({"median": d.median * 1e6, "p95": d.p95 * 1e6, "max": d.max * 1e6, "frames": d.count}))
 }
 
-fn report(runs: &[Run]) -> Value {
+fn report(runs: &[Run], lags: &[LagScore]) -> Value {
     let grasps: Vec<&Run> = runs.iter().filter(|r| r.kind != Kind::Strike).collect();
     let successes = grasps.iter().filter(|r| r.score.success).count();
     let rate = if grasps.is_empty() { 0.0 } else { successes as f64 / grasps.len() as f64 };
@@ -166,7 +187,7 @@ fn report(runs: &[Run]) -> Value {
                 "object": r.object, "kind": match r.kind { Kind::Grasp => "grasp", Kind::Pinch => "pinch", Kind::Strike => "strike" },
                 "approach": r.approach, "speed_m_s": r.speed, "success": r.score.success, "place_error_mm": mm(r.score.place_error_m),
                 "max_penetration_mm": mm(r.score.max_penetration_m), "mean_penetration_mm": mm(r.score.mean_penetration_m),
-                "slip_mm": mm(r.score.slip_m), "release_frames": r.score.release_frames, "tunnelled": r.score.tunnelled, "step_us": us(steps),
+                "slip_mm": mm(r.score.slip_m), "carry_lag_mm": mm(r.score.carry_lag_m), "release_frames": r.score.release_frames, "tunnelled": r.score.tunnelled, "step_us": us(steps),
             })
         })
         .collect();
@@ -176,10 +197,14 @@ fn report(runs: &[Run]) -> Value {
         "grasps": grasps.len(), "successes": successes, "success_rate": rate, "success_pass": !grasps.is_empty() && rate >= SUCCESS_TARGET,
         "max_penetration_mm": mm(max_penetration), "mean_penetration_mm": mm(mean_penetration), "penetration_pass": max_penetration <= PENETRATION_TARGET_M,
         "max_slip_mm": mm(slip), "slip_pass": !grasps.is_empty() && slip <= SLIP_TARGET_M,
+        "max_carry_lag_mm": mm(grasps.iter().map(|r| r.score.carry_lag_m).fold(0.0, f32::max)),
         "release_frames": Distribution::of(&mut latency),
         "tunnelled": tunnelled, "tunnelling_pass": tunnelled == 0,
         "step_us": us(Distribution::of(&mut all_steps)), "teapot_step_us": us(teapot), "teapot_step_pass": teapot.is_some_and(|d| d.median * 1e6 <= STEP_TARGET_US),
         "runs": lines,
+        "lag": lags.iter().map(|l| json!({"speed_m_s": l.speed, "lag_mm": mm(l.lag_m), "lag_ms": (f64::from(l.lag_s) * 1e4).round() / 10.0, "jitter_mm": mm(l.jitter_m)})).collect::<Vec<_>>(),
+        "lag_pass": lags.iter().filter(|l| l.speed == 0.5).all(|l| l.lag_m <= LAG_TARGET_M),
+        "jitter_pass": lags.iter().all(|l| l.jitter_m <= JITTER_TARGET_M),
     })
 }
 
@@ -225,5 +250,12 @@ fn print_tables(r: &Value) {
         f(&r["teapot_step_us"]["p95"]),
         pass(&r["teapot_step_pass"])
     );
+    let lag_at = |speed: f64| r["lag"].as_array().into_iter().flatten().find(|l| f(&l["speed_m_s"]) == speed).map_or(f64::NAN, |l| f(&l["lag_mm"]));
+    let lags: Vec<String> = r["lag"].as_array().into_iter().flatten().map(|l| format!("{:.2} m/s {:.1} mm ({:.0} ms)", f(&l["speed_m_s"]), f(&l["lag_mm"]), f(&l["lag_ms"]))).collect();
+    let jitter = r["lag"].as_array().into_iter().flatten().map(|l| f(&l["jitter_mm"])).fold(0.0, f64::max);
+    println!("rendered wrist behind the true one at 0.5 m/s ≤ 5 mm  {:>5.1} mm     {}", lag_at(0.5), pass(&r["lag_pass"]));
+    println!("held and carried (0.5 m/s on average, eased): the rendered wrist falls behind by at most {:.1} mm more than at the carry's start", f(&r["max_carry_lag_mm"]));
+    println!("still hand's jitter, RMS ≤ 0.5 mm        {:>6.2} mm     {}", jitter, pass(&r["jitter_pass"]));
+    println!("lag of a free hand swept at constant speed (1.5 mm joint noise): {}", lags.join(", "));
     println!("release latency: median {} frames, max {} frames; all objects: {:.0} µs a frame (median)", r["release_frames"]["median"], r["release_frames"]["max"], f(&r["step_us"]["median"]));
 }

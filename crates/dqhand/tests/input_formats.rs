@@ -183,6 +183,59 @@ fn fuzz_json_record_a_written_unit_quaternion_reads_back_bit_for_bit() {
     assert_eq!(r.tracker.unwrap().orientation.to_array(), q);
 }
 
+/// The One Euro filter on a 3-vector, written from the paper's equations with the derivative
+/// low-passed per component and its length setting the one cutoff (f64 throughout).
+struct ReferenceVec3 {
+    freq_min: f64,
+    beta: f64,
+    d_cutoff: f64,
+    x_prev: Option<[f64; 3]>,
+    dx_prev: [f64; 3],
+}
+
+impl ReferenceVec3 {
+    fn filter(&mut self, x: [f64; 3], dt: f64) -> [f64; 3] {
+        let Some(prev) = self.x_prev else {
+            self.x_prev = Some(x);
+            return x;
+        };
+        let a_d = Reference::alpha(self.d_cutoff, dt);
+        let edx: [f64; 3] = std::array::from_fn(|k| a_d * (x[k] - prev[k]) / dt + (1.0 - a_d) * self.dx_prev[k]);
+        self.dx_prev = edx;
+        let speed = edx.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let a = Reference::alpha(self.freq_min + self.beta * speed, dt);
+        let out = std::array::from_fn(|k| a * x[k] + (1.0 - a) * prev[k]);
+        self.x_prev = Some(out);
+        out
+    }
+}
+
+#[test]
+fn a_still_noisy_position_trembles_less_than_the_noise_and_settles_where_it_is() {
+    // The velocity is low-passed as a vector: a still point's noise averages out of it, so
+    // the cutoff stays near its minimum (low-passing each step's speed, never negative,
+    // would raise it with the noise).
+    let mut f = OneEuroVec3::new(OneEuroParams::POSITION);
+    let mut rng = dqhand::math::Rng::new(7);
+    let sigma = 0.0015 / 3f32.sqrt();
+    let at = Vec3::new(0.1, 1.0, -0.3);
+    // Offsets from the true point, in f64: the mean of squares would cancel in f32.
+    let (mut sum, mut square, mut n) = (glam::DVec3::ZERO, 0.0f64, 0.0f64);
+    for k in 0..600 {
+        let x = at + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+        let y = (f.filter(x, 1.0 / 60.0) - at).as_dvec3();
+        if k >= 60 {
+            sum += y;
+            square += y.length_squared();
+            n += 1.0;
+        }
+    }
+    let mean = sum / n;
+    let tremble = (square / n - mean.length_squared()).max(0.0).sqrt();
+    assert!(mean.length() < 0.0005, "{mean:?}");
+    assert!(tremble < 0.0005, "tremble {tremble} m against 1.5 mm of noise");
+}
+
 proptest! {
     /// Any record that parses is written as a line that parses back to the same record, with
     /// orientations unit or off unit length by up to 5 % (the parser takes 10 %).
@@ -266,6 +319,23 @@ proptest! {
             let expected = reference_speed.filter(d.into(), dt.into()) as f32;
             let got = v.filter(direction * d, dt);
             prop_assert!((got - direction * expected).length() < 1e-3 * (1.0 + expected));
+        }
+    }
+
+    /// On any path, the position filter is the reference's, velocity per component.
+    #[test]
+    fn position_filter_matches_the_reference_on_any_path(
+        steps in proptest::collection::vec((support::vec3(0.05), 0.002f32..0.05), 1..150),
+        min_cutoff in 0.1f32..5.0, beta in 0.0f32..50.0, d_cutoff in 0.5f32..3.0,
+    ) {
+        let mut v = OneEuroVec3::new(OneEuroParams { min_cutoff, beta, d_cutoff });
+        let mut reference = ReferenceVec3 { freq_min: min_cutoff.into(), beta: beta.into(), d_cutoff: d_cutoff.into(), x_prev: None, dx_prev: [0.0; 3] };
+        let mut x = Vec3::new(0.0, 1.0, 0.0);
+        for &(step, dt) in &steps {
+            x += step;
+            let want = reference.filter(x.as_dvec3().to_array(), dt.into());
+            let got = v.filter(x, dt);
+            prop_assert!((got.as_dvec3() - glam::DVec3::from(want)).length() < 1e-4, "got {got:?}, want {want:?}");
         }
     }
 

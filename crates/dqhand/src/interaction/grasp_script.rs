@@ -74,6 +74,8 @@ pub struct Script {
     pub truth: Vec<Pose>,
     /// The stages.
     pub times: GraspTimes,
+    /// Where the carry takes the hand (and the object), m.
+    pub carry: Vec3,
 }
 
 /// Records per second.
@@ -260,7 +262,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     // The approach is at constant speed (its speed is the point); the rest eased.
     let eased = |k: usize| k != 2;
     let frames = (end * RATE_HZ).floor() as usize + 1;
-    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times };
+    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times, carry: task.carry };
     for i in 0..frames {
         let t = i as f64 / RATE_HZ;
         let k = keys.iter().rposition(|k| k.0 <= t).unwrap_or(0).min(keys.len() - 2);
@@ -313,4 +315,57 @@ pub fn sequence(model: &Arc<Model>, file: &str, objects: &ObjectColliders, tasks
         scripts.push(s);
     }
     Ok(scripts)
+}
+
+/// A free hand moved at a constant speed, for the loop's lag, and held still before, for its
+/// jitter: what [`crate::interaction::benchmark::lag`] measures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sweep {
+    /// The records, one per frame, joints with [`SWEEP_NOISE_M`] of noise.
+    pub records: Vec<Record>,
+    /// The true pose of each record (the `full` joint model).
+    pub truth: Vec<Pose>,
+    /// The stretch the hand is still (after the filters settled), s.
+    pub rest: (f64, f64),
+    /// The stretch it moves at `speed` (after a ramp and a settling time), s.
+    pub steady: (f64, f64),
+    /// Its speed there, m/s, along `direction`.
+    pub speed: f32,
+    pub direction: Vec3,
+}
+
+/// Joint noise of a sweep's records, m RMS: the gesture benchmark's.
+pub const SWEEP_NOISE_M: f32 = 0.0015;
+
+/// Records of `model`'s open hand at `start`, still for 2 s, then sped up along `direction`
+/// to `speed` (m/s) over 0.2 s and carried on for 1.3 s; the steady stretch is its last
+/// second. Seeded noise: the same seed makes the same records.
+///
+/// # Errors
+/// As [`Model::hand_kinematics`].
+pub fn sweep(model: &Arc<Model>, start: Vec3, direction: Vec3, speed: f32, side: Side, seed: u64) -> Result<Sweep> {
+    const REST_S: f64 = 2.0;
+    const RAMP_S: f64 = 0.2;
+    const MOVE_S: f64 = 1.3;
+    let direction = direction.normalize();
+    let mut hand = model.hand_kinematics(JointModel::Full)?;
+    let joints = JointPositions::new(hand.skeleton())?;
+    let mut rng = crate::math::Rng::new(seed);
+    let sigma = SWEEP_NOISE_M / 3f32.sqrt();
+    let frames = ((REST_S + RAMP_S + MOVE_S) * RATE_HZ).floor() as usize + 1;
+    let mut out = Sweep { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), rest: (0.5, REST_S), steady: (REST_S + MOVE_S + RAMP_S - 1.0, REST_S + RAMP_S + MOVE_S), speed, direction };
+    for i in 0..frames {
+        let t = i as f64 / RATE_HZ;
+        // Constant acceleration over the ramp, then constant speed.
+        let moving = (t - REST_S).max(0.0);
+        let travelled = if moving < RAMP_S { moving * moving / (2.0 * RAMP_S) } else { RAMP_S / 2.0 + (moving - RAMP_S) };
+        let mut pose = Pose::rest(JointModel::Full.dof_count());
+        pose.wrist = Some(DualQuat::from_rotation_translation(Quat::IDENTITY, start + direction * (speed * travelled as f32)));
+        hand.pose(&pose);
+        let world: &[Affine3A] = hand.world();
+        let positions = joints.read(world).map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma);
+        out.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None, arrival: None });
+        out.truth.push(pose);
+    }
+    Ok(out)
 }

@@ -50,6 +50,9 @@ pub struct RunScore {
     pub mean_penetration_m: f32,
     /// How far the carried object moved in the tracked wrist's frame during the carry, m.
     pub slip_m: f32,
+    /// How much farther the rendered wrist fell behind the true one along the carry than it
+    /// was at the carry's start, at most, m: the hand and what it holds lagging the user's.
+    pub carry_lag_m: f32,
     /// Frames from the fingers beginning to open to the release, if released.
     pub release_frames: Option<u32>,
     /// The rendered palm's centre crossed an object's surface between two frames.
@@ -103,6 +106,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         max_penetration_m: 0.0,
         mean_penetration_m: 0.0,
         slip_m: 0.0,
+        carry_lag_m: 0.0,
         release_frames: None,
         tunnelled: false,
         step_s: Vec::with_capacity(script.records.len()),
@@ -111,9 +115,10 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let mut released = false;
     let (mut penetration_sum, mut contact_frames) = (0.0f64, 0u32);
     let mut in_wrist: Option<Vec3> = None;
+    let mut carry_offset: Option<f32> = None;
     let mut palm: Option<Vec3> = None;
     let mut skin: Vec<[f32; 3]> = Vec::new();
-    for record in &script.records {
+    for (record, truth) in script.records.iter().zip(&script.truth) {
         // The loop takes records as they come; a script's records are all good.
         let _ = manip.push(record);
         let started = Instant::now();
@@ -131,6 +136,11 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
                 let here = wrist.inverse().transform_point3(manip.poses()[object].1);
                 let first = *in_wrist.get_or_insert(here);
                 score.slip_m = score.slip_m.max(here.distance(first));
+                if let (Some(rendered), Some(true_wrist)) = (manip.constraint().rendered().wrist, truth.wrist) {
+                    let behind = (true_wrist.to_rotation_translation().1 - rendered.to_rotation_translation().1).dot(script.carry.normalize_or_zero());
+                    let first = *carry_offset.get_or_insert(behind);
+                    score.carry_lag_m = score.carry_lag_m.max(behind - first);
+                }
             }
         }
         if let Some(GraspEvent::Release { object: o, .. }) = event {
