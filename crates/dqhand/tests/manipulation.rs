@@ -373,3 +373,79 @@ fn a_free_hand_lags_at_most_5_mm_at_half_a_metre_a_second_and_a_still_one_barely
     assert!(scores[0].lag_m < scores[1].lag_m && scores[1].lag_m < scores[2].lag_m, "{scores:?}");
     assert!(scores[0].lag_s > scores[1].lag_s && scores[1].lag_s > scores[2].lag_s, "{scores:?}");
 }
+
+/// Issue 28: a ball let go by a still hand above the table, tracked as a headset tracks (2 mm
+/// joint jitter, lost records, 30 ms behind), falls straight: no more than 1 cm across by
+/// half way down, the opening fingers do not bat it away, and it lands where it was let go.
+#[test]
+fn a_ball_let_go_by_a_still_jittering_hand_falls_straight() {
+    let scene = scene("grasp");
+    let task = GraspTask { drop: 0.1, ..GraspTask::from_above("ball") };
+    let exact = script(&scene, &task);
+    for seed in 1..=3 {
+        let s = grasp_script::HeadsetTracking::QUEST_LIKE.track(&exact, seed);
+        assert!(s.records.len() < exact.records.len(), "some records are lost");
+        let mut manip = ManipulationLoop::new(model(), JointModel::Full, None, InputConfig::default(), None, &scene, GraspParams::default()).unwrap();
+        let carried_to = scene.objects[0].position + task.carry;
+        let r = benchmark::score(&mut manip, &s, 0, carried_to);
+        if r.release_frames.is_none() { println!("seed {seed}: not released"); continue; }
+        assert!(r.release_drift_m <= 0.01, "seed {seed}: {} mm across while falling", r.release_drift_m * 1e3);
+        let rest = manip.poses()[0].1;
+        let across = Vec3::new(rest.x - carried_to.x, 0.0, rest.z - carried_to.z).length();
+        assert!(across <= 0.02, "seed {seed}: came to rest {} mm across from where it was carried", across * 1e3);
+    }
+}
+
+/// The room has a floor: a ball rolled off the table lands on it and stays; one thrown out
+/// of reach is put back where the scene file has it, and the step says so.
+#[test]
+fn the_floor_stops_a_falling_ball_and_one_thrown_out_of_reach_is_put_back() {
+    let scene = scene("grasp");
+    let objects = ObjectColliders::new(&scene).unwrap();
+    let radius = 0.04;
+    let mut physics = ScenePhysics::new(&scene, &objects);
+    physics.hold(0, glam::Quat::IDENTITY, scene.objects[0].position + Vec3::Y * 0.05);
+    physics.step(1.0 / 60.0);
+    physics.release(0, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO); // off the table's front edge
+    for _ in 0..180 {
+        physics.step(1.0 / 60.0);
+        assert!(physics.returned().is_empty());
+    }
+    let (_, p) = physics.pose(0);
+    assert!((p.y - (dqhand::physics::FLOOR_Y + radius)).abs() < 0.005, "rests on the floor: {p:?}");
+
+    let mut physics = ScenePhysics::new(&scene, &objects);
+    physics.hold(0, glam::Quat::IDENTITY, scene.objects[0].position + Vec3::Y * 0.05);
+    physics.step(1.0 / 60.0);
+    physics.release(0, Vec3::new(30.0, 3.0, 0.0), Vec3::ZERO);
+    let returned = (0..120).find(|_| {
+        physics.step(1.0 / 60.0);
+        physics.returned() == [0]
+    });
+    assert!(returned.is_some(), "put back once out of reach");
+    let (_, p) = physics.pose(0);
+    assert!(p.distance(scene.objects[0].position) < 1e-4, "where the scene file has it: {p:?}");
+    assert_eq!(physics.velocity(0).0, Vec3::ZERO);
+}
+
+/// Issue 28: a marble pinched, carried and set down by a jittering hand stays where it was
+/// set when the fingers open round it. With these seeds it rolled 10–26 cm away when the
+/// release gave it the wrist's velocity measured over 4 frames (tracking noise and the
+/// opening fingers' pull on the retargeted wrist, 16 cm/s and 2 rad/s): it is measured over 8
+/// frames now, and a release slower than a toss gives none.
+#[test]
+fn a_marble_set_down_stays_when_the_fingers_open_round_it() {
+    let all = scene("objects");
+    let marble = all.object("marble").unwrap().clone();
+    let mut scene = Scene { table: all.table, objects: vec![marble.clone()], actions: Vec::new() };
+    scene.objects[0].position = Vec3::new(-0.25, marble.position.y, -0.3);
+    let task = GraspTask { object: "marble".into(), approach: Vec3::NEG_Y, fingers: Vec3::NEG_Z, speed: 0.5, lift: 0.12, carry: Vec3::new(0.5, 0.0, 0.0), pinch: true, drop: 0.0, aim: Vec3::ZERO };
+    let exact = script(&scene, &task);
+    for seed in [49, 60, 62, 64, 73] {
+        let s = grasp_script::HeadsetTracking::QUEST_LIKE.track(&exact, seed);
+        let mut manip = ManipulationLoop::new(model(), JointModel::Full, None, InputConfig::default(), None, &scene, GraspParams::default()).unwrap();
+        let r = benchmark::score(&mut manip, &s, 0, scene.objects[0].position + task.carry);
+        assert!(r.release_frames.is_some(), "seed {seed}: released");
+        assert!(r.release_drift_m <= 0.01, "seed {seed}: rolled {} mm from where it was let go", r.release_drift_m * 1e3);
+    }
+}

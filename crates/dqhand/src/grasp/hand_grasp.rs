@@ -19,11 +19,19 @@ pub struct GraspParams {
     pub cooldown_s: f64,
     /// Seconds a held object survives a tracking loss.
     pub loss_grace_s: f64,
+    /// An object let go slower than this (its origin carried by the wrist's motion over the
+    /// last 8 frames), m/s, is set down or dropped: it leaves without the hand's velocity.
+    /// Tracking noise alone measures several cm/s (2 mm joint jitter, 30 ms late: up to
+    /// 16 cm/s at a marble 10 cm from the wrist), which would roll a ball set down away or
+    /// tip a dropped cube; a toss is faster.
+    pub still_m_s: f32,
+    /// A wrist turning slower than this, rad/s, gives the object no spin.
+    pub still_rad_s: f32,
 }
 
 impl Default for GraspParams {
     fn default() -> Self {
-        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5 }
+        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5, still_m_s: 0.25, still_rad_s: 2.0 }
     }
 }
 
@@ -52,7 +60,7 @@ const MAX_ANCHORS: usize = 16;
 /// two contacts (a pinch) still fix the object's rotation.
 const WRIST_POINTS: [Vec3; 4] = [Vec3::ZERO, Vec3::new(0.05, 0.0, 0.0), Vec3::new(0.0, 0.05, 0.0), Vec3::new(0.0, 0.0, 0.05)];
 /// Frames of held poses kept for the release velocity.
-const HISTORY: usize = 4;
+const HISTORY: usize = 8;
 
 #[derive(Clone, Debug)]
 struct Held {
@@ -219,7 +227,11 @@ impl Grasp {
         let (linvel, angvel) = if moving && dt > 0.0 {
             let q1 = if q0.dot(q1) < 0.0 { -q1 } else { q1 };
             let angvel = (q1 * q0.inverse()).to_scaled_axis() / dt;
-            ((p1 - p0) / dt + angvel.cross(held.target.1 - p1), angvel)
+            let angvel = if angvel.length() < self.params.still_rad_s { Vec3::ZERO } else { angvel };
+            // The object's origin as a point fixed to the wrist; slower than a toss, it is set
+            // down or dropped, not thrown.
+            let linvel = (p1 - p0) / dt + angvel.cross(held.target.1 - p1);
+            if linvel.length() < self.params.still_m_s { (Vec3::ZERO, Vec3::ZERO) } else { (linvel, angvel) }
         } else {
             (Vec3::ZERO, Vec3::ZERO)
         };

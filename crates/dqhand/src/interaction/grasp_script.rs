@@ -16,7 +16,7 @@ use super::synthetic::joint_set;
 use crate::collision::ObjectColliders;
 use crate::gesture::gesture;
 use crate::kinematics::Side;
-use crate::input::{HandData, Record};
+use crate::input::{HandData, Record, TrackedJoint};
 use crate::kinematics::{HandKinematics, JointModel, JointPositions, Motion, Pose};
 use crate::math::DualQuat;
 use crate::model::Model;
@@ -46,6 +46,12 @@ pub struct GraspTask {
     pub carry: Vec3,
     /// A pinch (thumb and index tips) instead of a whole-hand grasp.
     pub pinch: bool,
+    /// How high above where it was picked up the hand lets it go, m: 0 sets it down; above,
+    /// a still hand opens and it falls.
+    pub drop: f32,
+    /// Where the hand aims, off the object's middle (world, m; its part along the approach
+    /// is ignored): a user's grasp is rarely centred.
+    pub aim: Vec3,
 }
 
 /// When each stage of a scripted grasp happens, s.
@@ -76,6 +82,8 @@ pub struct Script {
     pub times: GraspTimes,
     /// Where the carry takes the hand (and the object), m.
     pub carry: Vec3,
+    /// How high above the table it is let go, m ([`GraspTask::drop`]).
+    pub drop: f32,
 }
 
 /// Records per second.
@@ -224,7 +232,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     // Where the palm goes. A grasp: it presses into the surface point seen along the
     // approach through the middle of the object's bounding box, shifted across the approach
     // so that the hand's grip point is over the middle. A pinch: the tips meet in the middle.
-    let grip = rotation * (frame.grip - frame.palm);
+    let grip = rotation * (frame.grip - frame.palm) - (task.aim - d * task.aim.dot(d));
     let grasp_at = if task.pinch {
         object.aabb().center() - grip
     } else {
@@ -236,7 +244,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     let start = grasp_at - d * STANDOFF_M;
     let lifted = grasp_at + Vec3::Y * task.lift;
     let carried = lifted + task.carry;
-    let set_down = carried - Vec3::Y * task.lift;
+    let set_down = carried - Vec3::Y * (task.lift - task.drop);
     let mut keys: Vec<Key> = Vec::new();
     let mut t = 0.0;
     let mut key = |dt: f64, p: Vec3, c: f32, keys: &mut Vec<Key>| {
@@ -262,7 +270,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     // The approach is at constant speed (its speed is the point); the rest eased.
     let eased = |k: usize| k != 2;
     let frames = (end * RATE_HZ).floor() as usize + 1;
-    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times, carry: task.carry };
+    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times, carry: task.carry, drop: task.drop };
     for i in 0..frames {
         let t = i as f64 / RATE_HZ;
         let k = keys.iter().rposition(|k| k.0 <= t).unwrap_or(0).min(keys.len() - 2);
@@ -286,7 +294,7 @@ impl GraspTask {
     /// user (−Z), lifted 12 cm, carried 20 cm toward the user (+Z) and set down.
     #[must_use]
     pub fn from_above(object: &str) -> Self {
-        Self { object: object.to_owned(), approach: -Vec3::Y, fingers: -Vec3::Z, speed: 0.5, lift: 0.12, carry: Vec3::new(0.0, 0.0, 0.2), pinch: false }
+        Self { object: object.to_owned(), approach: -Vec3::Y, fingers: -Vec3::Z, speed: 0.5, lift: 0.12, carry: Vec3::new(0.0, 0.0, 0.2), pinch: false, drop: 0.0, aim: Vec3::ZERO }
     }
 }
 
@@ -368,4 +376,48 @@ pub fn sweep(model: &Arc<Model>, start: Vec3, direction: Vec3, speed: f32, side:
         out.truth.push(pose);
     }
     Ok(out)
+}
+
+/// How a headset tracks a hand, beyond the script's truth: the issue's "headset-like
+/// tracking" for the grasp benchmark.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadsetTracking {
+    /// RMS noise of every joint position, m.
+    pub jitter_m: f32,
+    /// Share of records lost.
+    pub drop_rate: f64,
+    /// How old each record's hand is when it arrives, s (rounded to whole records).
+    pub latency_s: f64,
+}
+
+impl HeadsetTracking {
+    /// 2 mm of joint jitter, 1 % of records lost, 30 ms behind.
+    pub const QUEST_LIKE: Self = Self { jitter_m: 0.002, drop_rate: 0.01, latency_s: 0.03 };
+
+    /// `script` as this tracking reports it (seeded): each record carries the hand of
+    /// `latency_s` earlier with noisy joints, and some are lost. The truth and the times stay
+    /// the script's: the hand the user has now.
+    #[must_use]
+    pub fn track(&self, script: &Script, seed: u64) -> Script {
+        let mut rng = crate::math::Rng::new(seed);
+        let sigma = self.jitter_m / 3f32.sqrt();
+        let behind = (self.latency_s * RATE_HZ).round() as usize;
+        let mut out = Script { records: Vec::with_capacity(script.records.len()), truth: Vec::with_capacity(script.truth.len()), times: script.times, carry: script.carry, drop: script.drop };
+        for (k, (record, truth)) in script.records.iter().zip(&script.truth).enumerate() {
+            if rng.next_f64() < self.drop_rate {
+                continue;
+            }
+            let mut hand = script.records[k.saturating_sub(behind)].hand;
+            if let Some(HandData::Joints(joints)) = &mut hand {
+                for i in 0..25 {
+                    if let Some(&j) = joints.get(i) {
+                        joints.set(i, TrackedJoint { position: j.position + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma, ..j });
+                    }
+                }
+            }
+            out.records.push(Record { hand, ..*record });
+            out.truth.push(truth.clone());
+        }
+        out
+    }
 }

@@ -187,6 +187,14 @@ impl ManipulationLoop {
         self.input.pipeline().tracking()
     }
 
+    /// The objects the last [`Self::step`] put back where the scene file has them, because
+    /// they had left the room's reach ([`crate::physics::REACH_M`], or through the floor at
+    /// [`crate::physics::FLOOR_Y`]): an application reports them.
+    #[must_use]
+    pub fn returned(&self) -> &[usize] {
+        self.physics.returned()
+    }
+
     /// The object held, if any: its index in scene order (its name in [`Self::names`]).
     #[must_use]
     pub fn held(&self) -> Option<usize> {

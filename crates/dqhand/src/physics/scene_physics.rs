@@ -17,6 +17,13 @@ pub const TABLE_FRICTION: f32 = 0.8;
 /// See [`TABLE_FRICTION`].
 pub const TABLE_RESTITUTION: f32 = 0.3;
 
+/// The room's floor: the plane y = 0 (the scene files' table stands on it), so nothing that
+/// leaves the table falls for ever.
+pub const FLOOR_Y: f32 = 0.0;
+/// How far from the room's centre (the origin, across) an object may go before it is out of
+/// reach: put back where the scene file has it, m.
+pub const REACH_M: f32 = 5.0;
+
 /// How near a joint of the hand's kinematic bodies must be to where it goes
 /// to be left where it is, m and rad: far below anything the contact constraint resolves (it
 /// stops the hand a fraction of a millimetre short). Rapier lists every body borrowed
@@ -42,6 +49,8 @@ pub struct ScenePhysics {
     /// meets the hand (a released ball rests on the fingers, a rolling one stops at them)
     /// instead of passing into it.
     hand: Vec<(RigidBodyHandle, usize)>,
+    /// The objects the last step put back, out of reach ([`REACH_M`], or under the floor).
+    returned: Vec<usize>,
 }
 
 impl ScenePhysics {
@@ -65,7 +74,10 @@ impl ScenePhysics {
         if let Some(slab) = colliders.table_collider() {
             world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         }
-        Self { world, bodies, initial, held: None, hand: Vec::new() }
+        let floor = ColliderBuilder::cuboid(2.0 * REACH_M, 0.5, 2.0 * REACH_M).translation(Vec3::new(0.0, FLOOR_Y - 0.5, 0.0));
+        world.insert_collider(floor.friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
+        let returned = Vec::with_capacity(bodies.len());
+        Self { world, bodies, initial, held: None, hand: Vec::new(), returned }
     }
 
     /// Adds the hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves.
@@ -144,18 +156,39 @@ impl ScenePhysics {
     /// Every object back where the file puts it, at rest, none held.
     pub fn reset(&mut self) {
         self.held = None;
-        for (&h, &pose) in self.bodies.iter().zip(&self.initial) {
-            let body = &mut self.world.bodies[h];
-            body.set_body_type(RigidBodyType::Dynamic, true);
-            body.set_position(pose, true);
-            body.set_linvel(Vec3::ZERO, true);
-            body.set_angvel(Vec3::ZERO, true);
+        for i in 0..self.bodies.len() {
+            self.put_back(i);
         }
     }
 
-    /// Advances the simulation by `dt` seconds.
+    /// Object `i` back where the file puts it, at rest.
+    fn put_back(&mut self, i: usize) {
+        let body = &mut self.world.bodies[self.bodies[i]];
+        body.set_body_type(RigidBodyType::Dynamic, true);
+        body.set_position(self.initial[i], true);
+        body.set_linvel(Vec3::ZERO, true);
+        body.set_angvel(Vec3::ZERO, true);
+    }
+
+    /// Advances the simulation by `dt` seconds; a free object that leaves the reach of the
+    /// room ([`REACH_M`] across, or through the floor) is put back ([`Self::returned`]).
     pub fn step(&mut self, dt: f32) {
         self.world.integration_parameters.dt = dt;
         self.world.step();
+        self.returned.clear();
+        for i in 0..self.bodies.len() {
+            let p = self.world.bodies[self.bodies[i]].position().translation;
+            let out = Vec3::new(p.x, 0.0, p.z).length() > REACH_M || p.y < FLOOR_Y - 0.5;
+            if out && self.held != Some(i) {
+                self.put_back(i);
+                self.returned.push(i);
+            }
+        }
+    }
+
+    /// The objects the last [`Self::step`] put back because they had left the room's reach.
+    #[must_use]
+    pub fn returned(&self) -> &[usize] {
+        &self.returned
     }
 }

@@ -53,6 +53,11 @@ pub struct RunScore {
     /// How much farther the rendered wrist fell behind the true one along the carry than it
     /// was at the carry's start, at most, m: the hand and what it holds lagging the user's.
     pub carry_lag_m: f32,
+    /// How far across (in the horizontal plane) the object moved from where the hand let it
+    /// go, m: by the time it has fallen half way to the table when dropped (before landing,
+    /// where a cube may tip over), or to where it comes to rest when set down. A still hand's
+    /// opening fingers must not bat it away.
+    pub release_drift_m: f32,
     /// Frames from the fingers beginning to open to the release, if released.
     pub release_frames: Option<u32>,
     /// The rendered palm's centre crossed an object's surface between two frames.
@@ -107,6 +112,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         mean_penetration_m: 0.0,
         slip_m: 0.0,
         carry_lag_m: 0.0,
+        release_drift_m: 0.0,
         release_frames: None,
         tunnelled: false,
         step_s: Vec::with_capacity(script.records.len()),
@@ -116,6 +122,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let (mut penetration_sum, mut contact_frames) = (0.0f64, 0u32);
     let mut in_wrist: Option<Vec3> = None;
     let mut carry_offset: Option<f32> = None;
+    let mut let_go: Option<Vec3> = None;
+    let mut fallen: Option<Vec3> = None;
     let mut palm: Option<Vec3> = None;
     let mut skin: Vec<[f32; 3]> = Vec::new();
     for (record, truth) in script.records.iter().zip(&script.truth) {
@@ -146,7 +154,14 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         if let Some(GraspEvent::Release { object: o, .. }) = event {
             if o == object && t >= times.release && !released {
                 released = true;
+                let_go = Some(manip.poses()[object].1);
                 score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
+            }
+        }
+        if let (Some(at), None) = (let_go, fallen) {
+            let now = manip.poses()[object].1;
+            if script.drop > 0.0 && at.y - now.y >= script.drop / 2.0 {
+                fallen = Some(now);
             }
         }
         let held_index = manip.held();
@@ -176,7 +191,16 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         }
     }
     score.mean_penetration_m = if contact_frames > 0 { (penetration_sum / f64::from(contact_frames)) as f32 } else { 0.0 };
-    score.place_error_m = manip.poses()[object].1.distance(carried_to);
+    // A dropped object: where it was let go to fall (half way down, before it lands: a cube
+    // may tip over on landing), across; a set-down one: where it rests.
+    score.place_error_m = match fallen {
+        Some(f) => Vec3::new(f.x - carried_to.x, 0.0, f.z - carried_to.z).length(),
+        None => manip.poses()[object].1.distance(carried_to),
+    };
+    if let Some(at) = let_go {
+        let rest = fallen.unwrap_or(manip.poses()[object].1);
+        score.release_drift_m = Vec3::new(rest.x - at.x, 0.0, rest.z - at.z).length();
+    }
     score.success = grasped_before_carry && held_through_carry && released && manip.held().is_none() && score.place_error_m <= PLACE_TOLERANCE_M;
     score
 }
