@@ -251,7 +251,7 @@ fn report(runs: &[Run], lags: &[LagScore]) -> Value {
         "tunnelled": tunnelled, "tunnelling_pass": tunnelled == 0,
         "step_us": us(Distribution::of(&mut all_steps)), "teapot_step_us": us(teapot), "teapot_step_pass": teapot.is_some_and(|d| d.median * 1e6 <= STEP_TARGET_US),
         "runs": lines,
-        "lag": lags.iter().map(|l| json!({"speed_m_s": l.speed, "lag_mm": mm(l.lag_m), "lag_ms": (f64::from(l.lag_s) * 1e4).round() / 10.0, "jitter_mm": mm(l.jitter_m)})).collect::<Vec<_>>(),
+        "lag": lags.iter().map(|l| json!({"speed_m_s": (f64::from(l.speed) * 1000.0).round() / 1000.0, "lag_mm": mm(l.lag_m), "lag_ms": (f64::from(l.lag_s) * 1e4).round() / 10.0, "jitter_mm": mm(l.jitter_m)})).collect::<Vec<_>>(),
         "lag_pass": lags.iter().filter(|l| l.speed == 0.5).all(|l| l.lag_m <= LAG_TARGET_M),
         "jitter_pass": lags.iter().all(|l| l.jitter_m <= JITTER_TARGET_M),
     })

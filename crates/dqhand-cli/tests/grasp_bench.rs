@@ -1,6 +1,7 @@
 //! `dqhand grasp-bench` through the real command: a small run reports every measure, and the
-//! scripted grasp of the ball meets the targets for success, penetration, slip and
-//! tunnelling (correctness, not timing: the timings are only checked to be there).
+//! scripted grasp of the ball meets the targets for success, penetration, slip,
+//! tunnelling, the drop's drift and the free hand's lag and jitter (correctness, not timing:
+//! the timings are only checked to be there).
 
 use std::process::Command;
 
@@ -17,15 +18,25 @@ fn a_small_run_reports_every_measure_and_meets_the_targets() {
     let r: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(r["synthetic"].as_str().unwrap().contains("not captured from a person"));
     let runs = r["runs"].as_array().unwrap();
-    let what: Vec<(&str, &str)> = runs.iter().map(|x| (x["object"].as_str().unwrap(), x["kind"].as_str().unwrap())).collect();
-    assert_eq!(what, [("ball", "grasp"), ("plate", "strike")]);
-    assert_eq!((r["grasps"].as_u64(), r["successes"].as_u64()), (Some(1), Some(1)), "the ball is grasped, carried and set down");
+    let what: Vec<(&str, &str, bool)> = runs.iter().map(|x| (x["object"].as_str().unwrap(), x["kind"].as_str().unwrap(), x["headset"].as_bool().unwrap())).collect();
+    assert_eq!(what, [("ball", "grasp", false), ("ball", "grasp", true), ("ball", "drop", false), ("ball", "drop", true), ("plate", "strike", false)]);
+    let ball = &runs[0];
+    assert_eq!(ball["success"], true, "the ball is grasped at 10 m/s, carried and set down: {ball}");
+    assert!(ball["release_frames"].as_u64().is_some(), "released: {ball}");
+    assert!(ball["step_us"]["median"].as_f64().unwrap() > 0.0);
+    assert_eq!(r["headset_grasps"], 2, "the grasp and the drop as a headset tracks: {r}");
     assert!(r["max_penetration_mm"].as_f64().unwrap() <= 1.0, "penetration {}", r["max_penetration_mm"]);
     assert!(r["max_slip_mm"].as_f64().unwrap() <= 3.0, "slip {}", r["max_slip_mm"]);
     assert_eq!(r["tunnelled"], 0, "a 10 m/s strike on the 8 mm plate does not pass into it");
-    let ball = &runs[0];
-    assert!(ball["release_frames"].as_u64().is_some(), "released: {ball}");
-    assert!(ball["step_us"]["median"].as_f64().unwrap() > 0.0);
+    // Dropped by a still hand, exact and tracked like a headset: straight down.
+    assert!(r["max_drop_drift_mm"].as_f64().unwrap() <= 10.0 && r["drift_pass"] == true, "{r}");
+    // The free hand's lag and jitter at every speed, within the targets at 0.5 m/s.
+    let lag = r["lag"].as_array().unwrap();
+    assert_eq!(lag.iter().map(|l| l["speed_m_s"].as_f64().unwrap()).collect::<Vec<_>>(), [0.1, 0.25, 0.5, 1.0, 2.0]);
+    assert!(r["lag_pass"] == true && r["jitter_pass"] == true, "{lag:?}");
+    for l in lag {
+        assert!(l["lag_mm"].as_f64().unwrap() > 0.0 && l["jitter_mm"].as_f64().unwrap() > 0.0, "{l}");
+    }
     assert!(r["teapot_step_us"].is_null(), "no teapot run, no teapot time");
 }
 
