@@ -46,7 +46,7 @@ export function learningText(m: LearningMessage): string {
     case 'recording':
       return m.not ? `show what is not ${name}, for ${m.seconds} s…` : `hold ${name}, for ${m.seconds} s…`;
     case 'training':
-      return `learning ${name}… (the first time takes about half a minute)`;
+      return `learning ${name}…`;
     case 'noted':
       return `kept as not ${name}; now hold ${name} and press Learn`;
     case 'failed':
@@ -55,7 +55,7 @@ export function learningText(m: LearningMessage): string {
       const r = m.report;
       if (!r) return `learned ${name}`;
       const not = r.notRate === null ? '' : `, on ${percent(r.notRate)} of what is not it`;
-      const overlap = r.overlap.slice(0, 2).map((o) => `${o.gesture} ${percent(o.rate)}`).join(', ');
+      const overlap = r.overlap.slice(0, 2).map((o) => `${o.gesture} ${percent(o.rate)}`).join(', ') || 'none';
       const saved = m.path ? `; saved to ${m.path}` : '';
       return `learned ${name}: recognised on ${percent(r.recall)} of its frames held back${not}; other gestures taken for it: ${overlap}; ${r.verdict}${saved}`;
     }

@@ -246,7 +246,7 @@ fn report(runs: &[Run], lags: &[LagScore]) -> Value {
         "max_slip_mm": mm(slip), "slip_pass": !grasps.is_empty() && slip <= SLIP_TARGET_M,
         "max_carry_lag_mm": mm(grasps.iter().map(|r| r.score.carry_lag_m).fold(0.0, f32::max)),
         "max_drop_drift_mm": mm(drift(Kind::Drop)), "max_set_down_drift_mm": mm(drift(Kind::Grasp).max(drift(Kind::Pinch))),
-        "drift_pass": drift(Kind::Drop) <= DRIFT_TARGET_M && runs.iter().any(|r| r.kind == Kind::Drop),
+        "drift_pass": drift(Kind::Drop) <= DRIFT_TARGET_M && runs.iter().any(|r| r.kind == Kind::Drop) && runs.iter().filter(|r| r.kind == Kind::Drop).all(|r| r.score.release_frames.is_some()),
         "release_frames": Distribution::of(&mut latency),
         "tunnelled": tunnelled, "tunnelling_pass": tunnelled == 0,
         "step_us": us(Distribution::of(&mut all_steps)), "teapot_step_us": us(teapot), "teapot_step_pass": teapot.is_some_and(|d| d.median * 1e6 <= STEP_TARGET_US),
@@ -315,7 +315,7 @@ fn print_tables(r: &Value) {
     let jitter = r["lag"].as_array().into_iter().flatten().map(|l| f(&l["jitter_mm"])).fold(0.0, f64::max);
     println!("rendered wrist behind the true one at 0.5 m/s ≤ 5 mm  {:>5.1} mm     {}", lag_at(0.5), pass(&r["lag_pass"]));
     println!("held and carried (0.5 m/s on average, eased): the rendered wrist falls behind by at most {:.1} mm more than at the carry's start", f(&r["max_carry_lag_mm"]));
-    println!("dropped by a still hand {} cm above the table, lands ≤ 1 cm across  {:>5.1} mm     {}  (set down: {:.1} mm)", DROP_M * 100.0, f(&r["max_drop_drift_mm"]), pass(&r["drift_pass"]), f(&r["max_set_down_drift_mm"]));
+    println!("dropped by a still hand {} cm above the table, ≤ 1 cm across half way down  {:>5.1} mm     {}  (set down: {:.1} mm)", DROP_M * 100.0, f(&r["max_drop_drift_mm"]), pass(&r["drift_pass"]), f(&r["max_set_down_drift_mm"]));
     println!("still hand's jitter, RMS ≤ 0.5 mm        {:>6.2} mm     {}", jitter, pass(&r["jitter_pass"]));
     println!("lag of a free hand swept at constant speed (1.5 mm joint noise): {}", lags.join(", "));
     println!("release latency: median {} frames, max {} frames; all objects: {:.0} µs a frame (median)", r["release_frames"]["median"], r["release_frames"]["max"], f(&r["step_us"]["median"]));

@@ -94,6 +94,11 @@ pub struct Frames {
 }
 
 impl Frames {
+    /// Frames kept, to train on and to check.
+    pub fn count(&self) -> usize {
+        self.fit.len() + self.check.len()
+    }
+
     /// Adds one recording's frames (times and features): `edge_s` cut from both ends (the
     /// hand moving into and out of the gesture), then split by time; `set` recognises them
     /// as the live input would.
@@ -231,7 +236,8 @@ pub fn learn(name: &str, gesture: &Frames, not: &Frames, generated: &Generated) 
     let mut overlap: Vec<(f64, &str)> = generated.held_out.iter().map(|(c, f)| (taken(f).0, *c)).collect();
     overlap.sort_by(|a, b| b.0.total_cmp(&a.0));
     let frames = (gesture.fit.len() + gesture.check.len()).max(1) as f64;
-    let already = gesture.shown.iter().max_by_key(|(_, n)| **n).map(|(g, n)| (*n as f64 / frames, g.clone()));
+    // The gesture it replaces (learned again under its name) is not a duplicate of it.
+    let already = gesture.shown.iter().filter(|(g, _)| *g != name).max_by_key(|(_, n)| **n).map(|(g, n)| (*n as f64 / frames, g.clone()));
     let report = Report { trained: (gesture.fit.len(), not.fit.len(), generated.tune.len()), recall, not_rate, overlap, already };
     Ok((classifier, report))
 }

@@ -34,6 +34,11 @@ use crate::learn_gesture::{learn, Frames, Generated, EDGE_S};
 pub const LEARNED_FILE: &str = "gestures-learned.json";
 /// How often the job looks whether the recording is over.
 const POLL: Duration = Duration::from_millis(50);
+/// Most frames of counter-examples kept for one gesture (about a minute of recording at
+/// 60 Hz): a page pressing Not it without end must not grow the server without end.
+const MAX_NOT_FRAMES: usize = 4000;
+/// Most gestures learned from the panel: each one is a classifier run on every record.
+const MAX_LEARNED: usize = 16;
 
 /// The viewers' gesture learning: the job now, and what every job reuses.
 pub struct LiveLearning {
@@ -127,7 +132,10 @@ pub fn start(feed: &Arc<Feed>, request: LearnRequest) -> anyhow::Result<()> {
         if let Job::Recording(r) | Job::Training(r) = &*job {
             anyhow::bail!("learn: still learning {:?}; wait for it to finish", r.name);
         }
-        anyhow::ensure!(feed.input.gesture_set().is_some(), "learn: this server does not recognise gestures");
+        let Some(set) = feed.input.gesture_set() else { anyhow::bail!("learn: this server does not recognise gestures") };
+        let learned = set.gestures().iter().filter(|g| g.model().is_some()).count();
+        let new = !set.gestures().iter().any(|g| g.name() == request.name);
+        anyhow::ensure!(request.not || !new || learned < MAX_LEARNED, "learn: {learned} gestures learned already (at most {MAX_LEARNED}); learn one again under its name to replace it");
         feed.input.capture(f64::from(request.seconds))?;
         *job = Job::Recording(request.clone());
         learning.version.fetch_add(1, Ordering::SeqCst);
@@ -142,7 +150,10 @@ pub fn start(feed: &Arc<Feed>, request: LearnRequest) -> anyhow::Result<()> {
     let feed = Arc::clone(feed);
     std::thread::spawn(move || {
         let learning = &feed.learning;
-        let outcome = run(&feed, &request);
+        // A panic in the job must not leave it "recording" for ever (every later learn
+        // would be refused): it fails like any error.
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&feed, &request)))
+            .unwrap_or_else(|_| Err(anyhow::anyhow!("learn {:?}: the job failed (an internal error; the server logged it)", request.name)));
         learning.set(match outcome {
             Ok(Some((report, path))) => Job::Learned(request, report, path),
             Ok(None) => Job::Noted(request),
@@ -171,6 +182,7 @@ fn run(feed: &Feed, request: &LearnRequest) -> anyhow::Result<Option<(Value, Opt
             _ => Frames::default(),
         };
         kept.add(frames, 0.0, &set).map_err(no_hand)?;
+        anyhow::ensure!(kept.count() <= MAX_NOT_FRAMES, "learn {:?}: {} frames of what it is not already; press Learn", request.name, MAX_NOT_FRAMES);
         *not = Some((request.name.clone(), kept));
         return Ok(None);
     }
@@ -185,15 +197,17 @@ fn run(feed: &Feed, request: &LearnRequest) -> anyhow::Result<Option<(Value, Opt
     let (classifier, report) = learn(&request.name, &gesture, &counter, generated)?;
     let mut set = set;
     set.insert_learned(&request.name, classifier)?;
+    let json = set.to_json() + "\n";
+    // Taken first, saved after: the file never holds a set that is not in use.
+    feed.input.set_gestures(set)?;
     let path = match &learning.directory {
         Some(dir) => {
             let path = dir.join(LEARNED_FILE);
-            std::fs::create_dir_all(dir).and_then(|()| std::fs::write(&path, set.to_json() + "\n")).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            std::fs::create_dir_all(dir).and_then(|()| std::fs::write(&path, json)).map_err(|e| anyhow::anyhow!("{}: {e} (it is recognised, but not saved)", path.display()))?;
             Some(path)
         }
         None => None,
     };
-    feed.input.set_gestures(set)?;
     Ok(Some((report.json(), path)))
 }
 

@@ -270,8 +270,11 @@ impl LiveInput {
     /// gesture; [`Self::captured`] hands them over once the time is up.
     ///
     /// # Errors
-    /// A recording already going on.
+    /// `seconds` not in (0, 60], or a recording already going on.
     pub fn capture(&self, seconds: f64) -> Result<()> {
+        if !(seconds > 0.0 && seconds <= 60.0) {
+            return Err(Error::Command(format!("learn: {seconds} seconds to record (more than 0, at most 60)")));
+        }
         let mut state = self.lock();
         if state.capture.is_some() {
             return Err(Error::Command("learn: the hand is already being recorded for learning".into()));

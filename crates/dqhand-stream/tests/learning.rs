@@ -45,6 +45,10 @@ fn a_capture_records_the_hand_features_and_a_new_set_is_taken_mid_input() {
     let sequence = generate(&SyntheticParams { seed: 5, holds: 6, idle_s: 1.0, ..SyntheticParams::default() }).unwrap();
     let (first, second) = sequence.records.split_at(sequence.records.len() / 2);
 
+    // A time that is not one is refused (NaN would never end).
+    for bad in [f64::NAN, 0.0, -1.0, 61.0, f64::INFINITY] {
+        assert!(input.capture(bad).unwrap_err().to_string().contains("seconds to record"), "{bad}");
+    }
     // Ten records recorded; nothing handed over before the time is up, once after it.
     input.capture(0.3).unwrap();
     assert!(input.capture(1.0).unwrap_err().to_string().contains("already being recorded"));

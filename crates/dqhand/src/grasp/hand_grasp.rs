@@ -25,7 +25,8 @@ pub struct GraspParams {
     /// 16 cm/s at a marble 10 cm from the wrist), which would roll a ball set down away or
     /// tip a dropped cube; a toss is faster.
     pub still_m_s: f32,
-    /// A wrist turning slower than this, rad/s, gives the object no spin.
+    /// A wrist turning slower than this, rad/s, gives the object no spin (and an object let
+    /// go slower than [`Self::still_m_s`] none either).
     pub still_rad_s: f32,
 }
 

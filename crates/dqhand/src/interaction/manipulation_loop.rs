@@ -99,7 +99,8 @@ impl ManipulationLoop {
     }
 
     /// Recognises `gestures` from now on ([`GestureLoop::set_gestures`]); the scene's actions
-    /// are bound to them by name.
+    /// (of a loop made with gestures: one made without has none bound) are bound to them by
+    /// name.
     ///
     /// # Errors
     /// A scene action naming a gesture `gestures` lacks; the loop is then unchanged.

@@ -18,10 +18,10 @@ pub const TABLE_FRICTION: f32 = 0.8;
 pub const TABLE_RESTITUTION: f32 = 0.3;
 
 /// The room's floor: the plane y = 0 (the scene files' table stands on it), so nothing that
-/// leaves the table falls for ever.
+/// leaves the table falls for ever; lower where a scene puts an object lower.
 pub const FLOOR_Y: f32 = 0.0;
 /// How far from the room's centre (the origin, across) an object may go before it is out of
-/// reach: put back where the scene file has it, m.
+/// reach: put back where the scene file has it, m; farther where a scene puts one farther.
 pub const REACH_M: f32 = 5.0;
 
 /// How near a joint of the hand's kinematic bodies must be to where it goes
@@ -51,6 +51,9 @@ pub struct ScenePhysics {
     hand: Vec<(RigidBodyHandle, usize)>,
     /// The objects the last step put back, out of reach ([`REACH_M`], or under the floor).
     returned: Vec<usize>,
+    /// The floor's height and the reach across, m (for this scene's objects).
+    floor: f32,
+    reach: f32,
 }
 
 impl ScenePhysics {
@@ -74,10 +77,16 @@ impl ScenePhysics {
         if let Some(slab) = colliders.table_collider() {
             world.insert_collider(ColliderBuilder::new(slab.solid.clone()).position(slab.pose).friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         }
-        let floor = ColliderBuilder::cuboid(2.0 * REACH_M, 0.5, 2.0 * REACH_M).translation(Vec3::new(0.0, FLOOR_Y - 0.5, 0.0));
-        world.insert_collider(floor.friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
+        // Under every object and beyond the farthest, whatever the scene file says.
+        let (floor, reach) = colliders.objects().iter().fold((FLOOR_Y, REACH_M), |(floor, reach), o| {
+            let b = o.aabb();
+            let across = Vec3::new(b.mins.x.abs().max(b.maxs.x.abs()), 0.0, b.mins.z.abs().max(b.maxs.z.abs())).length();
+            (floor.min(b.mins.y - 0.01), reach.max(across + 1.0))
+        });
+        let slab = ColliderBuilder::cuboid(2.0 * reach, 0.5, 2.0 * reach).translation(Vec3::new(0.0, floor - 0.5, 0.0));
+        world.insert_collider(slab.friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         let returned = Vec::with_capacity(bodies.len());
-        Self { world, bodies, initial, held: None, hand: Vec::new(), returned }
+        Self { world, bodies, initial, held: None, hand: Vec::new(), returned, floor, reach }
     }
 
     /// Adds the hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves.
@@ -178,7 +187,7 @@ impl ScenePhysics {
         self.returned.clear();
         for i in 0..self.bodies.len() {
             let p = self.world.bodies[self.bodies[i]].position().translation;
-            let out = Vec3::new(p.x, 0.0, p.z).length() > REACH_M || p.y < FLOOR_Y - 0.5;
+            let out = Vec3::new(p.x, 0.0, p.z).length() > self.reach || p.y < self.floor - 0.5;
             if out && self.held != Some(i) {
                 self.put_back(i);
                 self.returned.push(i);

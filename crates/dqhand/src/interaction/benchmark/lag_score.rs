@@ -51,5 +51,5 @@ pub fn lag(manip: &mut ManipulationLoop, sweep: &Sweep) -> LagScore {
     let lag_m = (lag / steady.max(1) as f64) as f32;
     let n = still.max(1) as f64;
     let variance = square / n - (sum / n).length_squared();
-    LagScore { speed: sweep.speed, lag_m, lag_s: lag_m / sweep.speed, jitter_m: variance.max(0.0).sqrt() as f32 }
+    LagScore { speed: sweep.speed, lag_m, lag_s: if sweep.speed > 0.0 { lag_m / sweep.speed } else { 0.0 }, jitter_m: variance.max(0.0).sqrt() as f32 }
 }
