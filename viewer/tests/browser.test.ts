@@ -400,7 +400,9 @@ describe('the viewer page with a scene', () => {
     // Back on the scene: the table and the objects again.
     await settle(p, 3);
     await expect.poll(drawn, { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
-  });
+    // Two polls of up to 30 s and the settles: more than the default 120 s when a whole
+    // suite has loaded the two cores (it timed out once there, never alone).
+  }, 240_000);
 });
 
 describe('the Input panel learns a gesture from the live hand', () => {
