@@ -25,7 +25,7 @@ pub use glove_csv::{GloveCsvReader, GloveCsvWriter};
 pub use glove_layout::{GloveLayout, Sensor, SensorKind, RAW_MAX};
 pub use glove_mapper::GloveMapper;
 pub use glove_mapping::{Coupling, MappingEntry, MappingTable};
-pub use one_euro::{Filtered, OneEuro, OneEuroFilter, OneEuroParams, OneEuroRotation, OneEuroVec3};
+pub use one_euro::{Filtered, OneEuro, OneEuroFilter, OneEuroParams, OneEuroRotation, OneEuroVec3, Velocity};
 pub use pipeline::{InputPipeline, Tracking, MAX_LEAD_S};
 pub use record::{GloveSample, HandData, JointSet, Record, RigidPose, TrackedJoint, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 pub use rejection::{RejectKind, Rejection, Rejections};
