@@ -375,7 +375,7 @@ describe('the viewer page with a scene', () => {
     // read the canvas between the state and the next drawn frame).
     await expect.poll(() => countColour(p, { r: [0, 120], g: [40, 190], b: [150, 255] }), { timeout: 30_000, interval: 500 }).toBeGreaterThan(200);
     await expect.poll(() => countColour(p, { r: [120, 230], g: [80, 180], b: [40, 130] }), { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
-  });
+  }, 240_000);
 
   test('shows the ball held while the scripted recording grasps it', async () => {
     // The state and the Input panel's line together (the ball is held for about 2 s of each pass).
@@ -383,7 +383,7 @@ describe('the viewer page with a scene', () => {
     expect((await p.evaluate(() => (window as unknown as { dqhand: { state(): { errors: string[] } } }).dqhand.state())).errors).toEqual([]);
     // Released again later in the recording.
     await waitState(p, 's.scene.held === null && document.getElementById("held").textContent === "—"', 60_000);
-  });
+  }, 240_000);
 
   test('frames the camera on a world point (make figures, Fig. 9)', async () => {
     type View = (preset: string | number[], focus?: string | number[], distance?: number) => void;
