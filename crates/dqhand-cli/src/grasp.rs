@@ -5,6 +5,9 @@
 //! A trace line:
 //! `{"t": s, "tracking": "ok"|"lost", "held": name|null, "contacts": [{"bone", "object",
 //! "p": [x,y,z], "n": [x,y,z]}], "objects": {"<name>": {"p": [x,y,z], "q": [x,y,z,w]}}}`.
+//! With `--left-model` the loop has two hands (records drive the hand of their side) and
+//! `tracking`, `held` and `contacts` are per hand: `{"left": …, "right": …}`; the meshes are
+//! `<frame>-left.ply` and `<frame>-right.ply`.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -14,8 +17,9 @@ use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::grasp::GraspParams;
 use dqhand::input::{Record, Tracking};
-use dqhand::interaction::ManipulationLoop;
-use dqhand::kinematics::JointModel;
+use dqhand::hand::HandParams;
+use dqhand::interaction::{ManipulatingHand, ManipulationLoop};
+use dqhand::kinematics::{JointModel, Side};
 use dqhand::scene::Scene;
 use dqhand::skin::{Method, MethodSet, SkinLayer};
 use serde_json::{json, Map, Value};
@@ -45,6 +49,10 @@ pub struct Args {
     /// The hand: `builtin` or a skinned glTF with WebXR joint names.
     #[arg(long, default_value = "builtin")]
     model: ModelSource,
+    /// A left hand beside `--model` (then a right one), for recordings of both hands:
+    /// `builtin` (the built-in hand built as a left hand) or a skinned glTF of a left hand.
+    #[arg(long)]
+    left_model: Option<ModelSource>,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -54,16 +62,27 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let joint_model = JointModel::Full;
     let mapper = Some(args.recording.common.mapper(joint_model)?);
     let mut reader = args.recording.reader()?;
-    let mut manip = ManipulationLoop::new(model, joint_model, mapper, args.recording.common.config()?, args.recording.recognition.set()?, &scene, GraspParams::default())?;
+    let (config, gestures) = (args.recording.common.config()?, args.recording.recognition.set()?);
+    let mut manip = match &args.left_model {
+        None => ManipulationLoop::new(model, joint_model, mapper, config, gestures, &scene, GraspParams::default())?,
+        Some(left) => {
+            let left = match left {
+                ModelSource::Builtin(params) => ModelSource::Builtin(HandParams { side: Side::Left, ..*params }),
+                file => file.clone(),
+            };
+            let left = Arc::new(left.load().with_context(|| format!("--left-model {left}"))?);
+            ManipulationLoop::two_handed([(left, mapper.clone()), (model, mapper)], joint_model, config, gestures, &scene, GraspParams::default())?
+        }
+    };
     for w in manip.objects().warnings() {
         eprintln!("dqhand: warning: {}: {w}", args.scene);
     }
-    let mut skin = SkinLayer::new(Arc::clone(&manip.input().model().mesh), MethodSet::DQB);
+    let mut skins: Vec<SkinLayer> = manip.hands().iter().map(|h| SkinLayer::new(Arc::clone(&h.input().model().mesh), MethodSet::DQB)).collect();
     if let Some(dir) = &args.meshes {
         std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     }
     let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
-    let names: Vec<String> = manip.rendered().skeleton().names().map(str::to_owned).collect();
+    let names: Vec<String> = manip.hands()[0].rendered().skeleton().names().map(str::to_owned).collect();
     let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None, arrival: None };
     let mut pending: Option<Record> = None;
     let (mut frame, mut refused) = (0u64, 0u64);
@@ -98,10 +117,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         write_frame(&mut trace, now, &manip, &names)?;
         if let Some(dir) = &args.meshes {
             if frame % args.every == 0 {
-                let path = dir.join(format!("{frame}.ply"));
-                skin.deform(manip.rendered().layer());
-                let mesh = skin.deformed(Method::Dqb).expect("DQB is the set");
-                dqhand::io::write_ply(&path, mesh.positions(), mesh.normals(), skin.mesh().indices())?;
+                for (hand, skin) in manip.hands().iter().zip(&mut skins) {
+                    let name = if manip.hands().len() == 1 { format!("{frame}.ply") } else { format!("{frame}-{}.ply", hand.side().name()) };
+                    skin.deform(hand.rendered().layer());
+                    let mesh = skin.deformed(Method::Dqb).expect("DQB is the set");
+                    dqhand::io::write_ply(&dir.join(name), mesh.positions(), mesh.normals(), skin.mesh().indices())?;
+                }
             }
         }
         frame += 1;
@@ -117,14 +138,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &[String]) -> anyhow::Result<()> {
     let names = manip.names();
-    let contacts: Vec<Value> = manip
-        .contacts()
-        .iter()
-        .map(|c| json!({"bone": joints[c.joint], "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array()}))
-        .collect();
+    let per_hand = |f: &dyn Fn(&ManipulatingHand) -> Value| match manip.hands() {
+        [one] => f(one),
+        hands => Value::Object(hands.iter().map(|h| (h.side().name().to_owned(), f(h))).collect()),
+    };
+    let contacts = per_hand(&|h| {
+        h.contacts().iter().map(|c| json!({"bone": joints[c.joint], "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array()})).collect()
+    });
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({"p": p.to_array(), "q": q.to_array()}))).collect();
-    let tracking = if manip.tracking() == Tracking::Tracking { "ok" } else { "lost" };
-    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": manip.held().map(|i| &manip.names()[i]), "contacts": contacts, "objects": objects}))?;
+    let tracking = per_hand(&|h| json!(if h.tracking() == Tracking::Tracking { "ok" } else { "lost" }));
+    let held = per_hand(&|h| json!(h.held().map(|i| &names[i])));
+    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": held, "contacts": contacts, "objects": objects}))?;
     out.write_all(b"\n")?;
     Ok(())
 }

@@ -418,13 +418,14 @@ const BOX_TRIANGLES: [u32; 36] = [
 #[must_use]
 pub fn scene_message(manip: &ManipulationLoop) -> String {
     let names = manip.names();
-    let joints = manip.rendered().skeleton().joints();
+    let hand = &manip.hands()[0];
+    let joints = hand.rendered().skeleton().joints();
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({ "p": p.to_array(), "q": q.to_array() }))).collect();
-    let contacts: Vec<Value> = manip
+    let contacts: Vec<Value> = hand
         .contacts()
         .iter()
         .take(MAX_SCENE_CONTACTS)
         .map(|c| json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() }))
         .collect();
-    json!({ "type": "scene", "held": manip.held().map(|i| &manip.names()[i]), "objects": objects, "contacts": contacts }).to_string()
+    json!({ "type": "scene", "held": hand.held().map(|i| &manip.names()[i]), "objects": objects, "contacts": contacts }).to_string()
 }

@@ -116,8 +116,8 @@ impl SceneState {
     fn step(&mut self, now: f64) {
         self.manip.step(now);
         self.stepped = now;
-        let (poses, contacts) = (self.manip.poses(), self.manip.contacts().len());
-        let held = self.manip.held();
+        let (poses, contacts) = (self.manip.poses(), self.manip.hands()[0].contacts().len());
+        let held = self.manip.hands()[0].held();
         if poses != self.poses.as_slice() || contacts + self.contacts > 0 || held != self.held {
             self.poses.copy_from_slice(poses);
             (self.contacts, self.held) = (contacts, held);
@@ -131,7 +131,7 @@ impl Driver {
     fn gestures(&self) -> &GestureLoop {
         match self {
             Driver::Gestures(g) => g,
-            Driver::Scene(s) => s.manip.input(),
+            Driver::Scene(s) => s.manip.hands()[0].input(),
         }
     }
 
@@ -154,7 +154,7 @@ impl Driver {
     fn pose(&self) -> &Pose {
         match self {
             Driver::Gestures(g) => g.pipeline().pose(),
-            Driver::Scene(s) => s.manip.constraint().rendered(),
+            Driver::Scene(s) => s.manip.hands()[0].constraint().rendered(),
         }
     }
 }
@@ -359,7 +359,7 @@ impl LiveInput {
             add(Entry::Action { t: record.time, gesture, action });
         }
         if let Driver::Scene(s) = driver {
-            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.input().gesture_index()) {
+            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.hands()[0].input().gesture_index()) {
                 add(Entry::Scene { t: record.time, gesture, command });
             }
             s.step(arrival);

@@ -29,14 +29,14 @@ fn main() -> Result<(), dqhand::Error> {
     for record in &script.records {
         // A scripted record is always good; a live one may be refused (counted, the hand kept).
         let _ = manipulation.push(record);
-        match manipulation.step(record.time) {
+        match manipulation.step(record.time).of(0) {
             Some(GraspEvent::Grasp { object }) => println!("{:6.2} s  grasped {}", record.time, manipulation.names()[object]),
             Some(GraspEvent::Release { object, linvel, .. }) => {
                 println!("{:6.2} s  released {} at {:.2} m/s", record.time, manipulation.names()[object], linvel.length());
             }
             None => {}
         }
-        held_frames += usize::from(manipulation.held() == Some(ball));
+        held_frames += usize::from(manipulation.hands()[0].held() == Some(ball));
     }
     let (_, at) = manipulation.poses()[ball];
     println!("held the ball for {held_frames} of {} frames; it rests at ({:.3}, {:.3}, {:.3}) m", script.records.len(), at.x, at.y, at.z);

@@ -48,14 +48,14 @@ fn run(scene: &Scene, script: &Script, mut each: impl FnMut(&mut ManipulationLoo
     let mut manip = ManipulationLoop::new(model(), JointModel::Full, None, InputConfig::default(), None, scene, GraspParams::default()).unwrap();
     for r in &script.records {
         manip.push(r).unwrap();
-        let e = manip.step(r.time);
+        let e = manip.step(r.time).of(0);
         each(&mut manip, r.time, e);
     }
 }
 
 /// The rendered hand of `m`'s last frame, skinned with DQB by `skin`.
 fn dqb<'a>(skin: &'a mut SkinLayer, m: &ManipulationLoop) -> &'a Deformed {
-    skin.deform(m.rendered().layer());
+    skin.deform(m.hands()[0].rendered().layer());
     skin.deformed(Method::Dqb).expect("DQB is the set")
 }
 
@@ -75,10 +75,10 @@ fn ball_and_teapot_are_picked_up_carried_and_set_down() {
         let mut final_pose = start;
         run(&scene, &s, |m, t, _| {
             if t > s.times.carry_start && t < s.times.carry_end {
-                held_during_carry &= m.held() == Some(i);
+                held_during_carry &= m.hands()[0].held() == Some(i);
             }
             if t > s.times.release + 0.6 {
-                assert_eq!(m.held(), None, "{name} let go at {t}");
+                assert_eq!(m.hands()[0].held(), None, "{name} let go at {t}");
             }
             final_pose = m.poses()[i].1;
         });
@@ -104,7 +104,7 @@ fn rendered_skin_stays_out_of_the_ball_the_tracked_hand_does_not() {
         for p in skin.positions() {
             rendered = rendered.max(depth(&ball.shape, centre, Vec3::from(*p)));
         }
-        let world = m.constraint().tracked_world();
+        let world = m.hands()[0].constraint().tracked_world();
         for w in world {
             tracked = tracked.max(depth(&ball.shape, centre, Vec3::from(w.translation)));
         }
@@ -136,27 +136,27 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
         for p in skin {
             deepest = deepest.max(benchmark::depth(teapot, Some(&flat), Vec3::from(p)));
         }
-        if m.held().is_some_and(|i| m.names()[i] == "teapot") {
+        if m.hands()[0].held().is_some_and(|i| m.names()[i] == "teapot") {
             held_frames += 1;
             // The teapot's orientation in the tracked wrist's frame: the grip must not turn it.
-            let wrist = m.constraint().tracked_world()[m.rendered().rig().wrist()];
+            let wrist = m.hands()[0].constraint().tracked_world()[m.hands()[0].rendered().rig().wrist()];
             let (_, r, _) = wrist.to_scale_rotation_translation();
             let here = r.inverse() * m.poses()[0].0;
             let first = *in_wrist.get_or_insert(here);
             turned = turned.max(first.angle_between(here));
             // Until the fingers open to let go, the joints touching stay where they are on it.
             let (q, p) = m.poses()[0];
-            let on_teapot = |j: usize| q.inverse() * (Vec3::from(m.constraint().world()[j].translation) - p);
+            let on_teapot = |j: usize| q.inverse() * (Vec3::from(m.hands()[0].constraint().world()[j].translation) - p);
             for &(j, was) in touching.iter().filter(|_| t < s.times.release) {
                 slid = slid.max(on_teapot(j).distance(was));
             }
-            touching = m.contacts().iter().filter(|c| c.object == 0).map(|c| (c.joint, on_teapot(c.joint))).collect();
+            touching = m.hands()[0].contacts().iter().filter(|c| c.object == 0).map(|c| (c.joint, on_teapot(c.joint))).collect();
             // Its contacts (kept from frame to frame while the grip holds still) are what a
             // fresh query of the joint's proxies finds: the same point and normal.
             let teapot = &m.objects().objects()[0];
-            for c in m.contacts() {
+            for c in m.hands()[0].contacts() {
                 let fresh = proxies.colliders().iter().filter(|p| p.joint == c.joint).filter_map(|p| {
-                    let pose = dqhand::collision::pose_of(&m.constraint().world()[p.joint]);
+                    let pose = dqhand::collision::pose_of(&m.hands()[0].constraint().world()[p.joint]);
                     parry3d::query::contact(&pose, &*p.shape, &teapot.pose, &*teapot.surface, dqhand::collision::CONTACT_DISTANCE).ok().flatten()
                 });
                 let miss = fresh.map(|f| (f.point2.distance(c.point), f.normal1.angle_between(-c.normal))).fold((f32::INFINITY, f32::INFINITY), |a, b| if b.0 < a.0 { b } else { a });
@@ -266,14 +266,16 @@ fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
         let mut physics = ScenePhysics::new(&scene, &objects);
         if with_hand {
             physics.add_hand(&proxies);
-            physics.move_hand(&world);
+            physics.move_hand(0, &world);
         }
         physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.74, 0.0));
         physics.step(1.0 / 60.0);
         physics.release(0, Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO);
         let mut deepest = 0.0f32;
         for _ in 0..60 {
-            physics.move_hand(&world);
+            if with_hand {
+                physics.move_hand(0, &world);
+            }
             physics.step(1.0 / 60.0);
             let at = parry3d::math::Pose::from_translation(physics.pose(0).1);
             for p in proxies.colliders() {
@@ -337,7 +339,7 @@ fn each_record_poses_the_tracked_and_the_rendered_hand_once() {
     let scene = scene("grasp");
     let s = script(&scene, &GraspTask::from_above("ball"));
     let mut m = ManipulationLoop::new(model(), JointModel::Full, None, InputConfig::default(), None, &scene, GraspParams::default()).unwrap();
-    let passes = |m: &ManipulationLoop| (m.input().kinematics().layer().passes(), m.rendered().layer().passes());
+    let passes = |m: &ManipulationLoop| (m.hands()[0].input().kinematics().layer().passes(), m.hands()[0].rendered().layer().passes());
     let mut held = 0;
     for r in &s.records {
         let before = passes(&m);
@@ -345,7 +347,7 @@ fn each_record_poses_the_tracked_and_the_rendered_hand_once() {
         m.step(r.time);
         let after = passes(&m);
         assert_eq!((after.0 - before.0, after.1 - before.1), (1, 1), "passes (tracked, rendered) for the record at {} s", r.time);
-        held += usize::from(m.held().is_some());
+        held += usize::from(m.hands()[0].held().is_some());
     }
     assert!(held > 30, "the ball was held in {held} frames: the count covers grasping too");
 }

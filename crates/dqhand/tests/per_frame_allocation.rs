@@ -113,8 +113,8 @@ fn a_scene_frame_allocates_only_inside_rapier_and_parry_a_bounded_few_times() {
             manip.step(record.time);
         });
         match phase {
-            "approach" | "resting on the ball" => assert_eq!(manip.held(), None, "frame {i}: {phase}"),
-            "carrying the ball" | "holding the ball still" => assert_eq!(manip.held(), Some(ball), "frame {i}: {phase}"),
+            "approach" | "resting on the ball" => assert_eq!(manip.hands()[0].held(), None, "frame {i}: {phase}"),
+            "carrying the ball" | "holding the ball still" => assert_eq!(manip.hands()[0].held(), Some(ball), "frame {i}: {phase}"),
             _ => {}
         }
         // The first frames make the loop's and rapier's buffers.
@@ -239,18 +239,18 @@ fn the_contact_constraint_allocates_nothing_per_frame() {
     let objects = ObjectColliders::new(&scene).unwrap();
     let script = grasp_script::grasp(model.clone(), "grasp", &objects, &GraspTask::from_above("ball"), Side::Right).unwrap();
     let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, InputConfig::default(), None, &scene, GraspParams::default()).unwrap();
-    let tracked = manip.input().kinematics().clone();
+    let tracked = manip.hands()[0].input().kinematics().clone();
     let mut constraint = ContactConstraint::new(HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), tracked.skeleton()), tracked);
     let (mut allocated, mut touching) = (0, 0);
     for (i, r) in script.records.iter().enumerate() {
         manip.push(r).unwrap();
-        if let Some(dqhand::grasp::GraspEvent::Grasp { object }) = manip.step(r.time) {
+        if let Some(dqhand::grasp::GraspEvent::Grasp { object }) = manip.step(r.time).of(0) {
             // As the loop does: the rendered hand keeps its grip on what it holds.
             constraint.grip(object, &manip.objects().objects()[object].pose);
         }
         let before = allocations();
-        constraint.track(manip.input().pipeline().pose(), manip.input().kinematics().world());
-        let held = manip.held();
+        constraint.track(manip.hands()[0].input().pipeline().pose(), manip.hands()[0].input().kinematics().world());
+        let held = manip.hands()[0].held();
         constraint.solve(manip.objects(), held, r.time);
         if i > 0 {
             allocated += allocations() - before;

@@ -28,11 +28,15 @@ pub struct GraspParams {
     /// A wrist turning slower than this, rad/s, gives the object no spin (and an object let
     /// go slower than [`Self::still_m_s`] none either).
     pub still_rad_s: f32,
+    /// Two hands holding an object between them (neither alone) let go when their contacts
+    /// are carried this much farther apart than at the grasp, m: the user pulls the hands
+    /// apart. Squeezing brings them closer (the tracked palms go into the object).
+    pub apart_m: f32,
 }
 
 impl Default for GraspParams {
     fn default() -> Self {
-        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5, still_m_s: 0.25, still_rad_s: 2.0 }
+        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5, still_m_s: 0.25, still_rad_s: 2.0, apart_m: 0.015 }
     }
 }
 
@@ -73,8 +77,11 @@ struct Held {
     /// The anchors at the grasp ([`Held::place`]).
     reference: [Vec3; MAX_ANCHORS + 4],
     current: [Vec3; MAX_ANCHORS + 4],
-    /// The object's pose at the grasp.
+    /// The object's pose at the grasp (or when the other hand last let go of it).
     start: (Quat, Vec3),
+    /// Whether this hand's own grasp holds the object (thumb or palm against a finger), not
+    /// only its share of a two-hand hold.
+    alone: bool,
     /// The grasping fingers (thumb first) and the most their rendered closures (summed) have
     /// wrapped the object since the grasp: the tracked ones must open past it to release.
     fingers: [bool; 5],
@@ -135,7 +142,7 @@ impl Grasp {
         held.lost_since = None;
         held.closure = held.closure.max(grasping(closure, held.fingers, |c| c.rendered));
         let count = held.fingers.iter().filter(|g| **g).count() as f32;
-        if grasping(closure, held.fingers, |c| c.tracked) < held.closure - self.params.release_deg.to_radians() * count {
+        if held.alone && grasping(closure, held.fingers, |c| c.tracked) < held.closure - self.params.release_deg.to_radians() * count {
             return Some(self.release(now, true));
         }
         let n = held.count;
@@ -166,6 +173,41 @@ impl Grasp {
             return None;
         }
         let object = self.find_grasp(now, contacts, closure)?;
+        Some(self.take(now, object, objects[object], true, contacts, closure, rendered_world, tracked_world, wrist))
+    }
+
+    /// The object two free hands hold between them, if any: a pressing contact of each
+    /// ([`Self::detect`]'s rule for one contact: a palm, or a finger squeezed past its rendered
+    /// copy) on it, their normals opposed. Neither hand need hold it alone: two flat palms
+    /// pressing a large box from either side carry it.
+    #[must_use]
+    pub fn find_two_handed(now: f64, a: (&Grasp, &[Contact], &[Closure; 5]), b: (&Grasp, &[Contact], &[Closure; 5])) -> Option<usize> {
+        if a.0.held.is_some() || b.0.held.is_some() {
+            return None;
+        }
+        let opposed = a.0.params.opposition_deg.to_radians().cos();
+        let ready = |g: &Grasp, o: usize| now >= g.cooldown_until[o];
+        a.1.iter().filter(|c| a.0.pressing(c, a.2) && ready(a.0, c.object) && ready(b.0, c.object)).find_map(|ca| {
+            b.1.iter().any(|cb| cb.object == ca.object && b.0.pressing(cb, b.2) && ca.normal.dot(cb.normal) <= opposed).then_some(ca.object)
+        })
+    }
+
+    /// Takes hold of `object`, at `pose` now, by `contacts` (see [`Self::detect`]); `alone`:
+    /// this hand's grasp holds it by itself, else only with the other hand's. Allocates
+    /// nothing.
+    #[allow(clippy::too_many_arguments)]
+    pub fn take(
+        &mut self,
+        now: f64,
+        object: usize,
+        pose: (Quat, Vec3),
+        alone: bool,
+        contacts: &[Contact],
+        closure: &[Closure; 5],
+        rendered_world: &[Affine3A],
+        tracked_world: &[Affine3A],
+        wrist: usize,
+    ) -> GraspEvent {
         let mut held = Held {
             object,
             wrist,
@@ -173,11 +215,12 @@ impl Grasp {
             count: 0,
             reference: [Vec3::ZERO; MAX_ANCHORS + 4],
             current: [Vec3::ZERO; MAX_ANCHORS + 4],
-            start: objects[object],
+            start: pose,
+            alone,
             fingers: [false; 5],
             closure: 0.0,
             lost_since: None,
-            target: objects[object],
+            target: pose,
             history: [(now, Quat::IDENTITY, Vec3::ZERO); HISTORY],
             filled: 0,
         };
@@ -193,23 +236,78 @@ impl Grasp {
             held.count += 1;
         }
         place(&held.anchors[..held.count], wrist, tracked_world, rendered_world, &mut held.reference);
+        held.current = held.reference;
         held.closure = grasping(closure, held.fingers, |c| c.rendered);
         held.remember(now, &tracked_world[wrist]);
         self.held = Some(held);
-        Some(GraspEvent::Grasp { object })
+        GraspEvent::Grasp { object }
+    }
+
+    /// Whether this hand's grasp holds its object by itself ([`Self::take`]).
+    #[must_use]
+    pub fn alone(&self) -> bool {
+        self.held.as_ref().is_some_and(|h| h.alone)
+    }
+
+    /// The held object's holding points: each in the object's frame, and where the hand
+    /// carries it this frame (after [`Self::follow`]). Both hands' together give a two-hand
+    /// hold's best rigid fit.
+    pub fn holding_points(&self) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
+        self.held.iter().flat_map(|h| {
+            let (q, t) = h.start;
+            let to_object = q.inverse();
+            h.reference[..h.count].iter().zip(&h.current[..h.count]).map(move |(r, c)| (to_object * (*r - t), *c))
+        })
+    }
+
+    /// Where this hand's contacts on the held object are carried this frame (their mean), if
+    /// it holds one: how far apart two hands holding it between them are.
+    #[must_use]
+    pub fn contact_centre(&self) -> Option<Vec3> {
+        let h = self.held.as_ref()?;
+        let n = h.count - WRIST_POINTS.len();
+        (n > 0).then(|| h.current[..n].iter().copied().sum::<Vec3>() / n as f32)
+    }
+
+    /// The held object goes to `pose` this frame: both hands' fit, not this hand's alone.
+    pub fn set_target(&mut self, pose: (Quat, Vec3)) {
+        if let Some(h) = &mut self.held {
+            h.target = pose;
+        }
+    }
+
+    /// The held object, at `pose`, is now held from where the hand holds it this frame (the
+    /// other hand let go of it): it stays put instead of jumping to this hand's own fit since
+    /// its grasp.
+    pub fn rebase(&mut self, pose: (Quat, Vec3)) {
+        if let Some(h) = &mut self.held {
+            h.start = pose;
+            h.target = pose;
+            h.reference = h.current;
+        }
+    }
+
+    /// Lets go of the held object now (the other hand let go of a two-hand hold, or the two
+    /// hands drew apart), with the hand's velocity when `moving`.
+    pub fn let_go(&mut self, now: f64, moving: bool) -> Option<GraspEvent> {
+        self.held.is_some().then(|| self.release(now, moving))
+    }
+
+    /// Whether `c` presses on its object: a palm always does, a finger when it is tracked
+    /// closed past its rendered copy by [`GraspParams::press_deg`].
+    fn pressing(&self, c: &Contact, closure: &[Closure; 5]) -> bool {
+        match c.part {
+            HandPart::Palm => true,
+            HandPart::Finger(f) => closure[f].tracked - closure[f].rendered >= self.params.press_deg.to_radians(),
+        }
     }
 
     /// The object the contacts grasp, if any: a pressing thumb or palm contact and a pressing
     /// finger contact on it, with opposing normals.
     fn find_grasp(&self, now: f64, contacts: &[Contact], closure: &[Closure; 5]) -> Option<usize> {
-        let press = self.params.press_deg.to_radians();
         let opposed = self.params.opposition_deg.to_radians().cos();
-        let pressing = |c: &Contact| match c.part {
-            HandPart::Palm => true,
-            HandPart::Finger(f) => closure[f].tracked - closure[f].rendered >= press,
-        };
-        let thumb_side = |c: &&Contact| matches!(c.part, HandPart::Palm | HandPart::Finger(0)) && pressing(c);
-        let finger = |c: &&Contact| matches!(c.part, HandPart::Finger(1..)) && pressing(c);
+        let thumb_side = |c: &&Contact| matches!(c.part, HandPart::Palm | HandPart::Finger(0)) && self.pressing(c, closure);
+        let finger = |c: &&Contact| matches!(c.part, HandPart::Finger(1..)) && self.pressing(c, closure);
         contacts.iter().filter(thumb_side).find_map(|a| {
             let ok = now >= self.cooldown_until[a.object]
                 && contacts.iter().filter(finger).any(|b| b.object == a.object && a.normal.dot(b.normal) <= opposed);

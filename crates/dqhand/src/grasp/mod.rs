@@ -19,6 +19,12 @@
 //!   grasp can begin with fingers resting on the object open, and they cannot open further.
 //!   The object is then not grasped again for [`GraspParams::cooldown_s`]. It
 //!   leaves with the hand's velocity over the last frames, so a throw flies.
+//! * **Two hands.** Either hand grasps by itself; a hand may grasp what the other holds, and
+//!   the object then follows the best rigid fit of both hands' holding points. A free pair of
+//!   hands also grasps an object between them: a pressing contact of each (a palm, or a
+//!   squeezing finger) with opposing normals ([`Grasp::find_two_handed`]); such a hold lets go
+//!   when the hands draw [`GraspParams::apart_m`] apart. When one hand lets go, the other keeps
+//!   the object if its own grasp holds it ([`Grasp::alone`]; a hand-over), else drops it too.
 //! * **Tracking loss.** A held object stays where it is while tracking is lost, and drops
 //!   after [`GraspParams::loss_grace_s`].
 

@@ -14,100 +14,148 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
-use super::{CommandTable, GestureLoop};
-use crate::collision::{fit_proxies, Contact, ContactConstraint, HandProxies, ObjectColliders, PROXY_MARGIN};
+use super::ManipulatingHand;
+use crate::collision::ObjectColliders;
 use crate::gesture::{Events, GestureSet};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
-use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
-use crate::kinematics::{HandKinematics, JointModel};
+use crate::input::{GloveMapper, InputConfig, Record, Rejection};
+use crate::kinematics::JointModel;
+use crate::math::rigid_fit;
 use crate::model::Model;
 use crate::physics::ScenePhysics;
-use crate::scene::{Scene, SceneAction, SceneCommand};
-use crate::Result;
+use crate::scene::{Scene, SceneCommand};
+use crate::{Error, Result};
 
 /// The longest physics step taken at once, s: a stall in the records must not launch objects.
 const MAX_STEP_S: f64 = 1.0 / 30.0;
 
-/// One hand manipulating one scene.
+/// Most holding points of one object: both hands' ([`Grasp::holding_points`]).
+const MAX_HOLDING_POINTS: usize = 48;
+
+/// What a frame changed, per hand (in [`ManipulationLoop::hands`] order).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HandEvents([Option<GraspEvent>; 2]);
+
+impl HandEvents {
+    /// Hand `hand`'s grasp or release this frame.
+    #[must_use]
+    pub fn of(&self, hand: usize) -> Option<GraspEvent> {
+        self.0.get(hand).copied().flatten()
+    }
+
+    /// Every hand's event: (hand, event).
+    pub fn iter(&self) -> impl Iterator<Item = (usize, GraspEvent)> + '_ {
+        self.0.iter().enumerate().filter_map(|(k, e)| e.map(|e| (k, e)))
+    }
+}
+
+/// One or two hands manipulating one scene.
 pub struct ManipulationLoop {
-    input: GestureLoop,
-    scene_commands: Option<CommandTable<SceneAction>>,
+    hands: Vec<ManipulatingHand>,
     /// The scene command the last record triggered.
     command: Option<SceneCommand>,
     objects: ObjectColliders,
     names: Vec<String>,
-    constraint: ContactConstraint,
-    grasp: Grasp,
     physics: ScenePhysics,
     poses: Vec<(Quat, Vec3)>,
+    params: GraspParams,
+    /// How far apart the two hands' contacts were when they took an object between them.
+    between: f32,
     last: Option<f64>,
     reset_due: bool,
-    was_tracking: bool,
 }
 
 impl ManipulationLoop {
     /// A loop posing `model` with `joint_model` from records (as [`GestureLoop::new`]) in
-    /// `scene`. With `gestures`, the scene's actions are commands.
+    /// `scene`: one hand, which records of either side drive (the other side mirrored, as
+    /// the [`crate::input::Retargeter`] does). With `gestures`, the scene's actions are
+    /// commands.
     ///
     /// # Errors
     /// As [`GestureLoop::new`]; as [`ObjectColliders::new`] for the scene's meshes; a scene
     /// action naming a gesture not recognised ([`CommandTable::new`]).
+    ///
+    /// [`GestureLoop::new`]: super::GestureLoop::new
+    /// [`CommandTable::new`]: super::CommandTable::new
     pub fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
-        let input = GestureLoop::new(model.clone(), joint_model, glove, config, gestures)?;
-        let scene_commands = match input.gestures() {
-            Some(set) if !scene.actions.is_empty() => Some(CommandTable::new(&scene.actions, set)?),
-            _ => None,
-        };
-        let rendered = input.kinematics().clone();
-        let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rendered.skeleton());
-        let constraint = ContactConstraint::new(proxies.clone(), rendered);
+        Self::with_hands(vec![(model, glove)], joint_model, config, gestures, scene, params)
+    }
+
+    /// A loop of two hands: `hands`, a left and a right model each built as itself (and the
+    /// glove mapping of each, if gloves drive them); a record drives the hand of its side.
+    /// Each hand grasps by itself; both hold what they grasp together (see [`crate::grasp`]).
+    ///
+    /// # Errors
+    /// As [`Self::new`]; two models of one side.
+    pub fn two_handed(hands: [(Arc<Model>, Option<GloveMapper>); 2], joint_model: JointModel, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
+        let manip = Self::with_hands(hands.into(), joint_model, config, gestures, scene, params)?;
+        let [a, b] = [0, 1].map(|k| manip.hands[k].side());
+        if a == b {
+            return Err(Error::HandParameter(format!("two hands must be a left and a right one; both are {}", a.name())));
+        }
+        Ok(manip)
+    }
+
+    fn with_hands(models: Vec<(Arc<Model>, Option<GloveMapper>)>, joint_model: JointModel, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
         let objects = ObjectColliders::new(scene)?;
         let mut physics = ScenePhysics::new(scene, &objects);
-        physics.add_hand(&proxies);
-        let n = scene.objects.len();
-        let poses = (0..n).map(|i| physics.pose(i)).collect();
+        let hands = models
+            .into_iter()
+            .map(|(model, glove)| ManipulatingHand::new(model, joint_model, glove, config.clone(), gestures.clone(), scene, params, &mut physics))
+            .collect::<Result<Vec<_>>>()?;
+        let poses = (0..scene.objects.len()).map(|i| physics.pose(i)).collect();
         Ok(Self {
-            input,
-            scene_commands,
+            hands,
             command: None,
             names: scene.objects.iter().map(|o| o.name.clone()).collect(),
             objects,
-            constraint,
-            grasp: Grasp::new(params, n),
             physics,
             poses,
+            params,
+            between: 0.0,
             last: None,
             reset_due: false,
-            was_tracking: false,
         })
     }
 
-    /// Takes one record (as [`GestureLoop::push`]) and returns the gesture events
-    /// it caused; a scene action its gesture completes ([`Self::command`]) is carried out at
-    /// the next [`Self::step`]. Allocates nothing.
+    /// The hand a record of `side` drives: the one of that side, the only one in a loop of
+    /// one.
+    #[must_use]
+    pub fn hand_of(&self, side: crate::kinematics::Side) -> usize {
+        self.hands.iter().position(|h| h.side() == side).filter(|_| self.hands.len() > 1).unwrap_or(0)
+    }
+
+    /// Takes one record (as [`GestureLoop::push`]) into the hand of its side
+    /// ([`Self::hand_of`]) and returns the gesture events it caused there; a scene action its
+    /// gesture completes ([`Self::command`]) is carried out at the next [`Self::step`].
+    /// Allocates nothing.
     ///
     /// # Errors
     /// The record's refusal; the hand keeps its pose.
+    ///
+    /// [`GestureLoop::push`]: super::GestureLoop::push
     pub fn push(&mut self, record: &Record) -> std::result::Result<Events<'_>, Rejection> {
         self.command = None;
-        let events = self.input.push(record)?;
-        if let Some(table) = &mut self.scene_commands {
-            self.command = table.update(record.time, events.clone());
-            self.reset_due |= self.command == Some(SceneCommand::Reset);
-        }
+        let k = self.hand_of(record.side);
+        let (events, command) = self.hands[k].push(record)?;
+        self.command = command;
+        self.reset_due |= command == Some(SceneCommand::Reset);
         Ok(events)
     }
 
-    /// Recognises `gestures` from now on ([`GestureLoop::set_gestures`]); the scene's actions
-    /// (of a loop made with gestures: one made without has none bound) are bound to them by
-    /// name.
+    /// Recognises `gestures` from now on ([`GestureLoop::set_gestures`]) on every hand; the
+    /// scene's actions (of a loop made with gestures: one made without has none bound) are
+    /// bound to them by name.
     ///
     /// # Errors
     /// A scene action naming a gesture `gestures` lacks; the loop is then unchanged.
+    ///
+    /// [`GestureLoop::set_gestures`]: super::GestureLoop::set_gestures
     pub fn set_gestures(&mut self, gestures: GestureSet) -> Result<()> {
-        let scene_commands = self.scene_commands.as_ref().map(|t| t.rebind(&gestures)).transpose()?;
-        self.input.set_gestures(gestures);
-        self.scene_commands = scene_commands;
+        let tables = self.hands.iter().map(|h| h.rebind(&gestures)).collect::<Result<Vec<_>>>()?;
+        for (hand, table) in self.hands.iter_mut().zip(tables) {
+            hand.set_gestures(gestures.clone(), table);
+        }
         Ok(())
     }
 
@@ -117,9 +165,10 @@ impl ManipulationLoop {
         self.command
     }
 
-    /// Counts a record refused before it reached the loop.
+    /// Counts a record refused before it reached the loop (against the first hand: a refused
+    /// record's side is not to be trusted).
     pub fn reject(&mut self, rejection: Rejection) {
-        self.input.reject(rejection);
+        self.hands[0].reject(rejection);
     }
 
     /// Puts every object back where the scene file has it, at rest, and lets go.
@@ -128,50 +177,76 @@ impl ManipulationLoop {
     }
 
     /// One frame at `now` (s; the records' clock): see the module documentation. Returns
-    /// the grasp or release it caused. Its own work allocates nothing; rapier's step inside
-    /// it allocates a few times a frame.
-    pub fn step(&mut self, now: f64) -> Option<GraspEvent> {
-        self.input.advance(now);
+    /// the grasps and releases it caused. Its own work allocates nothing; rapier's step
+    /// inside it allocates a few times a frame.
+    pub fn step(&mut self, now: f64) -> HandEvents {
         let dt = self.last.map_or(1.0 / 60.0, |last| (now - last).clamp(0.0, MAX_STEP_S));
         self.last = Some(now);
         if std::mem::take(&mut self.reset_due) {
             self.physics.reset();
-            self.grasp.clear();
-            self.constraint.restart();
+            self.hands.iter_mut().for_each(ManipulatingHand::reset);
             self.read_poses();
         }
-        let tracking = self.tracking() == Tracking::Tracking;
-        if tracking && !self.was_tracking {
-            // Tracking came back (or began): the rendered hand starts from the tracked one.
-            self.constraint.restart();
+        let mut events = HandEvents::default();
+        for (k, hand) in self.hands.iter_mut().enumerate() {
+            events.0[k] = hand.follow(now);
         }
-        self.was_tracking = tracking;
-        let tracked = self.input.kinematics();
-        self.constraint.track(self.input.pipeline().pose(), tracked.world());
-        let mut event = self.grasp.follow(now, tracking, self.constraint.closure(), self.constraint.tracked_world(), self.constraint.world());
-        if let Some((q, t)) = self.grasp.target() {
-            let held = self.grasp.held().expect("a target is a held object's");
-            let t = self.objects.above_table(held, q, t);
-            self.objects.set_pose(held, q, t);
-            self.poses[held] = (q, t);
+        if let [a, b] = &mut self.hands[..] {
+            share(now, [a, b], &self.poses, self.between + self.params.apart_m, &mut events);
         }
-        self.constraint.solve(&self.objects, self.grasp.held(), now);
-        if event.is_none() {
-            event = self.grasp.detect(now, tracking, self.constraint.contacts(), self.constraint.closure(), self.constraint.world(), self.constraint.tracked_world(), tracked.rig().wrist(), &self.poses);
+        for hand in &self.hands {
+            if let (Some(held), Some((q, t))) = (hand.grasp.held(), hand.grasp.target()) {
+                let t = self.objects.above_table(held, q, t);
+                self.objects.set_pose(held, q, t);
+                self.poses[held] = (q, t);
+            }
         }
-        match event {
-            Some(GraspEvent::Grasp { object }) => self.constraint.grip(object, &self.objects.objects()[object].pose),
-            Some(GraspEvent::Release { object, linvel, angvel }) => self.physics.release(object, linvel, angvel),
-            None => {}
+        for (k, hand) in self.hands.iter_mut().enumerate() {
+            let detected = hand.solve(now, &self.objects, &self.poses, events.0[k].is_none());
+            events.0[k] = events.0[k].or(detected);
         }
-        if let Some(held) = self.grasp.held() {
-            let (q, t) = self.poses[held];
-            self.physics.hold(held, q, t);
+        if let [a, b] = &mut self.hands[..] {
+            let (ca, cb) = (&a.constraint, &b.constraint);
+            if let Some(object) = events.0.iter().all(Option::is_none).then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure()), (&b.grasp, cb.contacts(), cb.closure()))).flatten() {
+                let pose = self.poses[object];
+                events.0 = [a.take_with_other(now, object, pose), b.take_with_other(now, object, pose)].map(Some);
+                self.between = a.grasp.contact_centre().zip(b.grasp.contact_centre()).map_or(0.0, |(p, q)| p.distance(q));
+            }
         }
-        self.physics.move_hand(self.constraint.world());
+        self.apply(&events);
+        for hand in &self.hands {
+            hand.place(&mut self.physics);
+        }
         self.physics.step(dt as f32);
         self.read_poses();
-        event
+        events
+    }
+
+    /// The frame's grasps and releases into the rendered hands and the physics: an object
+    /// no hand holds any more leaves with the velocity its hands gave it (their mean).
+    fn apply(&mut self, events: &HandEvents) {
+        let mut released: [Option<(usize, Vec3, Vec3, f32)>; 2] = [None; 2];
+        for (k, event) in events.iter() {
+            match event {
+                GraspEvent::Grasp { object } => self.hands[k].constraint.grip(object, &self.objects.objects()[object].pose),
+                GraspEvent::Release { object, linvel, angvel } if self.hands.iter().all(|h| h.grasp.held() != Some(object)) => {
+                    match released.iter_mut().flatten().find(|r| r.0 == object) {
+                        Some(r) => *r = (object, r.1 + linvel, r.2 + angvel, r.3 + 1.0),
+                        None => released[k] = Some((object, linvel, angvel, 1.0)),
+                    }
+                }
+                GraspEvent::Release { .. } => {}
+            }
+        }
+        for (object, linvel, angvel, n) in released.into_iter().flatten() {
+            self.physics.release(object, linvel / n, angvel / n);
+        }
+        for hand in &self.hands {
+            if let Some(held) = hand.grasp.held() {
+                let (q, t) = self.poses[held];
+                self.physics.hold(held, q, t);
+            }
+        }
     }
 
     fn read_poses(&mut self) {
@@ -182,10 +257,10 @@ impl ManipulationLoop {
         }
     }
 
-    /// Whether the hand is tracked.
+    /// The hands: one, or a left and a right one in the order given.
     #[must_use]
-    pub fn tracking(&self) -> Tracking {
-        self.input.pipeline().tracking()
+    pub fn hands(&self) -> &[ManipulatingHand] {
+        &self.hands
     }
 
     /// The objects the last [`Self::step`] put back where the scene file has them, because
@@ -194,18 +269,6 @@ impl ManipulationLoop {
     #[must_use]
     pub fn returned(&self) -> &[usize] {
         self.physics.returned()
-    }
-
-    /// The object held, if any: its index in scene order (its name in [`Self::names`]).
-    #[must_use]
-    pub fn held(&self) -> Option<usize> {
-        self.grasp.held()
-    }
-
-    /// The rendered hand's contacts after the last frame.
-    #[must_use]
-    pub fn contacts(&self) -> &[Contact] {
-        self.constraint.contacts()
     }
 
     /// The objects' names, in scene order.
@@ -226,22 +289,41 @@ impl ManipulationLoop {
         &self.objects
     }
 
-    /// The contact constraint (the tracked and rendered poses, finger closures).
-    #[must_use]
-    pub fn constraint(&self) -> &ContactConstraint {
-        &self.constraint
-    }
+}
 
-    /// The rendered hand's kinematics layer, posed once per frame by the contact constraint:
-    /// what a [`crate::skin::SkinLayer`] deforms for the hand the user sees.
-    #[must_use]
-    pub fn rendered(&self) -> &HandKinematics {
-        self.constraint.kinematics()
+/// Two hands on one object: when one lets go the other keeps it (rebased where it is) if
+/// its grasp holds it alone, else lets go too; two hands that hold it between them let
+/// go when their contacts are farther apart than `apart`; else the object takes the best rigid fit of both hands' points.
+fn share(now: f64, [a, b]: [&mut ManipulatingHand; 2], poses: &[(Quat, Vec3)], apart: f32, events: &mut HandEvents) {
+    for k in 0..2 {
+        let other = if k == 0 { &mut *b } else { &mut *a };
+        if let Some(GraspEvent::Release { object, .. }) = events.0[k] {
+            if other.grasp.held() == Some(object) {
+                if other.grasp.alone() {
+                    other.grasp.rebase(poses[object]);
+                } else {
+                    events.0[1 - k] = other.grasp.let_go(now, true);
+                }
+            }
+        }
     }
-
-    /// The gesture loop under it (pipeline, recognised gesture).
-    #[must_use]
-    pub fn input(&self) -> &GestureLoop {
-        &self.input
+    if a.grasp.held().is_none() || a.grasp.held() != b.grasp.held() {
+        return;
     }
+    if !a.grasp.alone() && !b.grasp.alone() {
+        let gap = a.grasp.contact_centre().zip(b.grasp.contact_centre()).map_or(0.0, |(p, q)| p.distance(q));
+        if gap > apart {
+            events.0 = [a.grasp.let_go(now, true), b.grasp.let_go(now, true)];
+            return;
+        }
+    }
+    let (mut from, mut to) = ([Vec3::ZERO; MAX_HOLDING_POINTS], [Vec3::ZERO; MAX_HOLDING_POINTS]);
+    let mut n = 0;
+    for (p, q) in a.grasp.holding_points().chain(b.grasp.holding_points()).take(MAX_HOLDING_POINTS) {
+        (from[n], to[n]) = (p, q);
+        n += 1;
+    }
+    let fit = rigid_fit(&from[..n], &to[..n]);
+    a.grasp.set_target(fit);
+    b.grasp.set_target(fit);
 }

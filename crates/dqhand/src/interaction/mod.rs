@@ -17,6 +17,7 @@ pub mod gesture_examples;
 mod gesture_loop;
 #[cfg(feature = "synthetic")]
 pub mod grasp_script;
+mod manipulating_hand;
 mod manipulation_loop;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
@@ -25,4 +26,5 @@ pub mod variation;
 
 pub use command_table::{CommandRow, CommandTable};
 pub use gesture_loop::GestureLoop;
-pub use manipulation_loop::ManipulationLoop;
+pub use manipulating_hand::ManipulatingHand;
+pub use manipulation_loop::{HandEvents, ManipulationLoop};

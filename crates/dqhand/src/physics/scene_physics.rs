@@ -44,11 +44,12 @@ pub struct ScenePhysics {
     bodies: Vec<RigidBodyHandle>,
     /// Where the file puts each object.
     initial: Vec<Pose>,
-    held: Option<usize>,
-    /// The rendered hand's proxies as kinematic bodies, with their joints: a free object
-    /// meets the hand (a released ball rests on the fingers, a rolling one stops at them)
-    /// instead of passing into it.
-    hand: Vec<(RigidBodyHandle, usize)>,
+    /// Per object, whether a hand holds it (it moves kinematically).
+    held: Vec<bool>,
+    /// Each rendered hand's proxies as kinematic bodies, with their joints: a free object
+    /// meets the hands (a released ball rests on the fingers, a rolling one stops at them)
+    /// instead of passing into them.
+    hands: Vec<Vec<(RigidBodyHandle, usize)>>,
     /// The objects the last step put back, out of reach ([`REACH_M`], or under the floor).
     returned: Vec<usize>,
     /// The floor's height and the reach across, m (for this scene's objects).
@@ -86,25 +87,31 @@ impl ScenePhysics {
         let slab = ColliderBuilder::cuboid(2.0 * reach, 0.5, 2.0 * reach).translation(Vec3::new(0.0, floor - 0.5, 0.0));
         world.insert_collider(slab.friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         let returned = Vec::with_capacity(bodies.len());
-        Self { world, bodies, initial, held: None, hand: Vec::new(), returned, floor, reach }
+        Self { world, held: vec![false; bodies.len()], bodies, initial, hands: Vec::new(), returned, floor, reach }
     }
 
-    /// Adds the hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves.
-    pub fn add_hand(&mut self, proxies: &HandProxies) {
-        for p in proxies.colliders() {
-            let body = RigidBodyBuilder::kinematic_position_based().build();
-            let (handle, _) = self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build());
-            self.hand.push((handle, p.joint));
-        }
+    /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves; returns its
+    /// index there.
+    pub fn add_hand(&mut self, proxies: &HandProxies) -> usize {
+        let hand = proxies
+            .colliders()
+            .iter()
+            .map(|p| {
+                let body = RigidBodyBuilder::kinematic_position_based().build();
+                (self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build()).0, p.joint)
+            })
+            .collect();
+        self.hands.push(hand);
+        self.hands.len() - 1
     }
 
-    /// Puts the hand's joints at `world`. Placed, not swept: the solver would give the bodies
+    /// Puts hand `hand`'s joints at `world`. Placed, not swept: the solver would give the bodies
     /// the velocity of the move, and a hand that stops at an object within the frame (the
     /// contact constraint stops it a fraction of a millimetre short) would strike it at full
     /// speed. So the hand holds free objects off and stops them, and does not bat them.
     /// A joint already where it goes ([`PLACED_M`]) is left alone.
-    pub fn move_hand(&mut self, world: &[Affine3A]) {
-        for &(h, joint) in &self.hand {
+    pub fn move_hand(&mut self, hand: usize, world: &[Affine3A]) {
+        for &(h, joint) in &self.hands[hand] {
             let pose = pose_of(&world[joint]);
             let placed = &self.world.bodies[h];
             if near(placed.position(), &pose) && near(placed.next_position(), &pose) {
@@ -130,30 +137,25 @@ impl ScenePhysics {
         (b.linvel(), b.angvel())
     }
 
-    /// The object moved by the hand, if any.
+    /// Whether a hand holds object `i`.
     #[must_use]
-    pub fn held(&self) -> Option<usize> {
-        self.held
+    pub fn held(&self, i: usize) -> bool {
+        self.held[i]
     }
 
-    /// Object `i` is in the hand: the next [`Self::step`] moves it to `rotation`,
+    /// Object `i` is in a hand: the next [`Self::step`] moves it to `rotation`,
     /// `translation`, pushing what it meets on the way.
     pub fn hold(&mut self, i: usize, rotation: Quat, translation: Vec3) {
-        if self.held != Some(i) {
-            if let Some(h) = self.held {
-                self.release(h, Vec3::ZERO, Vec3::ZERO);
-            }
+        if !self.held[i] {
             self.world.bodies[self.bodies[i]].set_body_type(RigidBodyType::KinematicPositionBased, true);
-            self.held = Some(i);
+            self.held[i] = true;
         }
         self.world.bodies[self.bodies[i]].set_next_kinematic_position(Pose::from_parts(translation, rotation));
     }
 
-    /// Object `i` leaves the hand with its origin moving at `linvel` and turning at `angvel`.
+    /// Object `i` leaves the hands with its origin moving at `linvel` and turning at `angvel`.
     pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3) {
-        if self.held == Some(i) {
-            self.held = None;
-        }
+        self.held[i] = false;
         let body = &mut self.world.bodies[self.bodies[i]];
         body.set_body_type(RigidBodyType::Dynamic, true);
         // The simulation moves the centre of mass; the hand gave the origin's velocity.
@@ -164,7 +166,7 @@ impl ScenePhysics {
 
     /// Every object back where the file puts it, at rest, none held.
     pub fn reset(&mut self) {
-        self.held = None;
+        self.held.fill(false);
         for i in 0..self.bodies.len() {
             self.put_back(i);
         }
@@ -188,7 +190,7 @@ impl ScenePhysics {
         for i in 0..self.bodies.len() {
             let p = self.world.bodies[self.bodies[i]].position().translation;
             let out = Vec3::new(p.x, 0.0, p.z).length() > self.reach || p.y < self.floor - 0.5;
-            if out && self.held != Some(i) {
+            if out && !self.held[i] {
                 self.put_back(i);
                 self.returned.push(i);
             }

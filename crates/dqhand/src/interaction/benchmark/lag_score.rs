@@ -34,7 +34,7 @@ pub fn lag(manip: &mut ManipulationLoop, sweep: &Sweep) -> LagScore {
             continue;
         }
         manip.step(record.time);
-        let (Some(rendered), Some(true_wrist)) = (manip.constraint().rendered().wrist, truth.wrist) else { continue };
+        let (Some(rendered), Some(true_wrist)) = (manip.hands()[0].constraint().rendered().wrist, truth.wrist) else { continue };
         let offset = true_wrist.to_rotation_translation().1 - rendered.to_rotation_translation().1;
         let t = record.time;
         if t >= sweep.steady.0 && t <= sweep.steady.1 {

@@ -12,7 +12,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Quat, Vec3};
 use parry3d::bounding_volume::Aabb;
 use parry3d::query::Ray;
 use serde::Serialize;
@@ -48,8 +48,11 @@ pub struct RunScore {
     pub max_penetration_m: f32,
     /// The mean over frames with a contact of each frame's deepest vertex, m.
     pub mean_penetration_m: f32,
-    /// How far the carried object moved in the tracked wrist's frame during the carry, m.
+    /// How far the carried object moved in the tracked wrist's frame during the carry, m (the
+    /// wrist of the hand holding it when the carry began).
     pub slip_m: f32,
+    /// How far it turned in that frame, degrees.
+    pub slip_deg: f32,
     /// How much farther the rendered wrist fell behind the true one along the carry than it
     /// was at the carry's start, at most, m: the hand and what it holds lagging the user's.
     pub carry_lag_m: f32,
@@ -60,9 +63,11 @@ pub struct RunScore {
     pub release_drift_m: f32,
     /// Frames from the fingers beginning to open to the release, if released.
     pub release_frames: Option<u32>,
-    /// The rendered palm's centre crossed an object's surface between two frames.
+    /// The rendered palm's centre or a fingertip crossed the surface of an object it did not
+    /// hold between two frames.
     pub tunnelled: bool,
-    /// Seconds each frame's [`ManipulationLoop::step`] took (collision, grasp, physics).
+    /// Seconds each frame's [`ManipulationLoop::step`] took (collision, grasp, physics; every
+    /// hand's).
     #[serde(skip)]
     pub step_s: Vec<f64>,
 }
@@ -90,8 +95,13 @@ pub fn depth(object: &ObjectCollider, mesh: Option<&FlatMesh>, p: Vec3) -> f32 {
     }
 }
 
-/// Runs `script` through `manip` (fresh, on the script's scene) and scores it: `object` is the
-/// index of the scripted object, `carried_to` where the script sets it down.
+/// WebXR indices of the points that must not cross a surface: the five fingertips; the palm's
+/// centre is added between the wrist (0) and the middle finger's knuckle (11).
+const TIPS: [usize; 5] = [4, 9, 14, 19, 24];
+
+/// Runs `script` through `manip` (fresh, on the script's scene; one hand or two, as the script
+/// has records of one side or both) and scores it: `object` is the index of the scripted
+/// object, `carried_to` where the script sets it down.
 ///
 /// # Panics
 /// If the loop's skeleton lacks the WebXR joints (the built-in hand has them).
@@ -102,8 +112,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         .iter()
         .map(|o| o.mesh.as_ref().map(|m| (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect())))
         .collect();
-    let joints = JointPositions::new(manip.rendered().skeleton()).expect("a hand with WebXR joints");
-    let mut rendered_skin = SkinLayer::new(Arc::clone(&manip.input().model().mesh), MethodSet::DQB);
+    let joints: Vec<JointPositions> = manip.hands().iter().map(|h| JointPositions::new(h.rendered().skeleton()).expect("a hand with WebXR joints")).collect();
+    let mut rendered_skin: Vec<SkinLayer> = manip.hands().iter().map(|h| SkinLayer::new(Arc::clone(&h.input().model().mesh), MethodSet::DQB)).collect();
     let times = script.times;
     let mut score = RunScore {
         success: false,
@@ -111,6 +121,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         max_penetration_m: 0.0,
         mean_penetration_m: 0.0,
         slip_m: 0.0,
+        slip_deg: 0.0,
         carry_lag_m: 0.0,
         release_drift_m: 0.0,
         release_frames: None,
@@ -120,39 +131,53 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let (mut grasped_before_carry, mut held_through_carry) = (false, true);
     let mut released = false;
     let (mut penetration_sum, mut contact_frames) = (0.0f64, 0u32);
-    let mut in_wrist: Option<Vec3> = None;
+    let mut in_wrist: Option<(Quat, Vec3)> = None;
+    let mut carrier: Option<usize> = None;
     let mut carry_offset: Option<f32> = None;
     let mut let_go: Option<Vec3> = None;
     let mut fallen: Option<Vec3> = None;
-    let mut palm: Option<Vec3> = None;
+    let mut tracked_points: Vec<Option<[Vec3; TIPS.len() + 1]>> = vec![None; manip.hands().len()];
     let mut skin: Vec<[f32; 3]> = Vec::new();
-    for (record, truth) in script.records.iter().zip(&script.truth) {
-        // The loop takes records as they come; a script's records are all good.
-        let _ = manip.push(record);
+    let mut next = 0;
+    while next < script.records.len() {
+        // A frame: the records of its time (one per hand); a script's records are all good.
+        let t = script.records[next].time;
+        let frame = next..next + script.records[next..].iter().take_while(|r| r.time == t).count();
+        next = frame.end;
+        for record in &script.records[frame.clone()] {
+            let _ = manip.push(record);
+        }
         let started = Instant::now();
-        let event = manip.step(record.time);
+        let events = manip.step(t);
         score.step_s.push(started.elapsed().as_secs_f64());
-        let t = record.time;
-        let held = manip.held() == Some(object);
-        if t < times.carry_start && held {
+        let holder = manip.hands().iter().position(|h| h.held() == Some(object));
+        if t < times.carry_start && holder.is_some() {
             grasped_before_carry = true;
         }
         if t >= times.carry_start && t <= times.carry_end {
-            held_through_carry &= held;
-            if held {
-                let wrist: &Affine3A = &manip.constraint().tracked_world()[manip.rendered().rig().wrist()];
-                let here = wrist.inverse().transform_point3(manip.poses()[object].1);
-                let first = *in_wrist.get_or_insert(here);
-                score.slip_m = score.slip_m.max(here.distance(first));
-                if let (Some(rendered), Some(true_wrist)) = (manip.constraint().rendered().wrist, truth.wrist) {
-                    let behind = (true_wrist.to_rotation_translation().1 - rendered.to_rotation_translation().1).dot(script.carry.normalize_or_zero());
-                    let first = *carry_offset.get_or_insert(behind);
-                    score.carry_lag_m = score.carry_lag_m.max(behind - first);
+            held_through_carry &= holder.is_some();
+            let hands = manip.hands();
+            match carrier.or(holder).map(|k| &hands[k]).filter(|h| h.held() == Some(object)) {
+                Some(hand) => {
+                    carrier = carrier.or(holder);
+                    let wrist: &Affine3A = &hand.constraint().tracked_world()[hand.rendered().rig().wrist()];
+                    let (q, p) = manip.poses()[object];
+                    let here = (wrist.to_scale_rotation_translation().1.inverse() * q, wrist.inverse().transform_point3(p));
+                    let first = *in_wrist.get_or_insert(here);
+                    score.slip_m = score.slip_m.max(here.1.distance(first.1));
+                    score.slip_deg = score.slip_deg.max(here.0.angle_between(first.0).to_degrees());
+                    let truth = frame.clone().find(|&r| hands[manip.hand_of(script.records[r].side)].side() == hand.side()).and_then(|r| script.truth[r].wrist);
+                    if let (Some(rendered), Some(true_wrist)) = (hand.constraint().rendered().wrist, truth) {
+                        let behind = (true_wrist.to_rotation_translation().1 - rendered.to_rotation_translation().1).dot(script.carry.normalize_or_zero());
+                        let first = *carry_offset.get_or_insert(behind);
+                        score.carry_lag_m = score.carry_lag_m.max(behind - first);
+                    }
                 }
+                None => held_through_carry = false,
             }
         }
-        if let Some(GraspEvent::Release { object: o, .. }) = event {
-            if o == object && t >= times.release && !released {
+        if events.iter().any(|(_, e)| matches!(e, GraspEvent::Release { object: o, .. } if o == object)) && holder.is_none() {
+            if t >= times.release && !released {
                 released = true;
                 let_go = Some(manip.poses()[object].1);
                 score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
@@ -164,18 +189,21 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
                 fallen = Some(now);
             }
         }
-        let held_index = manip.held();
-        // The rendered palm's centre (between the wrist and the middle finger's knuckle) must
-        // not cross a surface between frames.
-        let world = manip.rendered().world();
-        let p = joints.read(world);
-        let centre = (p[0] + p[11]) / 2.0;
-        if let Some(last) = palm.replace(centre) {
-            score.tunnelled |= crossed(manip.objects(), held_index, last, centre);
-        }
         skin.clear();
-        rendered_skin.deform(manip.rendered().layer());
-        skin.extend_from_slice(rendered_skin.deformed(Method::Dqb).expect("DQB is the set").positions());
+        for (k, hand) in manip.hands().iter().enumerate() {
+            // The rendered palm's centre (between the wrist and the middle finger's knuckle)
+            // and the fingertips must not cross a surface between frames.
+            let p = joints[k].read(hand.rendered().world());
+            let mut now = [(p[0] + p[11]) / 2.0; TIPS.len() + 1];
+            for (n, &tip) in now[1..].iter_mut().zip(&TIPS) {
+                *n = p[tip];
+            }
+            if let Some(last) = tracked_points[k].replace(now) {
+                score.tunnelled |= last.iter().zip(&now).any(|(a, b)| crossed(manip.objects(), hand.held(), *a, *b));
+            }
+            rendered_skin[k].deform(hand.rendered().layer());
+            skin.extend_from_slice(rendered_skin[k].deformed(Method::Dqb).expect("DQB is the set").positions());
+        }
         let colliders = manip.objects().objects();
         let mut deepest = 0.0f32;
         for v in &skin {
@@ -185,7 +213,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             }
         }
         score.max_penetration_m = score.max_penetration_m.max(deepest);
-        if !manip.contacts().is_empty() {
+        if manip.hands().iter().any(|h| !h.contacts().is_empty()) {
             penetration_sum += f64::from(deepest);
             contact_frames += 1;
         }
@@ -201,7 +229,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         let rest = fallen.unwrap_or(manip.poses()[object].1);
         score.release_drift_m = Vec3::new(rest.x - at.x, 0.0, rest.z - at.z).length();
     }
-    score.success = grasped_before_carry && held_through_carry && released && manip.held().is_none() && score.place_error_m <= PLACE_TOLERANCE_M;
+    score.success = grasped_before_carry && held_through_carry && released && manip.hands().iter().all(|h| h.held() != Some(object)) && score.place_error_m <= PLACE_TOLERANCE_M;
     score
 }
 
