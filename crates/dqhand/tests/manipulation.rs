@@ -266,7 +266,7 @@ fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
         let mut physics = ScenePhysics::new(&scene, &objects);
         if with_hand {
             physics.add_hand(&proxies);
-            physics.move_hand(0, &world);
+            physics.move_hand(0, Some(&world));
         }
         physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.74, 0.0));
         physics.step(1.0 / 60.0);
@@ -274,7 +274,7 @@ fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
         let mut deepest = 0.0f32;
         for _ in 0..60 {
             if with_hand {
-                physics.move_hand(0, &world);
+                physics.move_hand(0, Some(&world));
             }
             physics.step(1.0 / 60.0);
             let at = parry3d::math::Pose::from_translation(physics.pose(0).1);

@@ -32,11 +32,15 @@ pub struct GraspParams {
     /// are carried this much farther apart than at the grasp, m: the user pulls the hands
     /// apart. Squeezing brings them closer (the tracked palms go into the object).
     pub apart_m: f32,
+    /// A hand whose tracked wrist is this much farther into an object than its rendered one
+    /// (along the contact's normal), m, presses on it with every contact there: a flat hand
+    /// pushed against a box, whose fingers do not close.
+    pub push_m: f32,
 }
 
 impl Default for GraspParams {
     fn default() -> Self {
-        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5, still_m_s: 0.25, still_rad_s: 2.0, apart_m: 0.015 }
+        Self { opposition_deg: 100.0, press_deg: 4.0, release_deg: 8.0, cooldown_s: 0.3, loss_grace_s: 0.5, still_m_s: 0.25, still_rad_s: 2.0, apart_m: 0.015, push_m: 0.005 }
     }
 }
 
@@ -58,6 +62,10 @@ pub enum GraspEvent {
         angvel: Vec3,
     },
 }
+
+/// One hand as [`Grasp::find_two_handed`] reads it: its grasp, contacts, finger closures, and
+/// its tracked wrist less its rendered one (m).
+pub type TwoHanded<'a> = (&'a Grasp, &'a [Contact], &'a [Closure; 5], Vec3);
 
 /// At most this many contact points hold an object (the first ones found).
 const MAX_ANCHORS: usize = 16;
@@ -176,19 +184,22 @@ impl Grasp {
         Some(self.take(now, object, objects[object], true, contacts, closure, rendered_world, tracked_world, wrist))
     }
 
-    /// The object two free hands hold between them, if any: a pressing contact of each
-    /// ([`Self::detect`]'s rule for one contact: a palm, or a finger squeezed past its rendered
-    /// copy) on it, their normals opposed. Neither hand need hold it alone: two flat palms
-    /// pressing a large box from either side carry it.
+    /// The object two free hands hold between them, if any: a pressing contact of each on it
+    /// ([`Self::detect`]'s rule for one contact: a palm, or a finger squeezed past its
+    /// rendered copy; or any contact of a hand pushed [`GraspParams::push_m`] into the
+    /// object), their normals opposed. Neither hand need hold it alone: two flat hands
+    /// pressing a large box from either side carry it. Each hand is given as its grasp,
+    /// contacts, finger closures and push (its tracked wrist less its rendered one, m).
     #[must_use]
-    pub fn find_two_handed(now: f64, a: (&Grasp, &[Contact], &[Closure; 5]), b: (&Grasp, &[Contact], &[Closure; 5])) -> Option<usize> {
+    pub fn find_two_handed(now: f64, a: TwoHanded<'_>, b: TwoHanded<'_>) -> Option<usize> {
         if a.0.held.is_some() || b.0.held.is_some() {
             return None;
         }
         let opposed = a.0.params.opposition_deg.to_radians().cos();
         let ready = |g: &Grasp, o: usize| now >= g.cooldown_until[o];
-        a.1.iter().filter(|c| a.0.pressing(c, a.2) && ready(a.0, c.object) && ready(b.0, c.object)).find_map(|ca| {
-            b.1.iter().any(|cb| cb.object == ca.object && b.0.pressing(cb, b.2) && ca.normal.dot(cb.normal) <= opposed).then_some(ca.object)
+        let presses = |(g, _, closure, push): TwoHanded<'_>, c: &Contact| g.pressing(c, closure) || push.dot(-c.normal) >= g.params.push_m;
+        a.1.iter().filter(|c| presses(a, c) && ready(a.0, c.object) && ready(b.0, c.object)).find_map(|ca| {
+            b.1.iter().any(|cb| cb.object == ca.object && presses(b, cb) && ca.normal.dot(cb.normal) <= opposed).then_some(ca.object)
         })
     }
 
@@ -480,5 +491,46 @@ mod tests {
         assert_eq!(g.follow(0.6, true, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None, "tracking back");
         assert_eq!(g.follow(0.7, false, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), None);
         assert!(matches!(g.follow(1.21, false, &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO)), Some(GraspEvent::Release { linvel: Vec3::ZERO, .. })), "0.51 s lost: dropped");
+    }
+
+    #[test]
+    fn two_hands_pressing_opposite_sides_hold_an_object_between_them() {
+        let (a, b) = (Grasp::new(GraspParams::default(), 1), Grasp::new(GraspParams::default(), 1));
+        // Flat fingers (not squeezing) of each hand on either side of the object.
+        let left = [contact(HandPart::Finger(1), 2, -Vec3::X)];
+        let right = [contact(HandPart::Finger(1), 2, Vec3::X)];
+        let flat = closure(30.0);
+        let pushed = |side: Vec3| -side * 0.01;
+        // Neither hand pushed into it: no hold; both pushed 1 cm in: held.
+        assert_eq!(Grasp::find_two_handed(0.0, (&a, &left, &flat, Vec3::ZERO), (&b, &right, &flat, Vec3::ZERO)), None);
+        assert_eq!(Grasp::find_two_handed(0.0, (&a, &left, &flat, pushed(-Vec3::X)), (&b, &right, &flat, pushed(Vec3::X))), Some(0));
+        // Pushed, but along the surface (5 mm deep is needed), or both on one side: none.
+        assert_eq!(Grasp::find_two_handed(0.0, (&a, &left, &flat, Vec3::Y * 0.01), (&b, &right, &flat, pushed(Vec3::X))), None);
+        assert_eq!(Grasp::find_two_handed(0.0, (&a, &left, &flat, pushed(-Vec3::X)), (&b, &left, &flat, pushed(-Vec3::X))), None);
+        // Palms always press.
+        let palms = ([contact(HandPart::Palm, 0, -Vec3::X)], [contact(HandPart::Palm, 0, Vec3::X)]);
+        assert_eq!(Grasp::find_two_handed(0.0, (&a, &palms.0, &flat, Vec3::ZERO), (&b, &palms.1, &flat, Vec3::ZERO)), Some(0));
+    }
+
+    #[test]
+    fn a_hand_holding_with_the_other_is_not_released_by_its_fingers_and_is_rebased_where_it_holds() {
+        let mut g = Grasp::new(GraspParams::default(), 1);
+        g.take(0.0, 0, BALL[0], false, &pinch(), &closure(40.0), &world(Vec3::ZERO), &world(Vec3::ZERO), WRIST);
+        assert!(!g.alone());
+        // Its fingers open wide: a hand holding its share does not let go for that.
+        assert_eq!(g.follow(0.1, true, &closure(0.0), &world(Vec3::X * 0.01), &world(Vec3::ZERO)), None);
+        // Its points in the object's frame, and where the hand carries them.
+        let points: Vec<(Vec3, Vec3)> = g.holding_points().collect();
+        assert_eq!(points.len(), 2 + WRIST_POINTS.len());
+        assert!(points.iter().all(|(o, w)| (*w - *o - Vec3::X * 0.01).length() < 1e-6), "{points:?}");
+        // The other hand lets go with the object 2 cm up: it stays there, not where this
+        // hand alone would have put it.
+        let up = (Quat::IDENTITY, Vec3::Y * 0.02);
+        g.rebase(up);
+        assert_eq!(g.target(), Some(up));
+        assert_eq!(g.follow(0.2, true, &closure(0.0), &world(Vec3::X * 0.01), &world(Vec3::ZERO)), None);
+        let (q, t) = g.target().unwrap();
+        assert!((t - up.1).length() < 1e-6 && q.angle_between(Quat::IDENTITY) < 1e-5, "{t}");
+        assert!(matches!(g.let_go(0.3, false), Some(GraspEvent::Release { object: 0, .. })));
     }
 }

@@ -21,8 +21,9 @@
 //!   leaves with the hand's velocity over the last frames, so a throw flies.
 //! * **Two hands.** Either hand grasps by itself; a hand may grasp what the other holds, and
 //!   the object then follows the best rigid fit of both hands' holding points. A free pair of
-//!   hands also grasps an object between them: a pressing contact of each (a palm, or a
-//!   squeezing finger) with opposing normals ([`Grasp::find_two_handed`]); such a hold lets go
+//!   hands also grasps an object between them: a pressing contact of each (a palm, a
+//!   squeezing finger, or any contact of a hand pushed into the object) with opposing normals
+//!   ([`Grasp::find_two_handed`]); such a hold lets go
 //!   when the hands draw [`GraspParams::apart_m`] apart. When one hand lets go, the other keeps
 //!   the object if its own grasp holds it ([`Grasp::alone`]; a hand-over), else drops it too.
 //! * **Tracking loss.** A held object stays where it is while tracking is lost, and drops
@@ -30,4 +31,4 @@
 
 mod hand_grasp;
 
-pub use hand_grasp::{Grasp, GraspEvent, GraspParams};
+pub use hand_grasp::{Grasp, GraspEvent, GraspParams, TwoHanded};

@@ -13,7 +13,7 @@ use glam::{Affine3A, Mat3, Quat, Vec3};
 use parry3d::query::Ray;
 
 use super::synthetic::joint_set;
-use crate::collision::ObjectColliders;
+use crate::collision::{ObjectCollider, ObjectColliders};
 use crate::gesture::gesture;
 use crate::kinematics::Side;
 use crate::input::{HandData, Record, TrackedJoint};
@@ -206,87 +206,225 @@ fn smooth(s: f64) -> f32 {
 /// A keyframe: time, palm position, closure.
 type Key = (f64, Vec3, f32);
 
-/// Records of `model` doing `task` in `scene` (called `file` in errors), whose objects are
+/// One hand's part of a script: its kinematics, how it is turned and closes, and its
+/// keyframes.
+struct HandPath {
+    hand: HandKinematics,
+    joints: JointPositions,
+    closing: Closing,
+    frame: HandFrame,
+    rotation: Quat,
+    side: Side,
+    keys: Vec<Key>,
+}
+
+impl HandPath {
+    /// `model`'s hand with its palm facing `approach` and its fingers along `fingers` (made
+    /// perpendicular), closing as a pinch or a grasp.
+    fn new(model: &Model, side: Side, approach: Vec3, fingers: Vec3, pinch: bool) -> Result<Self> {
+        let d = approach.normalize();
+        let f = (fingers - d * fingers.dot(d)).normalize();
+        let mut hand = model.hand_kinematics(JointModel::Full)?;
+        let joints = JointPositions::new(hand.skeleton())?;
+        let closing = Closing::new(pinch);
+        let frame = hand_frame(&mut hand, &joints, &closing);
+        let rotation = {
+            let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
+            let world = Mat3::from_cols(d, f, d.cross(f));
+            Quat::from_mat3(&(world * hand.transpose())).normalize()
+        };
+        Ok(Self { hand, joints, closing, frame, rotation, side, keys: Vec::new() })
+    }
+
+    /// Where the palm goes to take `object`, aiming `aim` off its middle. A grasp (`grip`):
+    /// the palm presses into the surface point seen along the approach `d` through the middle
+    /// of the object's bounding box, shifted across the approach so that the hand's grip
+    /// point is over the middle; a flat hand, the palm's centre is. A pinch: the tips meet in
+    /// the middle.
+    fn reach(&self, object: &ObjectCollider, d: Vec3, aim: Vec3, grip: bool) -> Vec3 {
+        let offset = if grip { self.rotation * (self.frame.grip - self.frame.palm) } else { Vec3::ZERO };
+        let offset = offset - (aim - d * aim.dot(d));
+        if self.closing.pinch {
+            return object.aabb().center() - offset;
+        }
+        let centre = object.aabb().center() - (offset - d * offset.dot(d));
+        let ray = Ray::new(centre - d, d);
+        let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
+        centre - d + d * (toi + PRESS_M)
+    }
+
+    /// A keyframe `dt` after the last (at 0 for the first): palm at `p`, closed by `c`.
+    /// Returns its time.
+    fn key(&mut self, dt: f64, p: Vec3, c: f32) -> f64 {
+        let t = self.keys.last().map_or(0.0, |k| k.0) + dt;
+        self.keys.push((t, p, c));
+        t
+    }
+
+    /// The record and the tracked pose at `t`: between the keys, eased, except the key
+    /// numbered `linear` which is reached at constant speed.
+    fn at(&mut self, t: f64, linear: Option<usize>) -> (Record, Pose) {
+        let keys = &self.keys;
+        let k = keys.iter().rposition(|k| k.0 <= t).unwrap_or(0).min(keys.len() - 2);
+        let ((t0, p0, c0), (t1, p1, c1)) = (keys[k], keys[k + 1]);
+        let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+        let s = if Some(k + 1) == linear { s.clamp(0.0, 1.0) as f32 } else { smooth(s) };
+        let palm = p0.lerp(p1, s);
+        let mut pose = self.closing.pose(c0 + (c1 - c0) * s);
+        pose.wrist = Some(DualQuat::from_rotation_translation(self.rotation, palm - self.rotation * self.frame.palm));
+        self.hand.pose(&pose);
+        let world: &[Affine3A] = self.hand.world();
+        let positions = self.joints.read(world);
+        (Record { time: t, side: self.side, hand: Some(HandData::Joints(joint_set(world, &self.joints, &positions))), tracker: None, arrival: None }, pose)
+    }
+}
+
+/// The object called `name` among `objects` (of the scene `file`).
+fn find<'a>(objects: &'a ObjectColliders, file: &str, name: &str) -> Result<&'a ObjectCollider> {
+    objects.objects().iter().find(|o| o.name == name).ok_or_else(|| Error::Scene { file: file.to_owned(), problem: SceneProblem::NoObject(name.to_owned()) })
+}
+
+/// The records of `paths` (one record per path and frame, in path order) from 0 to `end`,
+/// with `times` and the rest of the script.
+fn play(paths: &mut [HandPath], times: GraspTimes, carry: Vec3, drop: f32, linear: Option<usize>) -> Script {
+    let frames = (times.end * RATE_HZ).floor() as usize + 1;
+    let mut script = Script { records: Vec::with_capacity(frames * paths.len()), truth: Vec::with_capacity(frames * paths.len()), times, carry, drop };
+    for i in 0..frames {
+        let t = i as f64 / RATE_HZ;
+        for path in paths.iter_mut() {
+            let (record, pose) = path.at(t, linear);
+            script.records.push(record);
+            script.truth.push(pose);
+        }
+    }
+    script
+}
+
+/// Records of `model` (a `side` hand) doing `task` in the scene `file`, whose objects are
 /// `objects`.
 ///
 /// # Errors
 /// [`SceneProblem::NoObject`] if the scene has no object of the task's; as
 /// [`Model::hand_kinematics`].
 pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &GraspTask, side: Side) -> Result<Script> {
-    let object = objects
-        .objects()
-        .iter()
-        .find(|o| o.name == task.object)
-        .ok_or_else(|| Error::Scene { file: file.to_owned(), problem: SceneProblem::NoObject(task.object.clone()) })?;
+    let object = find(objects, file, &task.object)?;
     let d = task.approach.normalize();
-    let f = (task.fingers - d * task.fingers.dot(d)).normalize();
-    let mut hand = model.hand_kinematics(JointModel::Full)?;
-    let joints = JointPositions::new(hand.skeleton())?;
-    let closing = Closing::new(task.pinch);
-    let frame = hand_frame(&mut hand, &joints, &closing);
-    let rotation = {
-        let hand = Mat3::from_cols(frame.palmar, frame.fingers, frame.palmar.cross(frame.fingers));
-        let world = Mat3::from_cols(d, f, d.cross(f));
-        Quat::from_mat3(&(world * hand.transpose())).normalize()
-    };
-    // Where the palm goes. A grasp: it presses into the surface point seen along the
-    // approach through the middle of the object's bounding box, shifted across the approach
-    // so that the hand's grip point is over the middle. A pinch: the tips meet in the middle.
-    let grip = rotation * (frame.grip - frame.palm) - (task.aim - d * task.aim.dot(d));
-    let grasp_at = if task.pinch {
-        object.aabb().center() - grip
-    } else {
-        let centre = object.aabb().center() - (grip - d * grip.dot(d));
-        let ray = Ray::new(centre - d, d);
-        let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
-        centre - d + d * (toi + PRESS_M)
-    };
+    let mut path = HandPath::new(&model, side, d, task.fingers, task.pinch)?;
+    let grasp_at = path.reach(object, d, task.aim, true);
     let start = grasp_at - d * STANDOFF_M;
     let lifted = grasp_at + Vec3::Y * task.lift;
     let carried = lifted + task.carry;
     let set_down = carried - Vec3::Y * (task.lift - task.drop);
-    let mut keys: Vec<Key> = Vec::new();
-    let mut t = 0.0;
-    let mut key = |dt: f64, p: Vec3, c: f32, keys: &mut Vec<Key>| {
-        t += dt;
-        keys.push((t, p, c));
-        t
-    };
-    key(0.0, start, 0.0, &mut keys);
-    key(0.3, start, 0.0, &mut keys);
-    let reached = key(f64::from(STANDOFF_M / task.speed), grasp_at, 0.0, &mut keys);
-    key(0.15, grasp_at, 0.0, &mut keys);
-    let closed = key(0.5, grasp_at, 1.0, &mut keys);
-    key(0.2, grasp_at, 1.0, &mut keys);
-    let carry_start = key(0.5, lifted, 1.0, &mut keys);
-    let carry_end = key(f64::from(task.carry.length() / CARRY_SPEED), carried, 1.0, &mut keys);
-    key(0.2, carried, 1.0, &mut keys);
-    key(0.5, set_down, 1.0, &mut keys);
-    let release = key(0.1, set_down, 1.0, &mut keys);
-    key(0.4, set_down, 0.0, &mut keys);
-    key(0.5, set_down - d * STANDOFF_M, 0.0, &mut keys);
-    let end = key(1.0, set_down - d * STANDOFF_M, 0.0, &mut keys);
+    path.key(0.0, start, 0.0);
+    path.key(0.3, start, 0.0);
+    let reached = path.key(f64::from(STANDOFF_M / task.speed), grasp_at, 0.0);
+    path.key(0.15, grasp_at, 0.0);
+    let closed = path.key(0.5, grasp_at, 1.0);
+    path.key(0.2, grasp_at, 1.0);
+    let carry_start = path.key(0.5, lifted, 1.0);
+    let carry_end = path.key(f64::from(task.carry.length() / CARRY_SPEED), carried, 1.0);
+    path.key(0.2, carried, 1.0);
+    path.key(0.5, set_down, 1.0);
+    let release = path.key(0.1, set_down, 1.0);
+    path.key(0.4, set_down, 0.0);
+    path.key(0.5, set_down - d * STANDOFF_M, 0.0);
+    let end = path.key(1.0, set_down - d * STANDOFF_M, 0.0);
     let times = GraspTimes { reached, closed, carry_start, carry_end, release, end };
     // The approach is at constant speed (its speed is the point); the rest eased.
-    let eased = |k: usize| k != 2;
-    let frames = (end * RATE_HZ).floor() as usize + 1;
-    let mut script = Script { records: Vec::with_capacity(frames), truth: Vec::with_capacity(frames), times, carry: task.carry, drop: task.drop };
-    for i in 0..frames {
-        let t = i as f64 / RATE_HZ;
-        let k = keys.iter().rposition(|k| k.0 <= t).unwrap_or(0).min(keys.len() - 2);
-        let ((t0, p0, c0), (t1, p1, c1)) = (keys[k], keys[k + 1]);
-        let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
-        let s = if eased(k + 1) { smooth(s) } else { s.clamp(0.0, 1.0) as f32 };
-        let palm = p0.lerp(p1, s);
-        let mut pose = closing.pose(c0 + (c1 - c0) * s);
-        pose.wrist = Some(DualQuat::from_rotation_translation(rotation, palm - rotation * frame.palm));
-        hand.pose(&pose);
-        let world: &[Affine3A] = hand.world();
-        let positions = joints.read(world);
-        script.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None, arrival: None });
-        script.truth.push(pose);
+    Ok(play(&mut [path], times, task.carry, task.drop, Some(2)))
+}
+
+/// Records of two hands (`models`: a left and a right one) carrying `object` between their
+/// flat palms: each comes at it from its own side along X at 0.5 m/s, presses its palm
+/// [`PRESS_M`] into it, and they lift it by `lift`, carry it by `carry`, set it down and
+/// draw apart. A frame's records are the left hand's, then the right's.
+///
+/// # Errors
+/// As [`grasp`].
+pub fn carry_between(models: [&Model; 2], file: &str, objects: &ObjectColliders, object: &str, lift: f32, carry: Vec3) -> Result<Script> {
+    let object = find(objects, file, object)?;
+    let mut paths = [(Side::Left, Vec3::X), (Side::Right, Vec3::NEG_X)]
+        .into_iter()
+        .zip(models)
+        .map(|((side, d), model)| HandPath::new(model, side, d, Vec3::NEG_Z, false))
+        .collect::<Result<Vec<_>>>()?;
+    let mut times = GraspTimes { reached: 0.0, closed: 0.0, carry_start: 0.0, carry_end: 0.0, release: 0.0, end: 0.0 };
+    for (path, d) in paths.iter_mut().zip([Vec3::X, Vec3::NEG_X]) {
+        let at = path.reach(object, d, Vec3::ZERO, false);
+        let start = at - d * STANDOFF_M;
+        let (lifted, carried) = (at + Vec3::Y * lift, at + Vec3::Y * lift + carry);
+        path.key(0.0, start, 0.0);
+        path.key(0.3, start, 0.0);
+        times.reached = path.key(f64::from(STANDOFF_M / 0.5), at, 0.0);
+        times.closed = path.key(0.3, at, 0.0);
+        times.carry_start = path.key(0.5, lifted, 0.0);
+        times.carry_end = path.key(f64::from(carry.length() / CARRY_SPEED), carried, 0.0);
+        path.key(0.2, carried, 0.0);
+        times.release = path.key(0.5, carried - Vec3::Y * lift, 0.0);
+        path.key(0.5, carried - Vec3::Y * lift - d * STANDOFF_M, 0.0);
+        times.end = path.key(1.0, carried - Vec3::Y * lift - d * STANDOFF_M, 0.0);
     }
-    Ok(script)
+    Ok(play(&mut paths, times, carry, 0.0, Some(2)))
+}
+
+/// Records of a hand-over: the right hand (`models[1]`) grasps `object` from above near its
+/// +X end (`reach` off its middle), lifts it and carries it by `carry`; the left hand grasps
+/// it there near its −X end, the right one opens and draws back, and the left one carries
+/// it on by `carry` and sets it down. A frame's records are the left hand's, then the
+/// right's; the script's carry is the left hand's.
+///
+/// # Errors
+/// As [`grasp`].
+pub fn hand_over(models: [&Model; 2], file: &str, objects: &ObjectColliders, object: &str, reach: f32, lift: f32, carry: Vec3) -> Result<Script> {
+    let object = find(objects, file, object)?;
+    let d = Vec3::NEG_Y;
+    let [mut left, mut right] = [(Side::Left, -reach), (Side::Right, reach)].map(|(side, x)| (side, Vec3::X * x));
+    let mut paths = [&mut left, &mut right]
+        .into_iter()
+        .zip(models)
+        .map(|((side, aim), model)| {
+            let path = HandPath::new(model, *side, d, Vec3::NEG_Z, false)?;
+            *aim = path.reach(object, d, *aim, true);
+            Ok(path)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (left_at, right_at) = (left.1 + Vec3::Y * lift + carry, right.1);
+    // The right hand takes it and brings it to the meeting point.
+    let r = &mut paths[1];
+    r.key(0.0, right_at - d * STANDOFF_M, 0.0);
+    r.key(0.3, right_at - d * STANDOFF_M, 0.0);
+    r.key(f64::from(STANDOFF_M / 0.5), right_at, 0.0);
+    r.key(0.15, right_at, 0.0);
+    r.key(0.5, right_at, 1.0);
+    r.key(0.2, right_at, 1.0);
+    r.key(0.5, right_at + Vec3::Y * lift, 1.0);
+    let met = r.key(f64::from(carry.length() / CARRY_SPEED), right_at + Vec3::Y * lift + carry, 1.0);
+    // The left hand comes from above while the right holds it still, and grasps.
+    let l = &mut paths[0];
+    l.key(0.0, left_at - d * STANDOFF_M, 0.0);
+    l.key(met, left_at - d * STANDOFF_M, 0.0);
+    let reached = l.key(f64::from(STANDOFF_M / 0.5), left_at, 0.0);
+    l.key(0.15, left_at, 0.0);
+    let closed = l.key(0.5, left_at, 1.0);
+    l.key(0.2, left_at, 1.0);
+    // The right hand opens and draws back; the left carries it on and sets it down.
+    let r = &mut paths[1];
+    r.key(closed + 0.2 - met, right_at + Vec3::Y * lift + carry, 1.0);
+    r.key(0.4, right_at + Vec3::Y * lift + carry, 0.0);
+    r.key(0.5, right_at + Vec3::Y * lift + carry - d * STANDOFF_M, 0.0);
+    let l = &mut paths[0];
+    let carry_start = l.key(0.9, left_at, 1.0);
+    let carry_end = l.key(f64::from(carry.length() / CARRY_SPEED), left_at + carry, 1.0);
+    l.key(0.2, left_at + carry, 1.0);
+    l.key(0.5, left_at + carry - Vec3::Y * lift, 1.0);
+    let release = l.key(0.1, left_at + carry - Vec3::Y * lift, 1.0);
+    l.key(0.4, left_at + carry - Vec3::Y * lift, 0.0);
+    l.key(0.5, left_at + carry - Vec3::Y * lift - d * STANDOFF_M, 0.0);
+    let end = l.key(1.0, left_at + carry - Vec3::Y * lift - d * STANDOFF_M, 0.0);
+    let waited = end - paths[1].keys.last().map_or(0.0, |k| k.0);
+    paths[1].key(waited, right_at + Vec3::Y * lift + carry - d * STANDOFF_M, 0.0);
+    let times = GraspTimes { reached, closed, carry_start, carry_end, release, end };
+    Ok(play(&mut paths, times, carry, 0.0, None))
 }
 
 impl GraspTask {

@@ -108,9 +108,19 @@ impl ManipulatingHand {
         self.grasp.take(now, object, pose, false, c.contacts(), c.closure(), c.world(), c.tracked_world(), wrist)
     }
 
-    /// The hand's proxies where the rendered hand is, for the physics.
+    /// How far the tracked wrist is from the rendered one (tracked less rendered, m): into
+    /// what stops the rendered hand.
+    pub(super) fn pushed(&self) -> Vec3 {
+        let wrist = self.input.kinematics().rig().wrist();
+        let c = &self.constraint;
+        Vec3::from(c.tracked_world()[wrist].translation - c.world()[wrist].translation)
+    }
+
+    /// The hand's proxies where the rendered hand is, for the physics; none while the hand
+    /// is lost.
     pub(super) fn place(&self, physics: &mut ScenePhysics) {
-        physics.move_hand(self.physics, self.constraint.world());
+        let tracked = self.tracking() == Tracking::Tracking;
+        physics.move_hand(self.physics, tracked.then(|| self.constraint.world()));
     }
 
     /// Which hand this is (its model's).

@@ -207,7 +207,8 @@ impl ManipulationLoop {
         }
         if let [a, b] = &mut self.hands[..] {
             let (ca, cb) = (&a.constraint, &b.constraint);
-            if let Some(object) = events.0.iter().all(Option::is_none).then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure()), (&b.grasp, cb.contacts(), cb.closure()))).flatten() {
+            let (pa, pb) = (a.pushed(), b.pushed());
+            if let Some(object) = events.0.iter().all(Option::is_none).then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure(), pa), (&b.grasp, cb.contacts(), cb.closure(), pb))).flatten() {
                 let pose = self.poses[object];
                 events.0 = [a.take_with_other(now, object, pose), b.take_with_other(now, object, pose)].map(Some);
                 self.between = a.grasp.contact_centre().zip(b.grasp.contact_centre()).map_or(0.0, |(p, q)| p.distance(q));

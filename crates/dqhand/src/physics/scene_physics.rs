@@ -105,19 +105,29 @@ impl ScenePhysics {
         self.hands.len() - 1
     }
 
-    /// Puts hand `hand`'s joints at `world`. Placed, not swept: the solver would give the bodies
-    /// the velocity of the move, and a hand that stops at an object within the frame (the
-    /// contact constraint stops it a fraction of a millimetre short) would strike it at full
-    /// speed. So the hand holds free objects off and stops them, and does not bat them.
-    /// A joint already where it goes ([`PLACED_M`]) is left alone.
-    pub fn move_hand(&mut self, hand: usize, world: &[Affine3A]) {
+    /// Puts hand `hand`'s joints at `world`, or takes it out of the world (`None`: the hand
+    /// is not tracked, and an object it held off or pinched is free). Placed, not swept: the
+    /// solver would give the bodies the velocity of the move, and a hand that stops at an
+    /// object within the frame (the contact constraint stops it a fraction of a millimetre
+    /// short) would strike it at full speed. So the hand holds free objects off and stops
+    /// them, and does not bat them. A joint already where it goes ([`PLACED_M`]) is left
+    /// alone.
+    pub fn move_hand(&mut self, hand: usize, world: Option<&[Affine3A]>) {
         for &(h, joint) in &self.hands[hand] {
+            let body = &mut self.world.bodies[h];
+            let Some(world) = world else {
+                if body.is_enabled() {
+                    body.set_enabled(false);
+                }
+                continue;
+            };
+            if !body.is_enabled() {
+                body.set_enabled(true);
+            }
             let pose = pose_of(&world[joint]);
-            let placed = &self.world.bodies[h];
-            if near(placed.position(), &pose) && near(placed.next_position(), &pose) {
+            if near(body.position(), &pose) && near(body.next_position(), &pose) {
                 continue;
             }
-            let body = &mut self.world.bodies[h];
             body.set_position(pose, true);
             body.set_next_kinematic_position(pose);
         }

@@ -211,8 +211,11 @@ struct ActionJson {
 const SHAPES: [(&str, &[&str]); 4] = [("sphere", &["radius"]), ("box", &["size"]), ("cylinder", &["radius", "height"]), ("mesh", &["file", "scale"])];
 
 /// The built-in scenes' files (`data/scenes/`), compiled in.
-const BUILTIN_SCENES: [(&str, &str); 2] =
-    [("grasp", include_str!("../../data/scenes/grasp.json")), ("objects", include_str!("../../data/scenes/objects.json"))];
+const BUILTIN_SCENES: [(&str, &str); 3] = [
+    ("grasp", include_str!("../../data/scenes/grasp.json")),
+    ("objects", include_str!("../../data/scenes/objects.json")),
+    ("two-hands", include_str!("../../data/scenes/two-hands.json")),
+];
 
 /// Where a scene's mesh paths start: a folder, or (a built-in scene) `data/scenes/` of the
 /// crate, whose meshes are compiled in.
@@ -225,7 +228,7 @@ enum Folder<'a> {
 impl Scene {
     /// The scenes that ship with the crate (`data/scenes/`, compiled in): `grasp` (the paper's
     /// Figure 9: a ball and the Utah teapot on a table) and `objects` (every kind of object).
-    pub const BUILTIN: [&'static str; 2] = [BUILTIN_SCENES[0].0, BUILTIN_SCENES[1].0];
+    pub const BUILTIN: [&'static str; 3] = [BUILTIN_SCENES[0].0, BUILTIN_SCENES[1].0, BUILTIN_SCENES[2].0];
 
     /// A built-in scene by name ([`Self::BUILTIN`]; its meshes built in too), else the scene
     /// file at that path.
