@@ -15,7 +15,8 @@ use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
-use glam::Vec3;
+use dqhand::collision::{fit_proxies, pose_of, HandProxies, PROXY_MARGIN};
+use glam::{Affine3A, Vec3};
 
 /// The built-in hand as a left and as a right hand.
 fn models() -> [Arc<Model>; 2] {
@@ -102,4 +103,48 @@ fn a_box_held_between_two_hands_falls_when_one_hand_is_lost() {
     assert!(manip.hands().iter().all(|h| h.held().is_none()), "the right hand alone does not hold it");
     // It falls back onto the table: its bottom (10 cm below its centre) on the top at 0.75.
     assert!((lowest - 0.85).abs() < 0.01, "rests at {lowest}");
+}
+
+#[test]
+fn the_rendered_hands_stop_at_each_other_where_the_tracked_ones_overlap() {
+    let scene = Scene::named("two-hands").unwrap();
+    let [l, r] = models();
+    // Palm to palm over the table's free middle, each tracked hand 3 cm past the other's.
+    let script = grasp_script::clap([&l, &r], Vec3::new(0.0, 1.0, -0.05), 0.03).unwrap();
+    let mut manip = two_handed(&scene);
+    let proxies: Vec<HandProxies> = manip.hands().iter().map(|h| HandProxies::new(&fit_proxies(h.input().model(), PROXY_MARGIN), h.rendered().skeleton())).collect();
+    let overlap = |worlds: [&[Affine3A]; 2]| -> (f32, f32) {
+        // The deepest overlap of any left proxy with any right one (m), and the least gap.
+        let mut deepest = 0.0f32;
+        let mut gap = f32::INFINITY;
+        for a in proxies[0].colliders() {
+            for b in proxies[1].colliders() {
+                let d = parry3d::query::distance(&pose_of(&worlds[0][a.joint]), &*a.shape, &pose_of(&worlds[1][b.joint]), &*b.shape).unwrap().distance;
+                gap = gap.min(d);
+                if d <= 0.0 {
+                    let c = parry3d::query::contact(&pose_of(&worlds[0][a.joint]), &*a.shape, &pose_of(&worlds[1][b.joint]), &*b.shape, 0.0).unwrap();
+                    deepest = deepest.max(c.map_or(0.0, |c| -c.dist));
+                }
+            }
+        }
+        (deepest, gap)
+    };
+    let (mut rendered_deepest, mut tracked_deepest, mut closest) = (0.0f32, 0.0f32, f32::INFINITY);
+    let mut k = 0;
+    while k < script.records.len() {
+        let t = script.records[k].time;
+        while k < script.records.len() && script.records[k].time == t {
+            manip.push(&script.records[k]).unwrap();
+            k += 1;
+        }
+        manip.step(t);
+        let h = manip.hands();
+        let (deep, gap) = overlap([h[0].rendered().world(), h[1].rendered().world()]);
+        rendered_deepest = rendered_deepest.max(deep);
+        closest = closest.min(gap);
+        tracked_deepest = tracked_deepest.max(overlap([h[0].constraint().tracked_world(), h[1].constraint().tracked_world()]).0);
+    }
+    assert!(tracked_deepest > 0.02, "the tracked hands overlap: {tracked_deepest}");
+    assert!(rendered_deepest < 0.001, "the rendered ones do not: {rendered_deepest} m deep");
+    assert!(closest < 0.003, "they meet: {closest} m apart at the closest");
 }

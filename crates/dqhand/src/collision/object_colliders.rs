@@ -6,13 +6,18 @@
 //!
 //! The table is a fixed slab under the objects: the hand meets it (a finger does not close
 //! through it) and the physics rests objects on it, but it is not an object to grasp.
+//!
+//! With two hands, each hand's proxies, where it was last rendered, are obstacles to the
+//! other ([`ObjectColliders::add_hand`]): the rendered hands do not pass through each other.
 
-use glam::{Quat, Vec3};
+use glam::{Affine3A, Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query;
 use parry3d::shape::{Shape, SharedShape, TriMeshFlags};
 
+use super::hand_proxies::pose_of;
+use super::HandProxies;
 use crate::Warning;
 use crate::scene::{ObjectMesh, ObjectShape, Scene};
 use crate::{Error, Result};
@@ -86,12 +91,16 @@ const TABLE_MARGIN: f32 = 0.3;
 /// The table's least half sizes (x, z), m.
 const TABLE_MIN_HALF: [f32; 2] = [0.6, 0.4];
 
-/// Every object of a scene, in file order, and the table.
+/// Every object of a scene, in file order, the table, and the hands' proxies.
 #[derive(Clone)]
 pub struct ObjectColliders {
-    /// The objects, then the table's slab when there is one.
+    /// The objects, then the table's slab when there is one, then each hand's proxies.
     all: Vec<ObjectCollider>,
     count: usize,
+    /// Per hand: where its proxies are in `all`, their joints, and whether it is there.
+    hands: Vec<(core::ops::Range<usize>, Vec<usize>, bool)>,
+    /// The hand being solved: its own proxies are no obstacle to it.
+    solving: Option<usize>,
     table: Option<TableTop>,
     warnings: Vec<Warning>,
 }
@@ -138,7 +147,7 @@ impl ObjectColliders {
             let aabb = surface.compute_aabb(&pose);
             objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb });
         }
-        Ok(Self { all: objects, count, table, warnings })
+        Ok(Self { all: objects, count, hands: Vec::new(), solving: None, table, warnings })
     }
 
     /// The objects, in scene order (not the table).
@@ -203,11 +212,57 @@ impl ObjectColliders {
         &mut self.all[..self.count]
     }
 
-    /// The broad phase: the objects, and the table (its index one past the objects'), whose
-    /// bounding box meets `aabb` (grown by `margin`), except `skip`.
+    /// The broad phase: the objects, the table (its index one past the objects') and the
+    /// other hand's proxies ([`Self::solving`]), whose bounding box meets `aabb` (grown by
+    /// `margin`), except `skip`.
     pub fn near(&self, aabb: &Aabb, margin: f32, skip: Option<usize>) -> impl Iterator<Item = (usize, &ObjectCollider)> {
         let aabb = aabb.loosened(margin);
-        self.all.iter().enumerate().filter(move |(i, o)| Some(*i) != skip && o.aabb.intersects(&aabb))
+        self.all.iter().enumerate().filter(move |(i, o)| Some(*i) != skip && o.aabb.intersects(&aabb) && self.obstacle(*i))
+    }
+
+    /// Adds a hand's `proxies` as obstacles to the other hands; returns the hand's index.
+    /// It is not there until [`Self::move_hand`] puts it somewhere.
+    pub fn add_hand(&mut self, proxies: &HandProxies) -> usize {
+        let start = self.all.len();
+        for p in proxies.colliders() {
+            let pose = Pose::IDENTITY;
+            let aabb = p.shape.compute_aabb(&pose);
+            self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb });
+        }
+        self.hands.push((start..self.all.len(), proxies.colliders().iter().map(|p| p.joint).collect(), false));
+        self.hands.len() - 1
+    }
+
+    /// Puts hand `hand`'s proxies on its joints' `world` transforms, or takes it away
+    /// (`None`: not tracked). Allocates nothing.
+    pub fn move_hand(&mut self, hand: usize, world: Option<&[Affine3A]>) {
+        let (range, joints, there) = &mut self.hands[hand];
+        *there = world.is_some();
+        let Some(world) = world else { return };
+        for (o, &j) in self.all[range.clone()].iter_mut().zip(joints.iter()) {
+            o.pose = pose_of(&world[j]);
+            o.aabb = o.surface.compute_aabb(&o.pose);
+        }
+    }
+
+    /// The hand whose rendered pose is solved next: the other hands' proxies are obstacles
+    /// to it, its own are not (`None`: no hand's are).
+    pub fn solving(&mut self, hand: Option<usize>) {
+        self.solving = hand;
+    }
+
+    /// Whether collider `i` (as [`Self::near`] numbers them) is a hand's proxy.
+    #[must_use]
+    pub fn is_hand(&self, i: usize) -> bool {
+        self.hands.first().is_some_and(|(r, _, _)| i >= r.start)
+    }
+
+    /// Whether collider `i` stops the hand being solved.
+    fn obstacle(&self, i: usize) -> bool {
+        match self.hands.iter().position(|(r, _, _)| r.contains(&i)) {
+            None => true,
+            Some(h) => self.hands[h].2 && self.solving.is_some_and(|s| s != h),
+        }
     }
 }
 

@@ -367,6 +367,33 @@ pub fn carry_between(models: [&Model; 2], file: &str, objects: &ObjectColliders,
     Ok(play(&mut paths, times, carry, 0.0, Some(2)))
 }
 
+/// Records of two flat hands (`models`: a left and a right one) brought together palm to
+/// palm at `centre` and pressed on `press` past it (m; a user's hands meet, the tracked ones
+/// overlap), held there for half a second and drawn apart: what keeps the rendered hands out
+/// of each other. A frame's records are the left hand's, then the right's.
+///
+/// # Errors
+/// As [`grasp`].
+pub fn clap(models: [&Model; 2], centre: Vec3, press: f32) -> Result<Script> {
+    let mut paths = [(Side::Left, Vec3::X), (Side::Right, Vec3::NEG_X)]
+        .into_iter()
+        .zip(models)
+        .map(|((side, d), model)| HandPath::new(model, side, d, Vec3::NEG_Z, false))
+        .collect::<Result<Vec<_>>>()?;
+    let mut times = GraspTimes { reached: 0.0, closed: 0.0, carry_start: 0.0, carry_end: 0.0, release: 0.0, end: 0.0 };
+    for (path, d) in paths.iter_mut().zip([Vec3::X, Vec3::NEG_X]) {
+        let start = centre - d * STANDOFF_M;
+        path.key(0.0, start, 0.0);
+        path.key(0.3, start, 0.0);
+        times.reached = path.key(f64::from(STANDOFF_M / 0.5), centre, 0.0);
+        times.closed = path.key(f64::from(press / 0.1), centre + d * press, 0.0);
+        times.release = path.key(0.5, centre + d * press, 0.0);
+        times.end = path.key(0.6, start, 0.0);
+        (times.carry_start, times.carry_end) = (times.release, times.release);
+    }
+    Ok(play(&mut paths, times, Vec3::ZERO, 0.0, None))
+}
+
 /// Records of a hand-over: the right hand (`models[1]`) grasps `object` from above near its
 /// +X end (`reach` off its middle), lifts it and carries it by `carry`; the left hand grasps
 /// it there near its −X end, the right one opens and draws back, and the left one carries

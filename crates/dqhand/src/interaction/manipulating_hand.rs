@@ -31,7 +31,7 @@ impl ManipulatingHand {
     /// `model` posed from records (as [`GestureLoop::new`]) among `scene`'s objects, its
     /// proxies added to `physics`.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams, physics: &mut ScenePhysics) -> Result<Self> {
+    pub(super) fn new(model: Arc<Model>, joint_model: JointModel, glove: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams, physics: &mut ScenePhysics, objects: Option<&mut ObjectColliders>) -> Result<Self> {
         let input = GestureLoop::new(model.clone(), joint_model, glove, config, gestures)?;
         let scene_commands = match input.gestures() {
             Some(set) if !scene.actions.is_empty() => Some(CommandTable::new(&scene.actions, set)?),
@@ -40,6 +40,10 @@ impl ManipulatingHand {
         let rendered = input.kinematics().clone();
         let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), rendered.skeleton());
         let physics = physics.add_hand(&proxies);
+        if let Some(objects) = objects {
+            let obstacle = objects.add_hand(&proxies);
+            debug_assert_eq!(obstacle, physics, "a hand has one index in both");
+        }
         Ok(Self {
             input,
             scene_commands,
@@ -93,7 +97,8 @@ impl ManipulatingHand {
 
     /// The second half, with the objects where they are now: the rendered pose solved, and a
     /// grasp detected on it.
-    pub(super) fn solve(&mut self, now: f64, objects: &ObjectColliders, poses: &[(Quat, Vec3)], detect: bool) -> Option<GraspEvent> {
+    pub(super) fn solve(&mut self, now: f64, objects: &mut ObjectColliders, poses: &[(Quat, Vec3)], detect: bool) -> Option<GraspEvent> {
+        objects.solving(Some(self.physics));
         self.constraint.solve(objects, self.grasp.held(), now);
         let tracking = self.tracking() == Tracking::Tracking;
         let c = &self.constraint;
@@ -116,11 +121,14 @@ impl ManipulatingHand {
         Vec3::from(c.tracked_world()[wrist].translation - c.world()[wrist].translation)
     }
 
-    /// The hand's proxies where the rendered hand is, for the physics; none while the hand
-    /// is lost.
-    pub(super) fn place(&self, physics: &mut ScenePhysics) {
-        let tracked = self.tracking() == Tracking::Tracking;
-        physics.move_hand(self.physics, tracked.then(|| self.constraint.world()));
+    /// The hand's proxies where the rendered hand is, for the physics (and, with `objects`,
+    /// as obstacles to the other hand); none while the hand is lost.
+    pub(super) fn place(&self, physics: &mut ScenePhysics, objects: Option<&mut ObjectColliders>) {
+        let world = (self.tracking() == Tracking::Tracking).then(|| self.constraint.world());
+        physics.move_hand(self.physics, world);
+        if let Some(objects) = objects {
+            objects.move_hand(self.physics, world);
+        }
     }
 
     /// Which hand this is (its model's).

@@ -97,11 +97,12 @@ impl ManipulationLoop {
     }
 
     fn with_hands(models: Vec<(Arc<Model>, Option<GloveMapper>)>, joint_model: JointModel, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
-        let objects = ObjectColliders::new(scene)?;
+        let mut objects = ObjectColliders::new(scene)?;
         let mut physics = ScenePhysics::new(scene, &objects);
+        let two = models.len() > 1;
         let hands = models
             .into_iter()
-            .map(|(model, glove)| ManipulatingHand::new(model, joint_model, glove, config.clone(), gestures.clone(), scene, params, &mut physics))
+            .map(|(model, glove)| ManipulatingHand::new(model, joint_model, glove, config.clone(), gestures.clone(), scene, params, &mut physics, two.then_some(&mut objects)))
             .collect::<Result<Vec<_>>>()?;
         let poses = (0..scene.objects.len()).map(|i| physics.pose(i)).collect();
         Ok(Self {
@@ -201,10 +202,14 @@ impl ManipulationLoop {
                 self.poses[held] = (q, t);
             }
         }
+        // Each hand solved against the objects and the other hand as last placed.
+        let two = self.hands.len() > 1;
         for (k, hand) in self.hands.iter_mut().enumerate() {
-            let detected = hand.solve(now, &self.objects, &self.poses, events.0[k].is_none());
+            let detected = hand.solve(now, &mut self.objects, &self.poses, events.0[k].is_none());
             events.0[k] = events.0[k].or(detected);
+            hand.place(&mut self.physics, two.then_some(&mut self.objects));
         }
+        self.objects.solving(None);
         if let [a, b] = &mut self.hands[..] {
             let (ca, cb) = (&a.constraint, &b.constraint);
             let (pa, pb) = (a.pushed(), b.pushed());
@@ -215,9 +220,6 @@ impl ManipulationLoop {
             }
         }
         self.apply(&events);
-        for hand in &self.hands {
-            hand.place(&mut self.physics);
-        }
         self.physics.step(dt as f32);
         self.read_poses();
         events

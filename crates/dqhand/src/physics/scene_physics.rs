@@ -113,21 +113,21 @@ impl ScenePhysics {
     /// them, and does not bat them. A joint already where it goes ([`PLACED_M`]) is left
     /// alone.
     pub fn move_hand(&mut self, hand: usize, world: Option<&[Affine3A]>) {
+        // Rapier marks every body borrowed mutably as changed: only those that change are.
         for &(h, joint) in &self.hands[hand] {
-            let body = &mut self.world.bodies[h];
+            let placed = &self.world.bodies[h];
             let Some(world) = world else {
-                if body.is_enabled() {
-                    body.set_enabled(false);
+                if placed.is_enabled() {
+                    self.world.bodies[h].set_enabled(false);
                 }
                 continue;
             };
-            if !body.is_enabled() {
-                body.set_enabled(true);
-            }
             let pose = pose_of(&world[joint]);
-            if near(body.position(), &pose) && near(body.next_position(), &pose) {
+            if placed.is_enabled() && near(placed.position(), &pose) && near(placed.next_position(), &pose) {
                 continue;
             }
+            let body = &mut self.world.bodies[h];
+            body.set_enabled(true);
             body.set_position(pose, true);
             body.set_next_kinematic_position(pose);
         }

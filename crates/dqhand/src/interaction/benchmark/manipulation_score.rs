@@ -234,12 +234,12 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
 }
 
 /// Whether the segment `from`–`to` crosses the surface of an object (or the table) other
-/// than `skip`.
+/// than `skip` (not a hand's proxies: the rendered hands stop each other short of them).
 fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3) -> bool {
     let length = from.distance(to);
     if length <= f32::EPSILON {
         return false;
     }
     let ray = Ray::new(from, (to - from) / length);
-    objects.near(&Aabb::from_points([from, to]), 0.0, skip).any(|(_, o)| o.surface.cast_ray(&o.pose, &ray, length, false).is_some())
+    objects.near(&Aabb::from_points([from, to]), 0.0, skip).any(|(i, o)| !objects.is_hand(i) && o.surface.cast_ray(&o.pose, &ray, length, false).is_some())
 }
