@@ -55,7 +55,7 @@ fn a_baton_is_handed_from_the_right_hand_to_the_left() {
     let scene = Scene::named("two-hands").unwrap();
     let objects = ObjectColliders::new(&scene).unwrap();
     let [l, r] = models();
-    let carry = Vec3::new(0.0, 0.0, 0.15);
+    let carry = Vec3::new(0.0, 0.0, 0.12);
     let script = grasp_script::hand_over([&l, &r], "two-hands", &objects, "baton", 0.08, 0.12, carry).unwrap();
     let start = scene.objects[1].position;
     let (score, _) = run(&scene, &script, "baton", start + 2.0 * carry);

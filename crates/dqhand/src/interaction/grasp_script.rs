@@ -559,14 +559,17 @@ impl HeadsetTracking {
     /// 2 mm of joint jitter, 1 % of records lost, 30 ms behind.
     pub const QUEST_LIKE: Self = Self { jitter_m: 0.002, drop_rate: 0.01, latency_s: 0.03 };
 
-    /// `script` as this tracking reports it (seeded): each record carries the hand of
-    /// `latency_s` earlier with noisy joints, and some are lost. The truth and the times stay
+    /// `script` as this tracking reports it (seeded): each record carries its hand of
+    /// `latency_s` earlier with noisy joints, and some are lost (each hand's independently). The truth and the times stay
     /// the script's: the hand the user has now.
     #[must_use]
     pub fn track(&self, script: &Script, seed: u64) -> Script {
         let mut rng = crate::math::Rng::new(seed);
         let sigma = self.jitter_m / 3f32.sqrt();
-        let behind = (self.latency_s * RATE_HZ).round() as usize;
+        // A frame's records are one per hand: a hand's record `behind` frames earlier is as
+        // many frames' records back.
+        let per_frame = script.records.iter().take_while(|r| script.records.first().is_some_and(|f| f.time == r.time)).count().max(1);
+        let behind = (self.latency_s * RATE_HZ).round() as usize * per_frame;
         let mut out = Script { records: Vec::with_capacity(script.records.len()), truth: Vec::with_capacity(script.truth.len()), times: script.times, carry: script.carry, drop: script.drop };
         for (k, (record, truth)) in script.records.iter().zip(&script.truth).enumerate() {
             if rng.next_f64() < self.drop_rate {

@@ -28,6 +28,9 @@ use crate::skin::{Method, MethodSet, SkinLayer};
 /// Farthest a set-down object may rest from where the script carried it, m.
 pub const PLACE_TOLERANCE_M: f32 = 0.03;
 
+/// Deepest the rendered skin may be in a held object on any frame of a successful run, m.
+pub const HELD_DEPTH_M: f32 = 0.001;
+
 /// How far inside a mesh object depth is measured, m: the winding number over every triangle
 /// is too slow for every vertex of every frame, and skin deeper than this would have crossed
 /// the surface within it on its way in (the palm-crossing check counts a hand gone further).
@@ -39,8 +42,9 @@ pub type FlatMesh = (Vec<[f32; 3]>, Vec<u32>);
 /// What one scripted run measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunScore {
-    /// The object was grasped before the carry, held through it, let go once the fingers
-    /// opened, and came to rest within [`PLACE_TOLERANCE_M`] of where it was carried.
+    /// The object was grasped before the carry, held through it with the rendered skin no
+    /// deeper in it than [`HELD_DEPTH_M`] on any frame, let go once the fingers opened, and
+    /// came to rest within [`PLACE_TOLERANCE_M`] of where it was carried.
     pub success: bool,
     /// Where the object came to rest, from where it was carried to, m.
     pub place_error_m: f32,
@@ -48,6 +52,8 @@ pub struct RunScore {
     pub max_penetration_m: f32,
     /// The mean over frames with a contact of each frame's deepest vertex, m.
     pub mean_penetration_m: f32,
+    /// The deepest any rendered skin vertex went into the object on a frame it was held, m.
+    pub held_penetration_m: f32,
     /// How far the carried object moved in the tracked wrist's frame during the carry, m (the
     /// wrist of the hand holding it when the carry began).
     pub slip_m: f32,
@@ -63,8 +69,8 @@ pub struct RunScore {
     pub release_drift_m: f32,
     /// Frames from the fingers beginning to open to the release, if released.
     pub release_frames: Option<u32>,
-    /// The rendered palm's centre or a fingertip crossed the surface of an object it did not
-    /// hold between two frames.
+    /// The rendered palm's centre or a finger's last phalanx crossed the surface of an object
+    /// it did not hold between two frames.
     pub tunnelled: bool,
     /// Seconds each frame's [`ManipulationLoop::step`] took (collision, grasp, physics; every
     /// hand's).
@@ -95,9 +101,11 @@ pub fn depth(object: &ObjectCollider, mesh: Option<&FlatMesh>, p: Vec3) -> f32 {
     }
 }
 
-/// WebXR indices of the points that must not cross a surface: the five fingertips; the palm's
-/// centre is added between the wrist (0) and the middle finger's knuckle (11).
-const TIPS: [usize; 5] = [4, 9, 14, 19, 24];
+/// WebXR indices of the points that must not cross a surface: the middle of each finger's
+/// distal phalanx, between its distal joint and its tip (the tip itself lies on the skin, and
+/// touches what the finger rests on); the palm's centre is added between the wrist (0) and the
+/// middle finger's knuckle (11).
+const TIPS: [(usize, usize); 5] = [(3, 4), (8, 9), (13, 14), (18, 19), (23, 24)];
 
 /// Runs `script` through `manip` (fresh, on the script's scene; one hand or two, as the script
 /// has records of one side or both) and scores it: `object` is the index of the scripted
@@ -120,6 +128,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         place_error_m: f32::INFINITY,
         max_penetration_m: 0.0,
         mean_penetration_m: 0.0,
+        held_penetration_m: 0.0,
         slip_m: 0.0,
         slip_deg: 0.0,
         carry_lag_m: 0.0,
@@ -195,8 +204,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             // and the fingertips must not cross a surface between frames.
             let p = joints[k].read(hand.rendered().world());
             let mut now = [(p[0] + p[11]) / 2.0; TIPS.len() + 1];
-            for (n, &tip) in now[1..].iter_mut().zip(&TIPS) {
-                *n = p[tip];
+            for (n, &(distal, tip)) in now[1..].iter_mut().zip(&TIPS) {
+                *n = (p[distal] + p[tip]) / 2.0;
             }
             if let Some(last) = tracked_points[k].replace(now) {
                 score.tunnelled |= last.iter().zip(&now).any(|(a, b)| crossed(manip.objects(), hand.held(), *a, *b));
@@ -205,14 +214,21 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             skin.extend_from_slice(rendered_skin[k].deformed(Method::Dqb).expect("DQB is the set").positions());
         }
         let colliders = manip.objects().objects();
-        let mut deepest = 0.0f32;
+        let (mut deepest, mut in_held) = (0.0f32, 0.0f32);
         for v in &skin {
             let v = Vec3::from(*v);
-            for (o, m) in colliders.iter().zip(&meshes) {
-                deepest = deepest.max(depth(o, m.as_ref(), v));
+            for (i, (o, m)) in colliders.iter().zip(&meshes).enumerate() {
+                let d = depth(o, m.as_ref(), v);
+                deepest = deepest.max(d);
+                if i == object {
+                    in_held = in_held.max(d);
+                }
             }
         }
         score.max_penetration_m = score.max_penetration_m.max(deepest);
+        if holder.is_some() {
+            score.held_penetration_m = score.held_penetration_m.max(in_held);
+        }
         if manip.hands().iter().any(|h| !h.contacts().is_empty()) {
             penetration_sum += f64::from(deepest);
             contact_frames += 1;
@@ -229,17 +245,25 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         let rest = fallen.unwrap_or(manip.poses()[object].1);
         score.release_drift_m = Vec3::new(rest.x - at.x, 0.0, rest.z - at.z).length();
     }
-    score.success = grasped_before_carry && held_through_carry && released && manip.hands().iter().all(|h| h.held() != Some(object)) && score.place_error_m <= PLACE_TOLERANCE_M;
+    score.success = grasped_before_carry && held_through_carry && score.held_penetration_m <= HELD_DEPTH_M && released && manip.hands().iter().all(|h| h.held() != Some(object)) && score.place_error_m <= PLACE_TOLERANCE_M;
     score
 }
 
 /// Whether the segment `from`–`to` crosses the surface of an object (or the table) other
-/// than `skip` (not a hand's proxies: the rendered hands stop each other short of them).
+/// than `skip` (a mesh's inside is where parry's point query puts it) (not a hand's proxies: the rendered hands stop each other short of them).
 fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3) -> bool {
     let length = from.distance(to);
     if length <= f32::EPSILON {
         return false;
     }
     let ray = Ray::new(from, (to - from) / length);
-    objects.near(&Aabb::from_points([from, to]), 0.0, skip).any(|(i, o)| !objects.is_hand(i) && o.surface.cast_ray(&o.pose, &ray, length, false).is_some())
+    // Into or out of it, or in and out again within the step (both ends outside, the ray
+    // meets it): a point that stays inside has not crossed (it is a depth, measured apart).
+    objects.near(&Aabb::from_points([from, to]), 0.0, skip).filter(|(i, _)| !objects.is_hand(*i)).any(|(_, o)| {
+        let inside = |p: Vec3| o.surface.contains_point(&o.pose, p);
+        match (inside(from), inside(to)) {
+            (false, false) => o.surface.cast_ray(&o.pose, &ray, length, true).is_some(),
+            (a, b) => a != b,
+        }
+    })
 }

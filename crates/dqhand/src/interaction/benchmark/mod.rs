@@ -16,6 +16,6 @@ mod retarget_score;
 pub use angle_error::AngleError;
 pub use distribution::Distribution;
 pub use lag_score::{lag, LagScore};
-pub use manipulation_score::{depth, score, FlatMesh, RunScore, MESH_DEPTH_RANGE_M, PLACE_TOLERANCE_M};
+pub use manipulation_score::{depth, score, FlatMesh, RunScore, HELD_DEPTH_M, MESH_DEPTH_RANGE_M, PLACE_TOLERANCE_M};
 pub use recognition_score::{HoldOutcome, LoggedEvent, RecognitionScore, RECOGNITION_DEADLINE_S, NO_GESTURE};
 pub use retarget_score::{close_pinch, thumb_index_gap, RetargetScore, CLOSED_GAPS_M, CONTACT_GAP_M};
