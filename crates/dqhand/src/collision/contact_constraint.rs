@@ -125,6 +125,8 @@ pub struct ContactConstraint {
     /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
     /// small to cast add up to [`STILL_M`] at most.
     uncast: f32,
+    /// The proxy whose impact stopped the wrist in the last cast that was stopped.
+    stopped_by: Option<usize>,
     /// Per joint: the finger whose closure moves it (none for the wrist and the metacarpals that
     /// only the wrist moves; the ring and little metacarpals turn with their fingers).
     moved_by: Vec<Option<usize>>,
@@ -212,6 +214,7 @@ impl ContactConstraint {
             carried: None,
             held_prefix: [0; 5],
             uncast: 0.0,
+            stopped_by: None,
             moved_by,
             proxies,
             fingers,
@@ -343,7 +346,12 @@ impl ContactConstraint {
         }
         self.uncast = 0.0;
         let mut toi: f32 = 1.0;
-        for p in self.proxies.colliders() {
+        // The proxy that stopped the wrist last is asked first: a hand held back on a surface
+        // finds its time of impact at once, and every later cast only up to it.
+        let proxies = self.proxies.colliders();
+        let first = self.stopped_by.take().unwrap_or(0);
+        for k in (0..proxies.len()).map(|k| (k + first) % proxies.len()) {
+            let p = &proxies[k];
             let offset = to_wrist * world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
@@ -353,7 +361,14 @@ impl ContactConstraint {
             let bulge = radius * angvel.length().min(core::f32::consts::PI) / 2.0;
             let swept = p.shape.compute_swept_aabb(&from, &to).loosened(bulge);
             let motion = NonlinearRigidMotion::new(from, offset.inverse().transform_point3(Vec3::ZERO), linvel, angvel);
+            // How far any of its points can move before `toi`: a surface farther than that
+            // from where it starts cannot be reached (one distance query, where the cast
+            // would test every triangle the swept box meets).
+            let reach = (linvel.length() + angvel.length() * radius) * toi;
             for (_, o) in objects.near(&swept, 0.0, held) {
+                if o.distance_at_least(&from, &*p.shape, reach) > reach {
+                    continue;
+                }
                 let still = NonlinearRigidMotion::constant_position(o.pose);
                 // Nothing that misses the hull can hit the surface inside it (a proxy that
                 // starts inside the hull counts as a hit: the surface decides).
@@ -362,7 +377,11 @@ impl ContactConstraint {
                     continue;
                 }
                 if let Ok(Some(hit)) = query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false) {
-                    toi = toi.min(hit.time_of_impact);
+                    let hit = hit.time_of_impact;
+                    if hit < toi {
+                        toi = hit;
+                        self.stopped_by = Some(k);
+                    }
                 }
             }
         }
