@@ -74,3 +74,42 @@ fn bad_scenes_are_refused_naming_the_file_and_field() {
     assert!(err.contains("bad.json") && err.contains("mass"), "{err}");
     assert!(!Path::new(&trace).exists(), "nothing written");
 }
+
+#[test]
+fn a_recording_of_both_hands_drives_a_left_and_a_right_hand() {
+    let dir = temp_dir("two-hands");
+    let rec = dir.join("two.jsonl");
+    let trace = dir.join("trace.jsonl");
+    let meshes = dir.join("meshes");
+    let out = dqhand(&["synthesize", "--scene", "two-hands", "--out", rec.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&rec).unwrap();
+    assert!(text.contains("\"hand\":\"left\"") && text.contains("\"hand\":\"right\""), "records of both sides");
+    let args = ["grasp", "--scene", "two-hands", "--left-model", "builtin", "--input", rec.to_str().unwrap(), "--trace", trace.to_str().unwrap(), "--meshes", meshes.to_str().unwrap(), "--every", "300"];
+    let out = dqhand(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<Value> = std::fs::read_to_string(&trace).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    // Who held what, in turn: the box by both hands, then the bar by the right, by both, by
+    // the left alone.
+    let mut held: Vec<(Value, Value)> = Vec::new();
+    for l in &lines {
+        assert!(l["tracking"]["left"].is_string() && l["tracking"]["right"].is_string(), "{l}");
+        let now = (l["held"]["left"].clone(), l["held"]["right"].clone());
+        if held.last() != Some(&now) {
+            held.push(now);
+        }
+    }
+    let names: Vec<(Option<&str>, Option<&str>)> = held.iter().map(|(l, r)| (l.as_str(), r.as_str())).collect();
+    assert_eq!(
+        names,
+        [(None, None), (Some("box"), Some("box")), (None, None), (None, Some("baton")), (Some("baton"), Some("baton")), (Some("baton"), None), (None, None)],
+        "the hold of each hand in turn"
+    );
+    let last = lines.last().unwrap();
+    let bar = last["objects"]["baton"]["p"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect::<Vec<_>>();
+    assert!((bar[2] - 0.24).abs() < 0.03 && (bar[1] - 0.78).abs() < 0.01, "the bar handed over and set down 24 cm on: {bar:?}");
+    for side in ["left", "right"] {
+        let ply = meshes.join(format!("300-{side}.ply"));
+        assert!(std::fs::read(&ply).unwrap().starts_with(b"ply"), "{}", ply.display());
+    }
+}

@@ -148,3 +148,11 @@ fn the_rendered_hands_stop_at_each_other_where_the_tracked_ones_overlap() {
     assert!(rendered_deepest < 0.001, "the rendered ones do not: {rendered_deepest} m deep");
     assert!(closest < 0.003, "they meet: {closest} m apart at the closest");
 }
+
+#[test]
+fn two_hands_of_one_side_are_refused() {
+    let [_, r] = models();
+    let scene = Scene::named("two-hands").unwrap();
+    let e = ManipulationLoop::two_handed([(r.clone(), None), (r, None)], JointModel::Full, InputConfig::default(), None, &scene, GraspParams::default()).err().unwrap().to_string();
+    assert!(e.contains("a left and a right") && e.contains("right"), "{e}");
+}

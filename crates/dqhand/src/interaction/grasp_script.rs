@@ -86,6 +86,19 @@ pub struct Script {
     pub drop: f32,
 }
 
+impl Script {
+    /// The same script `offset` seconds later: its records and its times.
+    pub fn shift(&mut self, offset: f64) {
+        for r in &mut self.records {
+            r.time += offset;
+        }
+        let t = &mut self.times;
+        for x in [&mut t.reached, &mut t.closed, &mut t.carry_start, &mut t.carry_end, &mut t.release, &mut t.end] {
+            *x += offset;
+        }
+    }
+}
+
 /// Records per second.
 pub const RATE_HZ: f64 = 60.0;
 
@@ -477,14 +490,8 @@ pub fn sequence(model: &Arc<Model>, file: &str, objects: &ObjectColliders, tasks
     let mut scripts = Vec::with_capacity(tasks.len());
     for task in tasks {
         let mut s = grasp(model.clone(), file, objects, task, side)?;
-        for r in &mut s.records {
-            r.time += offset;
-        }
-        let t = &mut s.times;
-        for x in [&mut t.reached, &mut t.closed, &mut t.carry_start, &mut t.carry_end, &mut t.release, &mut t.end] {
-            *x += offset;
-        }
-        offset = t.end + TASK_GAP_S;
+        s.shift(offset);
+        offset = s.times.end + TASK_GAP_S;
         scripts.push(s);
     }
     Ok(scripts)
