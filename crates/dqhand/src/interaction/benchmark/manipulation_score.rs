@@ -185,12 +185,12 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
                 None => held_through_carry = false,
             }
         }
-        if events.iter().any(|(_, e)| matches!(e, GraspEvent::Release { object: o, .. } if o == object)) && holder.is_none() {
-            if t >= times.release && !released {
-                released = true;
-                let_go = Some(manip.poses()[object].1);
-                score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
-            }
+        // Let go by the last hand holding it.
+        let let_go_now = events.iter().any(|(_, e)| matches!(e, GraspEvent::Release { object: o, .. } if o == object)) && holder.is_none();
+        if let_go_now && t >= times.release && !released {
+            released = true;
+            let_go = Some(manip.poses()[object].1);
+            score.release_frames = Some(((t - times.release) * RATE_HZ).round() as u32);
         }
         if let (Some(at), None) = (let_go, fallen) {
             let now = manip.poses()[object].1;
