@@ -82,7 +82,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     }
     let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
-    let names: Vec<String> = manip.hands()[0].rendered().skeleton().names().map(str::to_owned).collect();
+    // Each hand's joint names (two models need not share a skeleton).
+    let names: Vec<Vec<String>> = manip.hands().iter().map(|h| h.rendered().skeleton().names().map(str::to_owned).collect()).collect();
     let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None, arrival: None };
     let mut pending: Option<Record> = None;
     let (mut frame, mut refused) = (0u64, 0u64);
@@ -136,18 +137,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &[String]) -> anyhow::Result<()> {
+fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &[Vec<String>]) -> anyhow::Result<()> {
     let names = manip.names();
-    let per_hand = |f: &dyn Fn(&ManipulatingHand) -> Value| match manip.hands() {
-        [one] => f(one),
-        hands => Value::Object(hands.iter().map(|h| (h.side().name().to_owned(), f(h))).collect()),
+    let per_hand = |f: &dyn Fn(&ManipulatingHand, &[String]) -> Value| match manip.hands() {
+        [one] => f(one, &joints[0]),
+        hands => Value::Object(hands.iter().zip(joints).map(|(h, j)| (h.side().name().to_owned(), f(h, j))).collect()),
     };
-    let contacts = per_hand(&|h| {
+    let contacts = per_hand(&|h, joints| {
         h.contacts().iter().map(|c| json!({"bone": joints[c.joint], "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array()})).collect()
     });
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({"p": p.to_array(), "q": q.to_array()}))).collect();
-    let tracking = per_hand(&|h| json!(if h.tracking() == Tracking::Tracking { "ok" } else { "lost" }));
-    let held = per_hand(&|h| json!(h.held().map(|i| &names[i])));
+    let tracking = per_hand(&|h, _| json!(if h.tracking() == Tracking::Tracking { "ok" } else { "lost" }));
+    let held = per_hand(&|h, _| json!(h.held().map(|i| &names[i])));
     serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": held, "contacts": contacts, "objects": objects}))?;
     out.write_all(b"\n")?;
     Ok(())

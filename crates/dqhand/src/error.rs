@@ -281,6 +281,16 @@ pub enum GestureProblem {
         /// The classifier's classes, comma-separated (empty without a classifier).
         valid: String,
     },
+    /// A two-hand gesture names a one-hand gesture the set lacks.
+    #[error("two-hand gesture {two_hand:?}: no gesture {gesture:?} in the set of each hand; valid: {valid}")]
+    UnknownGesture {
+        /// The two-hand gesture.
+        two_hand: String,
+        /// The one-hand gesture it names.
+        gesture: String,
+        /// The set's gesture names, comma-separated.
+        valid: String,
+    },
     /// A setting (`min_hold_s`, a hysteresis margin) is negative or not finite.
     #[error("{name} {value} is not a finite number ≥ 0")]
     BadSetting {

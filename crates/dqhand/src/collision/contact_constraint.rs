@@ -278,8 +278,8 @@ impl ContactConstraint {
     /// stop the wrist, and the fingers that touched it keep their grip (the module
     /// documentation, stage 2). Allocates nothing once `near` has grown to the scene.
     pub fn solve(&mut self, objects: &ObjectColliders, held: Option<usize>, now: f64) {
-        if self.near.capacity() < objects.objects().len() {
-            self.near.reserve(objects.objects().len());
+        if self.near.capacity() < objects.len() {
+            self.near.reserve(objects.len());
         }
         let target = self.tracked.wrist.unwrap_or_else(|| self.kinematics.rig().rest_wrist());
         let (wrist, carrier) = match self.grip {
@@ -365,7 +365,9 @@ impl ContactConstraint {
             for (_, o) in objects.near(&swept, 0.0, held) {
                 // parry's distance to a mesh's thin triangles can be several millimetres long.
                 let slack = if o.mesh.is_some() { MESH_DISTANCE_SLACK } else { 0.0 };
-                if o.distance_at_least(&from, &*p.shape, reach + slack) > reach + slack {
+                let gap = o.distance_at_least(&from, &*p.shape, reach + slack);
+                // (A query parry cannot answer reads as infinitely far: then cast.)
+                if gap > reach + slack && gap.is_finite() {
                     continue;
                 }
                 let still = NonlinearRigidMotion::constant_position(o.pose);

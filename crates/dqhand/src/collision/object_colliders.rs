@@ -165,7 +165,19 @@ impl ObjectColliders {
     /// The table's slab as a collider (index [`Self::objects`]`.len()` in [`Self::near`]).
     #[must_use]
     pub fn table_collider(&self) -> Option<&ObjectCollider> {
-        self.all.get(self.count)
+        self.table.and(self.all.get(self.count))
+    }
+
+    /// How many colliders [`Self::near`] may name: the objects, the table, the hands' proxies.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.all.len()
+    }
+
+    /// Whether there is nothing at all (no object, no table, no hand).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.all.is_empty()
     }
 
     /// What was accepted with a doubt (a flat mesh, dropped triangles), one line each.
@@ -249,12 +261,6 @@ impl ObjectColliders {
     /// to it, its own are not (`None`: no hand's are).
     pub fn solving(&mut self, hand: Option<usize>) {
         self.solving = hand;
-    }
-
-    /// Whether collider `i` (as [`Self::near`] numbers them) is a hand's proxy.
-    #[must_use]
-    pub fn is_hand(&self, i: usize) -> bool {
-        self.hands.first().is_some_and(|(r, _, _)| i >= r.start)
     }
 
     /// Whether collider `i` stops the hand being solved.

@@ -69,6 +69,9 @@ pub type TwoHanded<'a> = (&'a Grasp, &'a [Contact], &'a [Closure; 5], Vec3);
 
 /// At most this many contact points hold an object (the first ones found).
 const MAX_ANCHORS: usize = 16;
+/// At most this many points of one hand hold an object ([`Grasp::holding_points`]): its
+/// contacts and the wrist frame's.
+pub const MAX_HOLDING_POINTS: usize = MAX_ANCHORS + WRIST_POINTS.len();
 /// The wrist frame's points added to the contacts: origin and 5 cm along each axis, so that
 /// two contacts (a pinch) still fix the object's rotation.
 const WRIST_POINTS: [Vec3; 4] = [Vec3::ZERO, Vec3::new(0.05, 0.0, 0.0), Vec3::new(0.0, 0.05, 0.0), Vec3::new(0.0, 0.0, 0.05)];
@@ -299,9 +302,9 @@ impl Grasp {
     }
 
     /// Lets go of the held object now (the other hand let go of a two-hand hold, or the two
-    /// hands drew apart), with the hand's velocity when `moving`.
-    pub fn let_go(&mut self, now: f64, moving: bool) -> Option<GraspEvent> {
-        self.held.is_some().then(|| self.release(now, moving))
+    /// hands drew apart), with the hand's velocity.
+    pub fn let_go(&mut self, now: f64) -> Option<GraspEvent> {
+        self.held.is_some().then(|| self.release(now, true))
     }
 
     /// Whether `c` presses on its object: a palm always does, a finger when it is tracked
@@ -531,6 +534,6 @@ mod tests {
         assert_eq!(g.follow(0.2, true, &closure(0.0), &world(Vec3::X * 0.01), &world(Vec3::ZERO)), None);
         let (q, t) = g.target().unwrap();
         assert!((t - up.1).length() < 1e-6 && q.angle_between(Quat::IDENTITY) < 1e-5, "{t}");
-        assert!(matches!(g.let_go(0.3, false), Some(GraspEvent::Release { object: 0, .. })));
+        assert!(matches!(g.let_go(0.3), Some(GraspEvent::Release { object: 0, .. })));
     }
 }

@@ -31,4 +31,4 @@
 
 mod hand_grasp;
 
-pub use hand_grasp::{Grasp, GraspEvent, GraspParams, TwoHanded};
+pub use hand_grasp::{Grasp, GraspEvent, GraspParams, TwoHanded, MAX_HOLDING_POINTS};

@@ -582,7 +582,8 @@ impl HeadsetTracking {
             if rng.next_f64() < self.drop_rate {
                 continue;
             }
-            let mut hand = script.records[k.saturating_sub(behind)].hand;
+            // (The first frames, with nothing that old, carry their own hand.)
+            let mut hand = script.records[if k >= behind { k - behind } else { k }].hand;
             if let Some(HandData::Joints(joints)) = &mut hand {
                 for i in 0..25 {
                     if let Some(&j) = joints.get(i) {

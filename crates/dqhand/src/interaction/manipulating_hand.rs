@@ -113,6 +113,17 @@ impl ManipulatingHand {
         self.grasp.take(now, object, pose, false, c.contacts(), c.closure(), c.world(), c.tracked_world(), wrist)
     }
 
+    /// The hand's gesture now, while it is tracked.
+    pub(super) fn gesture(&self) -> Option<&str> {
+        self.input.gesture().filter(|_| self.tracking() == Tracking::Tracking)
+    }
+
+    /// Where the tracked wrist is (world, m).
+    pub(super) fn wrist(&self) -> Vec3 {
+        let wrist = self.input.kinematics().rig().wrist();
+        Vec3::from(self.constraint.tracked_world()[wrist].translation)
+    }
+
     /// How far the tracked wrist is from the rendered one (tracked less rendered, m): into
     /// what stops the rendered hand.
     pub(super) fn pushed(&self) -> Vec3 {

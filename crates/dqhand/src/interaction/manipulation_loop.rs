@@ -3,12 +3,16 @@
 //! never sinks in) and its contacts; grasping heuristics pick objects up, carry them and let
 //! them go; the physics moves the rest. Gestures stay commands: the scene file's actions.
 //!
-//! One frame ([`ManipulationLoop::step`]) in order:
+//! One frame ([`ManipulationLoop::step`]) in order, each hand in turn where there are two:
 //! 1. the tracked pose (records pushed since the last frame, tracking loss judged now);
-//! 2. the held object follows the tracked hand, or is released;
-//! 3. the rendered pose is solved against the objects where they now are;
-//! 4. a grasp is detected on the rendered contacts;
-//! 5. the physics steps (the held object moved by the hand), and the objects' poses are read.
+//! 2. the held object follows the tracked hand, or is released; with two hands, what both
+//!    hold takes the fit of both, a hand-over keeps what one lets go in the other, and the
+//!    gestures of both hands are recognised;
+//! 3. the rendered pose is solved against the objects where they now are (and the other hand,
+//!    as last solved), and its proxies placed in the physics (none while the hand is lost: what
+//!    rested on it falls);
+//! 4. a grasp is detected on the rendered contacts (a hand's own, then one of both hands);
+//! 5. the physics steps (the held objects moved by the hands), and the objects' poses are read.
 
 use std::sync::Arc;
 
@@ -16,10 +20,10 @@ use glam::{Quat, Vec3};
 
 use super::ManipulatingHand;
 use crate::collision::ObjectColliders;
-use crate::gesture::{Events, GestureSet};
+use crate::gesture::{Events, GestureSet, TwoHandEvent, TwoHandRecognizer};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
-use crate::input::{GloveMapper, InputConfig, Record, Rejection};
-use crate::kinematics::JointModel;
+use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
+use crate::kinematics::{JointModel, Side};
 use crate::math::rigid_fit;
 use crate::model::Model;
 use crate::physics::ScenePhysics;
@@ -30,11 +34,11 @@ use crate::{Error, Result};
 const MAX_STEP_S: f64 = 1.0 / 30.0;
 
 /// Most holding points of one object: both hands' ([`Grasp::holding_points`]).
-const MAX_HOLDING_POINTS: usize = 48;
+const MAX_HOLDING_POINTS: usize = 2 * crate::grasp::MAX_HOLDING_POINTS;
 
-/// What a frame changed, per hand (in [`ManipulationLoop::hands`] order).
+/// What a frame changed: per hand (in [`ManipulationLoop::hands`] order), and of both.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct HandEvents([Option<GraspEvent>; 2]);
+pub struct HandEvents([Option<GraspEvent>; 2], [Option<TwoHandEvent>; 2]);
 
 impl HandEvents {
     /// Hand `hand`'s grasp or release this frame.
@@ -46,6 +50,12 @@ impl HandEvents {
     /// Every hand's event: (hand, event).
     pub fn iter(&self) -> impl Iterator<Item = (usize, GraspEvent)> + '_ {
         self.0.iter().enumerate().filter_map(|(k, e)| e.map(|e| (k, e)))
+    }
+
+    /// The two-hand gesture that ended this frame and the one that began
+    /// ([`ManipulationLoop::two_hand_gestures`]).
+    pub fn two_hand(&self) -> impl Iterator<Item = TwoHandEvent> + '_ {
+        self.1.iter().flatten().copied()
     }
 }
 
@@ -61,6 +71,8 @@ pub struct ManipulationLoop {
     params: GraspParams,
     /// How far apart the two hands' contacts were when they took an object between them.
     between: f32,
+    /// Gestures of both hands, recognised in a loop of two with recognition on.
+    two_hand: Option<TwoHandRecognizer>,
     last: Option<f64>,
     reset_due: bool,
 }
@@ -84,15 +96,18 @@ impl ManipulationLoop {
     /// A loop of two hands: `hands`, a left and a right model each built as itself (and the
     /// glove mapping of each, if gloves drive them); a record drives the hand of its side.
     /// Each hand grasps by itself; both hold what they grasp together (see [`crate::grasp`]).
+    /// With `gestures` (holding `open_palm`), the built-in two-hand gestures are recognised too
+    /// ([`Self::set_two_hand_gestures`]).
     ///
     /// # Errors
     /// As [`Self::new`]; two models of one side.
     pub fn two_handed(hands: [(Arc<Model>, Option<GloveMapper>); 2], joint_model: JointModel, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene, params: GraspParams) -> Result<Self> {
-        let manip = Self::with_hands(hands.into(), joint_model, config, gestures, scene, params)?;
+        let mut manip = Self::with_hands(hands.into(), joint_model, config, gestures, scene, params)?;
         let [a, b] = [0, 1].map(|k| manip.hands[k].side());
         if a == b {
             return Err(Error::HandParameter(format!("two hands must be a left and a right one; both are {}", a.name())));
         }
+        manip.two_hand = manip.hands[0].input().gestures().and_then(|set| TwoHandRecognizer::builtin(set).ok());
         Ok(manip)
     }
 
@@ -114,6 +129,7 @@ impl ManipulationLoop {
             poses,
             params,
             between: 0.0,
+            two_hand: None,
             last: None,
             reset_due: false,
         })
@@ -160,6 +176,19 @@ impl ManipulationLoop {
         Ok(())
     }
 
+    /// Recognises `gestures` of both hands from now on (a loop of two hands with recognition
+    /// on: made without, no hand has a gesture), in place of the built-in ones; `None`: none.
+    pub fn set_two_hand_gestures(&mut self, gestures: Option<TwoHandRecognizer>) {
+        self.two_hand = gestures;
+    }
+
+    /// The gestures of both hands recognised, if any ([`HandEvents::two_hand`] says when one
+    /// begins and ends).
+    #[must_use]
+    pub fn two_hand_gestures(&self) -> Option<&TwoHandRecognizer> {
+        self.two_hand.as_ref()
+    }
+
     /// The scene command (a row of the scene's `actions`) that the last record triggered.
     #[must_use]
     pub fn command(&self) -> Option<SceneCommand> {
@@ -194,6 +223,10 @@ impl ManipulationLoop {
         }
         if let [a, b] = &mut self.hands[..] {
             share(now, [a, b], &self.poses, self.between + self.params.apart_m, &mut events);
+            if let Some(two) = &mut self.two_hand {
+                let (left, right) = if a.side() == Side::Left { (&*a, &*b) } else { (&*b, &*a) };
+                events.1 = two.update(left.gesture(), right.gesture(), left.wrist().distance(right.wrist()));
+            }
         }
         for hand in &self.hands {
             if let (Some(held), Some((q, t))) = (hand.grasp.held(), hand.grasp.target()) {
@@ -213,7 +246,9 @@ impl ManipulationLoop {
         if let [a, b] = &mut self.hands[..] {
             let (ca, cb) = (&a.constraint, &b.constraint);
             let (pa, pb) = (a.pushed(), b.pushed());
-            if let Some(object) = events.0.iter().all(Option::is_none).then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure(), pa), (&b.grasp, cb.contacts(), cb.closure(), pb))).flatten() {
+            let tracked = [&*a, &*b].iter().all(|h| h.tracking() == Tracking::Tracking);
+            let free = events.0.iter().all(Option::is_none) && tracked;
+            if let Some(object) = free.then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure(), pa), (&b.grasp, cb.contacts(), cb.closure(), pb))).flatten() {
                 let pose = self.poses[object];
                 events.0 = [a.take_with_other(now, object, pose), b.take_with_other(now, object, pose)].map(Some);
                 self.between = a.grasp.contact_centre().zip(b.grasp.contact_centre()).map_or(0.0, |(p, q)| p.distance(q));
@@ -226,22 +261,25 @@ impl ManipulationLoop {
     }
 
     /// The frame's grasps and releases into the rendered hands and the physics: an object
-    /// no hand holds any more leaves with the velocity its hands gave it (their mean).
+    /// no hand holds any more leaves with the velocity its hands gave it (the mean of those
+    /// that moved it: a still or lost hand gives none, and must not halve the other's throw).
     fn apply(&mut self, events: &HandEvents) {
         let mut released: [Option<(usize, Vec3, Vec3, f32)>; 2] = [None; 2];
         for (k, event) in events.iter() {
             match event {
                 GraspEvent::Grasp { object } => self.hands[k].constraint.grip(object, &self.objects.objects()[object].pose),
                 GraspEvent::Release { object, linvel, angvel } if self.hands.iter().all(|h| h.grasp.held() != Some(object)) => {
+                    let moved = f32::from(u8::from(linvel != Vec3::ZERO));
                     match released.iter_mut().flatten().find(|r| r.0 == object) {
-                        Some(r) => *r = (object, r.1 + linvel, r.2 + angvel, r.3 + 1.0),
-                        None => released[k] = Some((object, linvel, angvel, 1.0)),
+                        Some(r) => *r = (object, r.1 + linvel, r.2 + angvel, r.3 + moved),
+                        None => released[k] = Some((object, linvel, angvel, moved)),
                     }
                 }
                 GraspEvent::Release { .. } => {}
             }
         }
         for (object, linvel, angvel, n) in released.into_iter().flatten() {
+            let n = n.max(1.0);
             self.physics.release(object, linvel / n, angvel / n);
         }
         for hand in &self.hands {
@@ -305,24 +343,29 @@ fn share(now: f64, [a, b]: [&mut ManipulatingHand; 2], poses: &[(Quat, Vec3)], a
                 if other.grasp.alone() {
                     other.grasp.rebase(poses[object]);
                 } else {
-                    events.0[1 - k] = other.grasp.let_go(now, true);
+                    events.0[1 - k] = other.grasp.let_go(now);
                 }
             }
         }
     }
-    if a.grasp.held().is_none() || a.grasp.held() != b.grasp.held() {
+    let Some(object) = a.grasp.held().filter(|&o| b.grasp.held() == Some(o)) else { return };
+    if [&*a, &*b].iter().any(|h| h.tracking() != Tracking::Tracking) {
+        // A hand lost holds its points where it last had them: the object stays where it is
+        // (as one hand's held object does while lost) until the grace time lets it go.
+        a.grasp.set_target(poses[object]);
+        b.grasp.set_target(poses[object]);
         return;
     }
     if !a.grasp.alone() && !b.grasp.alone() {
         let gap = a.grasp.contact_centre().zip(b.grasp.contact_centre()).map_or(0.0, |(p, q)| p.distance(q));
         if gap > apart {
-            events.0 = [a.grasp.let_go(now, true), b.grasp.let_go(now, true)];
+            events.0 = [a.grasp.let_go(now), b.grasp.let_go(now)];
             return;
         }
     }
     let (mut from, mut to) = ([Vec3::ZERO; MAX_HOLDING_POINTS], [Vec3::ZERO; MAX_HOLDING_POINTS]);
     let mut n = 0;
-    for (p, q) in a.grasp.holding_points().chain(b.grasp.holding_points()).take(MAX_HOLDING_POINTS) {
+    for (p, q) in a.grasp.holding_points().chain(b.grasp.holding_points()) {
         (from[n], to[n]) = (p, q);
         n += 1;
     }

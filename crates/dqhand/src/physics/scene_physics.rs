@@ -147,12 +147,6 @@ impl ScenePhysics {
         (b.linvel(), b.angvel())
     }
 
-    /// Whether a hand holds object `i`.
-    #[must_use]
-    pub fn held(&self, i: usize) -> bool {
-        self.held[i]
-    }
-
     /// Object `i` is in a hand: the next [`Self::step`] moves it to `rotation`,
     /// `translation`, pushing what it meets on the way.
     pub fn hold(&mut self, i: usize, rotation: Quat, translation: Vec3) {

@@ -227,7 +227,8 @@ enum Folder<'a> {
 
 impl Scene {
     /// The scenes that ship with the crate (`data/scenes/`, compiled in): `grasp` (the paper's
-    /// Figure 9: a ball and the Utah teapot on a table) and `objects` (every kind of object).
+    /// Figure 9: a ball and the Utah teapot on a table), `objects` (every kind of object) and
+    /// `two-hands` (a 40 cm box and a bar, for two hands).
     pub const BUILTIN: [&'static str; 3] = [BUILTIN_SCENES[0].0, BUILTIN_SCENES[1].0, BUILTIN_SCENES[2].0];
 
     /// A built-in scene by name ([`Self::BUILTIN`]; its meshes built in too), else the scene

@@ -145,7 +145,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let mut carry_offset: Option<f32> = None;
     let mut let_go: Option<Vec3> = None;
     let mut fallen: Option<Vec3> = None;
-    let mut tracked_points: Vec<Option<[Vec3; TIPS.len() + 1]>> = vec![None; manip.hands().len()];
+    let mut rendered_points: Vec<Option<[Vec3; TIPS.len() + 1]>> = vec![None; manip.hands().len()];
     let mut skin: Vec<[f32; 3]> = Vec::new();
     let mut next = 0;
     while next < script.records.len() {
@@ -207,7 +207,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             for (n, &(distal, tip)) in now[1..].iter_mut().zip(&TIPS) {
                 *n = (p[distal] + p[tip]) / 2.0;
             }
-            if let Some(last) = tracked_points[k].replace(now) {
+            if let Some(last) = rendered_points[k].replace(now) {
                 score.tunnelled |= last.iter().zip(&now).any(|(a, b)| crossed(manip.objects(), hand.held(), *a, *b));
             }
             rendered_skin[k].deform(hand.rendered().layer());
@@ -250,7 +250,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
 }
 
 /// Whether the segment `from`–`to` crosses the surface of an object (or the table) other
-/// than `skip` (a mesh's inside is where parry's point query puts it) (not a hand's proxies: the rendered hands stop each other short of them).
+/// than `skip`; not a hand's proxies ([`ObjectColliders::near`] leaves them out between
+/// solves). A mesh's inside is where parry's point query puts it.
 fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3) -> bool {
     let length = from.distance(to);
     if length <= f32::EPSILON {
@@ -259,7 +260,7 @@ fn crossed(objects: &ObjectColliders, skip: Option<usize>, from: Vec3, to: Vec3)
     let ray = Ray::new(from, (to - from) / length);
     // Into or out of it, or in and out again within the step (both ends outside, the ray
     // meets it): a point that stays inside has not crossed (it is a depth, measured apart).
-    objects.near(&Aabb::from_points([from, to]), 0.0, skip).filter(|(i, _)| !objects.is_hand(*i)).any(|(_, o)| {
+    objects.near(&Aabb::from_points([from, to]), 0.0, skip).any(|(_, o)| {
         let inside = |p: Vec3| o.surface.contains_point(&o.pose, p);
         match (inside(from), inside(to)) {
             (false, false) => o.surface.cast_ray(&o.pose, &ray, length, true).is_some(),
