@@ -120,7 +120,7 @@ pub fn sequence(poses: &[OutsidePose], side: Side, repeats: usize, seed: u64) ->
                     }
                     None => (wrist_at + wrists[h] * to_p, wrists[h] * to_q),
                 };
-                let noise = Vec3::new(rng.normal(), rng.normal(), rng.normal()) * (0.0015 / 3f32.sqrt());
+                let noise = rng.normal_vec3() * (0.0015 / 3f32.sqrt());
                 set.set(j, TrackedJoint { position: position + noise, orientation: Some(orientation.normalize()), radius: 0.0 });
             }
             records.push(Record { time: t, side, hand: Some(HandData::Joints(set)), tracker: None, arrival: None });

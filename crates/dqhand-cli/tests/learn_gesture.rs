@@ -11,7 +11,6 @@ use dqhand::hand::{build, HandParams};
 use dqhand::input::mediapipe::WEBXR_INDEX;
 use dqhand::kinematics::{JointModel, JointPositions, Pose};
 use dqhand::math::Rng;
-use glam::Vec3;
 
 fn dqhand(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dqhand")).args(args).output().unwrap()
@@ -27,7 +26,7 @@ fn record(path: &Path, pose: &Pose, length: f32, seconds: f64, seed: u64) {
     let mut rng = Rng::new(seed);
     let lines: Vec<String> = (0..(seconds * 30.0) as usize)
         .map(|k| {
-            let landmarks: Vec<[f32; 3]> = WEBXR_INDEX.iter().map(|&w| (joints[w] + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.002).to_array()).collect();
+            let landmarks: Vec<[f32; 3]> = WEBXR_INDEX.iter().map(|&w| (joints[w] + rng.normal_vec3() * 0.002).to_array()).collect();
             serde_json::json!({"t": k as f64 / 30.0, "hand": "right", "landmarks": landmarks}).to_string()
         })
         .collect();

@@ -222,7 +222,7 @@ fn a_still_noisy_position_trembles_less_than_the_noise_and_settles_where_it_is()
     // Offsets from the true point, in f64: the mean of squares would cancel in f32.
     let (mut sum, mut square, mut n) = (glam::DVec3::ZERO, 0.0f64, 0.0f64);
     for k in 0..600 {
-        let x = at + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+        let x = at + rng.normal_vec3() * sigma;
         let y = (f.filter(x, 1.0 / 60.0) - at).as_dvec3();
         if k >= 60 {
             sum += y;

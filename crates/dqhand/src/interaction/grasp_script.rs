@@ -543,7 +543,7 @@ pub fn sweep(model: &Arc<Model>, start: Vec3, direction: Vec3, speed: f32, side:
         pose.wrist = Some(DualQuat::from_rotation_translation(Quat::IDENTITY, start + direction * (speed * travelled as f32)));
         hand.pose(&pose);
         let world: &[Affine3A] = hand.world();
-        let positions = joints.read(world).map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma);
+        let positions = joints.read(world).map(|p| p + rng.normal_vec3() * sigma);
         out.records.push(Record { time: t, side, hand: Some(HandData::Joints(joint_set(world, &joints, &positions))), tracker: None, arrival: None });
         out.truth.push(pose);
     }
@@ -587,7 +587,7 @@ impl HeadsetTracking {
             if let Some(HandData::Joints(joints)) = &mut hand {
                 for i in 0..25 {
                     if let Some(&j) = joints.get(i) {
-                        joints.set(i, TrackedJoint { position: j.position + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma, ..j });
+                        joints.set(i, TrackedJoint { position: j.position + rng.normal_vec3() * sigma, ..j });
                     }
                 }
             }

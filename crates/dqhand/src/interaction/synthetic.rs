@@ -327,7 +327,7 @@ pub fn generate(params: &SyntheticParams) -> Result<Synthetic> {
         let world = posed.world();
         let mut positions = proportioned(&joints.read(world), &bone_scale);
         for p in &mut positions {
-            *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * sigma;
+            *p += rng.normal_vec3() * sigma;
         }
         if let Some(e) = errors {
             let jump = (rng.next_f64() < e.jump_rate).then(|| (rng.below(5), rng.unit() * e.jump_m));

@@ -33,10 +33,16 @@ impl Rng {
         ((-2.0 * u.ln()).sqrt() * (core::f64::consts::TAU * v).cos()) as f32
     }
 
+    /// A standard normal 3-vector (x, y, z drawn in that order): isotropic noise of RMS
+    /// length √3 — times `sigma / √3` for an RMS length of `sigma`.
+    pub fn normal_vec3(&mut self) -> Vec3 {
+        Vec3::new(self.normal(), self.normal(), self.normal())
+    }
+
     /// A uniformly random unit vector.
     pub fn unit(&mut self) -> Vec3 {
         loop {
-            let v = Vec3::new(self.normal(), self.normal(), self.normal());
+            let v = self.normal_vec3();
             if let Some(u) = v.try_normalize() {
                 return u;
             }
