@@ -347,6 +347,14 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     Ok(play(&mut [path], times, task.carry, task.drop, Some(2)))
 }
 
+/// The directions two facing hands' palms move in: the left hand's (+X), the right's (−X).
+const FACING: [Vec3; 2] = [Vec3::X, Vec3::NEG_X];
+
+/// `models` (a left and a right hand) flat, facing each other along X, fingers forward (−Z).
+fn facing(models: [&Model; 2]) -> Result<Vec<HandPath>> {
+    [Side::Left, Side::Right].into_iter().zip(FACING).zip(models).map(|((side, d), model)| HandPath::new(model, side, d, Vec3::NEG_Z, false)).collect()
+}
+
 /// Records of two hands (`models`: a left and a right one) carrying `object` between their
 /// flat palms: each comes at it from its own side along X at 0.5 m/s, presses its palm
 /// [`PRESS_M`] into it, and they lift it by `lift`, carry it by `carry`, set it down and
@@ -356,13 +364,9 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
 /// As [`grasp`].
 pub fn carry_between(models: [&Model; 2], file: &str, objects: &ObjectColliders, object: &str, lift: f32, carry: Vec3) -> Result<Script> {
     let object = find(objects, file, object)?;
-    let mut paths = [(Side::Left, Vec3::X), (Side::Right, Vec3::NEG_X)]
-        .into_iter()
-        .zip(models)
-        .map(|((side, d), model)| HandPath::new(model, side, d, Vec3::NEG_Z, false))
-        .collect::<Result<Vec<_>>>()?;
+    let mut paths = facing(models)?;
     let mut times = GraspTimes { reached: 0.0, closed: 0.0, carry_start: 0.0, carry_end: 0.0, release: 0.0, end: 0.0 };
-    for (path, d) in paths.iter_mut().zip([Vec3::X, Vec3::NEG_X]) {
+    for (path, d) in paths.iter_mut().zip(FACING) {
         let at = path.reach(object, d, Vec3::ZERO, false);
         let start = at - d * STANDOFF_M;
         let (lifted, carried) = (at + Vec3::Y * lift, at + Vec3::Y * lift + carry);
@@ -388,13 +392,9 @@ pub fn carry_between(models: [&Model; 2], file: &str, objects: &ObjectColliders,
 /// # Errors
 /// As [`grasp`].
 pub fn clap(models: [&Model; 2], centre: Vec3, press: f32) -> Result<Script> {
-    let mut paths = [(Side::Left, Vec3::X), (Side::Right, Vec3::NEG_X)]
-        .into_iter()
-        .zip(models)
-        .map(|((side, d), model)| HandPath::new(model, side, d, Vec3::NEG_Z, false))
-        .collect::<Result<Vec<_>>>()?;
+    let mut paths = facing(models)?;
     let mut times = GraspTimes { reached: 0.0, closed: 0.0, carry_start: 0.0, carry_end: 0.0, release: 0.0, end: 0.0 };
-    for (path, d) in paths.iter_mut().zip([Vec3::X, Vec3::NEG_X]) {
+    for (path, d) in paths.iter_mut().zip(FACING) {
         let start = centre - d * STANDOFF_M;
         path.key(0.0, start, 0.0);
         path.key(0.3, start, 0.0);
