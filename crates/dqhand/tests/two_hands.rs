@@ -12,7 +12,7 @@ use dqhand::hand::{HandParams, Side};
 use dqhand::input::InputConfig;
 use dqhand::interaction::benchmark::{self, RunScore};
 use dqhand::interaction::grasp_script::{self, Script};
-use dqhand::interaction::ManipulationLoop;
+use dqhand::interaction::{HandEvents, ManipulationLoop};
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
@@ -30,35 +30,43 @@ fn two_handed(scene: &Scene) -> ManipulationLoop {
     ManipulationLoop::two_handed([(l, None), (r, None)], JointModel::Full, InputConfig::default(), None, scene, GraspParams::default()).unwrap()
 }
 
-fn run(scene: &Scene, script: &Script, object: &str, carried_to: Vec3) -> (RunScore, ManipulationLoop) {
-    let mut manip = two_handed(scene);
+/// Scores the script `make` writes for the built-in hands on the `two-hands` scene, whose
+/// `object` it carries `carried` from where the scene puts it: a success.
+fn assert_succeeds(object: &str, carried: Vec3, make: impl FnOnce([&Model; 2], &ObjectColliders) -> dqhand::Result<Script>) {
+    let scene = Scene::named("two-hands").unwrap();
+    let [l, r] = models();
+    let script = make([&l, &r], &ObjectColliders::new(&scene).unwrap()).unwrap();
+    let mut manip = two_handed(&scene);
     let i = manip.names().iter().position(|n| n == object).unwrap();
-    let score = benchmark::score(&mut manip, script, i, carried_to);
-    (score, manip)
+    let score = benchmark::score(&mut manip, &script, i, scene.objects[i].position + carried);
+    assert!(score.success, "{:?}", RunScore { step_s: Vec::new(), ..score });
+}
+
+/// Plays `script` through `manip` a frame at a time (the records of one time, then a step),
+/// calling `each` with the loop, the time and the frame's events.
+fn play(manip: &mut ManipulationLoop, script: &Script, mut each: impl FnMut(&ManipulationLoop, f64, HandEvents)) {
+    let mut k = 0;
+    while k < script.records.len() {
+        let t = script.records[k].time;
+        while k < script.records.len() && script.records[k].time == t {
+            manip.push(&script.records[k]).unwrap();
+            k += 1;
+        }
+        let events = manip.step(t);
+        each(manip, t, events);
+    }
 }
 
 #[test]
 fn a_large_box_is_carried_between_two_flat_palms_and_set_down_when_they_draw_apart() {
-    let scene = Scene::named("two-hands").unwrap();
-    let objects = ObjectColliders::new(&scene).unwrap();
-    let [l, r] = models();
     let carry = Vec3::new(0.0, 0.0, 0.2);
-    let script = grasp_script::carry_between([&l, &r], "two-hands", &objects, "box", 0.12, carry).unwrap();
-    let start = scene.objects[0].position;
-    let (score, _) = run(&scene, &script, "box", start + carry);
-    assert!(score.success, "{:?}", RunScore { step_s: Vec::new(), ..score });
+    assert_succeeds("box", carry, |models, objects| grasp_script::carry_between(models, "two-hands", objects, "box", 0.12, carry));
 }
 
 #[test]
 fn a_baton_is_handed_from_the_right_hand_to_the_left() {
-    let scene = Scene::named("two-hands").unwrap();
-    let objects = ObjectColliders::new(&scene).unwrap();
-    let [l, r] = models();
     let carry = Vec3::new(0.0, 0.0, 0.12);
-    let script = grasp_script::hand_over([&l, &r], "two-hands", &objects, "baton", 0.08, 0.12, carry).unwrap();
-    let start = scene.objects[1].position;
-    let (score, _) = run(&scene, &script, "baton", start + 2.0 * carry);
-    assert!(score.success, "{:?}", RunScore { step_s: Vec::new(), ..score });
+    assert_succeeds("baton", 2.0 * carry, |models, objects| grasp_script::hand_over(models, "two-hands", objects, "baton", 0.08, 0.12, carry));
 }
 
 #[test]
@@ -73,14 +81,7 @@ fn a_box_held_between_two_hands_falls_when_one_hand_is_lost() {
     let mut manip = two_handed(&scene);
     let (mut released, mut lowest) = (None, f32::INFINITY);
     let mut path = Vec::new();
-    let mut k = 0;
-    while k < script.records.len() {
-        let t = script.records[k].time;
-        while k < script.records.len() && script.records[k].time == t {
-            manip.push(&script.records[k]).unwrap();
-            k += 1;
-        }
-        let events = manip.step(t);
+    play(&mut manip, &script, |manip, t, events| {
         if t < lost {
             assert_eq!(manip.hands().iter().map(|h| h.held()).collect::<Vec<_>>(), [manip.hands()[0].held(); 2], "both hold it or neither");
         }
@@ -93,7 +94,7 @@ fn a_box_held_between_two_hands_falls_when_one_hand_is_lost() {
             lowest = lowest.min(manip.poses()[0].1.y);
         }
         path.push((t, manip.poses()[0].1));
-    }
+    });
     let (_, at) = released.expect("the box is let go");
     assert_eq!(manip.hands()[0].tracking(), Tracking::Lost);
     // Judged lost after the input's grace, then held through the grasp's.
@@ -133,20 +134,13 @@ fn the_rendered_hands_stop_at_each_other_where_the_tracked_ones_overlap() {
         (deepest, gap)
     };
     let (mut rendered_deepest, mut tracked_deepest, mut closest) = (0.0f32, 0.0f32, f32::INFINITY);
-    let mut k = 0;
-    while k < script.records.len() {
-        let t = script.records[k].time;
-        while k < script.records.len() && script.records[k].time == t {
-            manip.push(&script.records[k]).unwrap();
-            k += 1;
-        }
-        manip.step(t);
+    play(&mut manip, &script, |manip, _, _| {
         let h = manip.hands();
         let (deep, gap) = overlap([h[0].rendered().world(), h[1].rendered().world()]);
         rendered_deepest = rendered_deepest.max(deep);
         closest = closest.min(gap);
         tracked_deepest = tracked_deepest.max(overlap([h[0].constraint().tracked_world(), h[1].constraint().tracked_world()]).0);
-    }
+    });
     assert!(tracked_deepest > 0.02, "the tracked hands overlap: {tracked_deepest}");
     assert!(rendered_deepest < 0.001, "the rendered ones do not: {rendered_deepest} m deep");
     assert!(closest < 0.003, "they meet: {closest} m apart at the closest");
@@ -168,16 +162,13 @@ fn both_palms_open_and_brought_together_are_gestures_of_both_hands() {
     let mut manip = ManipulationLoop::two_handed([(l, None), (r, None)], JointModel::Full, InputConfig::default(), Some(GestureSet::builtin()), &scene, GraspParams::default()).unwrap();
     let names: Vec<String> = manip.two_hand_gestures().unwrap().gestures().iter().map(|g| g.name.clone()).collect();
     let mut began = Vec::new();
-    for pair in script.records.chunks(2) {
-        for record in pair {
-            manip.push(record).unwrap();
-        }
-        for e in manip.step(pair[0].time).two_hand() {
+    play(&mut manip, &script, |_, t, events| {
+        for e in events.two_hand() {
             if let TwoHandEvent::Start(i) = e {
-                began.push((names[i].clone(), pair[0].time));
+                began.push((names[i].clone(), t));
             }
         }
-    }
+    });
     let order: Vec<&str> = began.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(order, ["both_palms_open", "hands_together", "both_palms_open"], "{began:?}");
     // Together while the tracked palms press (from when they meet until they draw apart).

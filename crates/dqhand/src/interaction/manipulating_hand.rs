@@ -85,7 +85,7 @@ impl ManipulatingHand {
     /// (or let go).
     pub(super) fn follow(&mut self, now: f64) -> Option<GraspEvent> {
         self.input.advance(now);
-        let tracking = self.tracking() == Tracking::Tracking;
+        let tracking = self.tracked();
         if tracking && !self.was_tracking {
             // Tracking came back (or began): the rendered hand starts from the tracked one.
             self.constraint.restart();
@@ -100,7 +100,7 @@ impl ManipulatingHand {
     pub(super) fn solve(&mut self, now: f64, objects: &mut ObjectColliders, poses: &[(Quat, Vec3)], detect: bool) -> Option<GraspEvent> {
         objects.solving(Some(self.physics));
         self.constraint.solve(objects, self.grasp.held(), now);
-        let tracking = self.tracking() == Tracking::Tracking;
+        let tracking = self.tracked();
         let c = &self.constraint;
         let wrist = self.input.kinematics().rig().wrist();
         detect.then(|| self.grasp.detect(now, tracking, c.contacts(), c.closure(), c.world(), c.tracked_world(), wrist, poses)).flatten()
@@ -115,7 +115,7 @@ impl ManipulatingHand {
 
     /// The hand's gesture now, while it is tracked.
     pub(super) fn gesture(&self) -> Option<&str> {
-        self.input.gesture().filter(|_| self.tracking() == Tracking::Tracking)
+        self.input.gesture().filter(|_| self.tracked())
     }
 
     /// Where the tracked wrist is (world, m).
@@ -135,11 +135,16 @@ impl ManipulatingHand {
     /// The hand's proxies where the rendered hand is, for the physics (and, with `objects`,
     /// as obstacles to the other hand); none while the hand is lost.
     pub(super) fn place(&self, physics: &mut ScenePhysics, objects: Option<&mut ObjectColliders>) {
-        let world = (self.tracking() == Tracking::Tracking).then(|| self.constraint.world());
+        let world = self.tracked().then(|| self.constraint.world());
         physics.move_hand(self.physics, world);
         if let Some(objects) = objects {
             objects.move_hand(self.physics, world);
         }
+    }
+
+    /// Whether the hand is tracked now ([`Self::tracking`]).
+    pub(super) fn tracked(&self) -> bool {
+        self.tracking() == Tracking::Tracking
     }
 
     /// Which hand this is (its model's).

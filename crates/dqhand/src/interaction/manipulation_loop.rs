@@ -22,7 +22,7 @@ use super::ManipulatingHand;
 use crate::collision::ObjectColliders;
 use crate::gesture::{Events, GestureSet, TwoHandEvent, TwoHandRecognizer};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
-use crate::input::{GloveMapper, InputConfig, Record, Rejection, Tracking};
+use crate::input::{GloveMapper, InputConfig, Record, Rejection};
 use crate::kinematics::{JointModel, Side};
 use crate::math::rigid_fit;
 use crate::model::Model;
@@ -246,7 +246,7 @@ impl ManipulationLoop {
         if let [a, b] = &mut self.hands[..] {
             let (ca, cb) = (&a.constraint, &b.constraint);
             let (pa, pb) = (a.pushed(), b.pushed());
-            let tracked = [&*a, &*b].iter().all(|h| h.tracking() == Tracking::Tracking);
+            let tracked = a.tracked() && b.tracked();
             let free = events.0.iter().all(Option::is_none) && tracked;
             if let Some(object) = free.then(|| Grasp::find_two_handed(now, (&a.grasp, ca.contacts(), ca.closure(), pa), (&b.grasp, cb.contacts(), cb.closure(), pb))).flatten() {
                 let pose = self.poses[object];
@@ -349,7 +349,7 @@ fn share(now: f64, [a, b]: [&mut ManipulatingHand; 2], poses: &[(Quat, Vec3)], a
         }
     }
     let Some(object) = a.grasp.held().filter(|&o| b.grasp.held() == Some(o)) else { return };
-    if [&*a, &*b].iter().any(|h| h.tracking() != Tracking::Tracking) {
+    if !(a.tracked() && b.tracked()) {
         // A hand lost holds its points where it last had them: the object stays where it is
         // (as one hand's held object does while lost) until the grace time lets it go.
         a.grasp.set_target(poses[object]);
