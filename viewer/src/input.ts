@@ -2,7 +2,7 @@
 // tracking, the gesture recognised now, record counters and a log of gesture events and the
 // actions they triggered. `InputLog` holds no DOM, so the tests run it in Node.
 
-import type { HelloInput, InputMessage, LearningMessage, Side, Tracking } from './protocol';
+import type { HandState, HelloInput, InputMessage, LearningMessage, SceneMessage, Side, Tracking } from './protocol';
 
 /** Entries the event log keeps. */
 export const LOG_LENGTH = 30;
@@ -23,7 +23,7 @@ export class InputLog {
    */
   add(message: Pick<InputMessage, 'events' | 'actions'>): void {
     const entries = [
-      ...message.events.map((e) => ({ t: e.t, order: 0, text: `${e.t.toFixed(2)}  ${e.event} ${e.gesture}` })),
+      ...message.events.map((e) => ({ t: e.t, order: 0, text: `${e.t.toFixed(2)}  ${e.hand ? `${e.hand} ` : ''}${e.event} ${e.gesture}` })),
       ...message.actions.map((a) => ({ t: a.t, order: 1, text: `${a.t.toFixed(2)}  ${a.gesture} → ${a.action}` })),
     ].sort((a, b) => a.t - b.t || a.order - b.order);
     for (const e of entries) this.lines.unshift(e.text);
@@ -33,6 +33,14 @@ export class InputLog {
   clear(): void {
     this.lines.length = 0;
   }
+}
+
+/** What the "holding" line says: the object held, or with two hands what each holds ("box in both hands", "left: cube, right: —"). */
+export function heldText(message: Pick<SceneMessage, 'held' | 'holding'>): string {
+  const h = message.holding;
+  if (!h) return message.held ?? '—';
+  if (h.left !== null && h.left === h.right) return `${h.left} in both hands`;
+  return h.left === null && h.right === null ? '—' : `left: ${h.left ?? '—'}, right: ${h.right ?? '—'}`;
 }
 
 const percent = (share: number) => `${(share * 100).toFixed(share > 0 && share < 0.1 ? 1 : 0)} %`;
@@ -72,6 +80,8 @@ export class InputPanel {
   side: Side | null = null;
   /** Whether our hand shows the tracked one mirrored (a hand of the other side). */
   mirrored = false;
+  /** With two hands, each one's state (the first hand's first); null with one. */
+  hands: HandState[] | null = null;
   accepted = 0;
   rejected = 0;
   readonly log = new InputLog();
@@ -100,21 +110,21 @@ export class InputPanel {
     this.$('holding').hidden = !on;
   }
 
-  /** The object the hand holds now (null: none). */
-  setHeld(name: string | null): void {
-    this.$('held').textContent = name ?? '—';
+  /** What the hands hold now (`heldText`). */
+  setHeld(text: string): void {
+    this.$('held').textContent = text;
   }
 
   /** Forgets the previous session's state (its counters and times restart with the new one). */
   reset(): void {
-    Object.assign(this, { tracking: 'waiting', gesture: null, side: null, mirrored: false, accepted: 0, rejected: 0 });
-    this.setHeld(null);
+    Object.assign(this, { tracking: 'waiting', gesture: null, side: null, mirrored: false, hands: null, accepted: 0, rejected: 0 });
+    this.setHeld('—');
     this.log.clear();
     this.render();
   }
 
   update(message: InputMessage): void {
-    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, side: message.side, mirrored: message.mirrored, accepted: message.accepted, rejected: message.rejected });
+    Object.assign(this, { tracking: message.tracking, gesture: message.gesture, side: message.side, mirrored: message.mirrored, hands: message.hands, accepted: message.accepted, rejected: message.rejected });
     this.log.add(message);
     this.render();
   }
@@ -124,7 +134,10 @@ export class InputPanel {
     badge.textContent = TRACKING_TEXT[this.tracking];
     badge.className = `badge ${this.tracking}`;
     this.$('tracking-lost').hidden = this.source === null || this.tracking !== 'lost';
-    this.$('gesture-now').textContent = this.gesture ?? '—';
+    this.$('gesture-now').classList.toggle('two', this.hands !== null);
+    this.$('gesture-now').textContent = this.hands
+      ? this.hands.map((h) => `${h.side}: ${h.tracking === 'tracking' ? h.gesture ?? '—' : TRACKING_TEXT[h.tracking]}`).join(', ')
+      : this.gesture ?? '—';
     this.$('input-accepted').textContent = this.accepted.toLocaleString();
     this.$('input-rejected').textContent = this.rejected.toLocaleString();
     const list = this.$('input-log');
@@ -132,9 +145,10 @@ export class InputPanel {
   }
 
   /** The test hook's view: null without an input. */
-  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: Side | null; mirrored: boolean; accepted: number; rejected: number; log: string[] } | null {
+  state(): { source: string; gestures: string[]; tracking: Tracking; gesture: string | null; side: Side | null; mirrored: boolean; hands: HandState[] | null; accepted: number; rejected: number; log: string[] } | null {
     if (!this.source) return null;
     const { tracking, gesture, side, mirrored, accepted, rejected } = this;
-    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, mirrored, accepted, rejected, log: [...this.log.lines] };
+    const hands = this.hands && this.hands.map((h) => ({ ...h }));
+    return { source: this.source.source, gestures: [...this.source.gestures], tracking, gesture, side, mirrored, hands, accepted, rejected, log: [...this.log.lines] };
   }
 }

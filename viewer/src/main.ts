@@ -3,7 +3,7 @@
 import './style.css';
 import { Vector3 } from 'three';
 import { Connection } from './connection';
-import { InputPanel } from './input';
+import { heldText, InputPanel } from './input';
 import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
 import { InputSender } from './sender';
@@ -46,7 +46,10 @@ const xr = new XRInput(scene.renderer, sender, $, {
 const connection = new Connection(`${wsOrigin}/stream`, {
   hello(h) {
     hello = h;
-    $('model-line').textContent = `${h.description}, ${h.triangles.toLocaleString()} triangles`;
+    const second = h.second_hand ? ` — and a ${h.second_hand.side} hand: ${h.second_hand.description}` : '';
+    $('model-line').textContent = `${h.description}, ${h.triangles.toLocaleString()} triangles${second}`;
+    // An engine driving two hands takes both of the user's, from the camera or the headset.
+    webcam.both = xr.both = h.second_hand !== null;
     buildGestures(h);
     buildSliders(h);
     const select = $<HTMLSelectElement>('joint-model');
@@ -66,8 +69,11 @@ const connection = new Connection(`${wsOrigin}/stream`, {
     scene.setTopology(t);
   },
   frame(f) {
-    frame = f;
-    followView(f.header);
+    // The controls and statistics follow the first hand; the second is only drawn.
+    if (!f.header.second) {
+      frame = f;
+      followView(f.header);
+    }
     scene.showFrame(f);
   },
   input(message) {
@@ -79,7 +85,7 @@ const connection = new Connection(`${wsOrigin}/stream`, {
   },
   scene(message) {
     scene.showScene(message);
-    inputPanel.setHeld(message.held);
+    inputPanel.setHeld(heldText(message));
   },
   recording(message) {
     showRecording(message.on);
@@ -359,6 +365,12 @@ window.dqhand = {
     input: inputPanel.state(),
     /** The manipulation scene, null without one: the objects drawn (placed by a scene message), the one held, contacts shown, scene messages shown. */
     scene: scene.objects && { drawn: scene.objects.drawn(), held: scene.objects.held, contacts: scene.objects.contacts, updates: scene.objects.updates },
+    /** The second hand (a server driving two), null without one: its side and its latest frame's wrist (world) and sequence number. */
+    secondHand: hello?.second_hand && {
+      side: hello.second_hand.side,
+      wrist: scene.secondFrame && Array.from(scene.secondFrame.header.wrist),
+      sequence: scene.secondFrame?.header.sequence ?? null,
+    },
     geometries: scene.renderer.info.memory.geometries,
     /** The WebXR input: modes offered, the session, records sent, the side of the hand sent. */
     xr: xr.state(),

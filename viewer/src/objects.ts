@@ -45,6 +45,8 @@ export class SceneObjects {
   private readonly normals: THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial>;
   /** The object held, as the latest scene message says. */
   held: string | null = null;
+  /** The names of the objects tinted as held, one per line. */
+  private tinted = '';
   contacts = 0;
   /** Scene messages shown. */
   updates = 0;
@@ -84,7 +86,7 @@ export class SceneObjects {
     }
   }
 
-  /** Moves the objects to a scene message's poses, tints the one held and draws the contacts (objects the hello did not name are ignored). */
+  /** Moves the objects to a scene message's poses, tints the ones held and draws the contacts (objects the hello did not name are ignored). */
   update(m: SceneMessage): void {
     for (const [name, { p, q }] of Object.entries(m.objects)) {
       const solid = this.objects.get(name);
@@ -93,10 +95,14 @@ export class SceneObjects {
       solid.quaternion.set(...q);
       solid.visible = true;
     }
-    if (m.held !== this.held) {
-      for (const [name, solid] of this.objects) solid.material.color.setHex(name === m.held ? HELD_COLOUR : solid.userData.colour);
-      this.held = m.held;
+    // With two hands, each one's object is tinted.
+    const held = m.holding ? [m.holding.left, m.holding.right].filter((o) => o !== null).join('\n') : m.held ?? '';
+    if (held !== this.tinted) {
+      const names = held.split('\n');
+      for (const [name, solid] of this.objects) solid.material.color.setHex(names.includes(name) ? HELD_COLOUR : solid.userData.colour);
+      this.tinted = held;
     }
+    this.held = m.held;
     const dots = this.dots.geometry.getAttribute('position') as THREE.BufferAttribute;
     const lines = this.normals.geometry.getAttribute('position') as THREE.BufferAttribute;
     const d = dots.array as Float32Array;

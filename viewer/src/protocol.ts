@@ -8,6 +8,8 @@ export const TOPOLOGY_MAGIC = 0x54485144; // "DQHT"
 export const FRAME_HEADER_BYTES = 76;
 export const TOPOLOGY_HEADER_BYTES = 20;
 export const FLAG_DISTORTION = 1;
+/** Frame flag: the frame is of the second hand (the hello's `second_hand`). */
+export const FLAG_SECOND_HAND = 2;
 export const STATE_PLAYING = 1;
 export const STATE_LIMITS = 2;
 export const METHODS = ['lb', 'qb', 'dqb'] as const;
@@ -22,6 +24,8 @@ export interface FrameHeader {
   dofCount: number;
   methods: Method[];
   distortion: boolean;
+  /** The frame is of the second hand (a server driving two). */
+  second: boolean;
   engineUs: number;
   engineFps: number;
   time: number;
@@ -51,6 +55,8 @@ export interface Frame {
 }
 
 export interface Topology {
+  /** Which hand: 0 the first, 1 the second (the hello's `second_hand`). */
+  hand: number;
   vertexCount: number;
   indices: Uint32Array;
   /** Parent joint index, -1 for a root. */
@@ -83,6 +89,16 @@ export interface Hello {
   input: HelloInput | null;
   /** The scene the hand manipulates (`dqhand demo --scene`), or null (an older server omits it: null). */
   scene: HelloScene | null;
+  /** The second hand, when the live input drives two (`dqhand demo --hands 2`), else null (an older server omits it: null). */
+  second_hand: SecondHand | null;
+}
+
+/** The hello's second hand: of the other side than the first, following the live input's hand of its side. */
+export interface SecondHand {
+  side: Side;
+  description: string;
+  vertices: number;
+  triangles: number;
 }
 
 /** Bounds of the scene messages (crates/dqhand-stream/src/frame.rs): larger ones are refused. */
@@ -122,13 +138,17 @@ export interface Contact {
   object: string;
   p: Vec3;
   n: Vec3;
+  /** The hand touching, with two hands; null with one. */
+  hand: Side | null;
 }
 
 /** The scene's state, sent at once on a grasp or release and at a bounded rate while it moves. */
 export interface SceneMessage {
   type: 'scene';
-  /** The object held, or null. */
+  /** The object held (with two hands, by the first hand in the engine's order that holds one), or null. */
   held: string | null;
+  /** With two hands, what each holds (null: nothing); null with one hand. */
+  holding: Record<Side, string | null> | null;
   /** Every object's world pose: translation and rotation xyzw. */
   objects: Record<string, { p: Vec3; q: [number, number, number, number] }>;
   contacts: Contact[];
@@ -154,6 +174,15 @@ export interface GestureEvent {
   t: number;
   event: 'start' | 'end';
   gesture: string;
+  /** With two hands, the hand whose gesture it is, or `both` for a gesture of both hands; null with one (the parser always sets it). */
+  hand?: Side | 'both' | null;
+}
+
+/** One hand of two in an input message: our hand's side, its tracking and its gesture now. */
+export interface HandState {
+  side: Side;
+  tracking: Tracking;
+  gesture: string | null;
 }
 
 /** An action the server applied because of a gesture, at `t` seconds of the input's clock. */
@@ -181,6 +210,8 @@ export interface InputMessage {
   side: Side | null;
   /** Our hand, of the other side, shows the tracked one mirrored (x → −x in the world). */
   mirrored: boolean;
+  /** With two hands, each one's state, the first hand's first; null with one. */
+  hands: HandState[] | null;
 }
 
 /** A hand's side. */
@@ -271,7 +302,7 @@ const UNUSED_METHOD = 255;
 export function decodeFrame(buffer: ArrayBuffer): Frame {
   const view = new DataView(buffer);
   if (buffer.byteLength < FRAME_HEADER_BYTES) throw new ProtocolError(`frame of ${buffer.byteLength} bytes is truncated`);
-  const flags = checkStart(view, FRAME_MAGIC, 'frame', FLAG_DISTORTION);
+  const flags = checkStart(view, FRAME_MAGIC, 'frame', FLAG_DISTORTION | FLAG_SECOND_HAND);
   const meshCount = view.getUint8(24);
   if (meshCount < 1 || meshCount > 3) throw new ProtocolError(`${meshCount} meshes (1 to 3)`);
   const methods: Method[] = [];
@@ -294,6 +325,7 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
     dofCount: view.getUint32(20, true),
     methods,
     distortion: (flags & FLAG_DISTORTION) !== 0,
+    second: (flags & FLAG_SECOND_HAND) !== 0,
     engineUs: view.getFloat32(28, true),
     engineFps: view.getFloat32(32, true),
     time: view.getFloat32(36, true),
@@ -324,7 +356,8 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
 
 export function decodeTopology(buffer: ArrayBuffer): Topology {
   const view = new DataView(buffer);
-  checkStart(view, TOPOLOGY_MAGIC, 'topology', 0);
+  // The hand field is read as flags: 0 or 1, any other value refused.
+  const hand = checkStart(view, TOPOLOGY_MAGIC, 'topology', 1);
   if (buffer.byteLength < TOPOLOGY_HEADER_BYTES) throw new ProtocolError('topology truncated');
   const vertexCount = view.getUint32(8, true);
   const indexCount = view.getUint32(12, true);
@@ -337,7 +370,7 @@ export function decodeTopology(buffer: ArrayBuffer): Topology {
   parents.forEach((p, j) => {
     if (p < -1 || p >= jointCount || p === j) throw new ProtocolError(`joint ${j}: parent ${p} is not another joint`);
   });
-  return { vertexCount, indices, parents };
+  return { hand, vertexCount, indices, parents };
 }
 
 /** Parses a text message from the server. */
@@ -365,6 +398,7 @@ const isTime = (v: unknown): v is number => typeof v === 'number' && Number.isFi
 const oneOf = <T extends string>(values: readonly T[], v: unknown): v is T => values.includes(v as T);
 const isSize = (v: unknown): v is number => isTime(v) && v > 0;
 const isVector = (v: unknown, n: number): boolean => Array.isArray(v) && v.length === n && v.every(isTime);
+const isSide = (v: unknown): v is Side => v === 'left' || v === 'right';
 const isName = (v: unknown): v is string => isString(v) && v.length > 0 && new TextEncoder().encode(v).length <= MAX_NAME_BYTES;
 /** A value for an error message, cut short: a bad mesh may be megabytes. */
 const show = (v: unknown) => {
@@ -379,7 +413,11 @@ function checkHello(value: Record<string, unknown>): Hello {
     throw new ProtocolError(`hello: input ${JSON.stringify(input)} is neither null nor {source, gestures}`);
   }
   const scene = value.scene == null ? null : checkHelloScene(value.scene);
-  return { ...value, input, scene } as unknown as Hello;
+  const second = value.second_hand ?? null;
+  if (second !== null && !(isObject(second) && isSide(second.side) && isString(second.description) && isCount(second.vertices) && isCount(second.triangles))) {
+    throw new ProtocolError(`hello: second_hand ${show(second)} is neither null nor {side, description, vertices, triangles}`);
+  }
+  return { ...value, input, scene, second_hand: second } as unknown as Hello;
 }
 
 /** Checks the hello's scene field by field (the error names the first bad one) and turns meshes into typed arrays. */
@@ -430,6 +468,8 @@ function checkHelloScene(v: unknown): HelloScene {
 function checkSceneMessage(v: Record<string, unknown>): SceneMessage {
   const bad = (field: string, value: unknown) => new ProtocolError(`scene message: ${field} ${show(value)}`);
   if (v.held !== null && !isName(v.held)) throw bad('held', v.held);
+  const holding = v.holding ?? null;
+  if (holding !== null && !(isObject(holding) && Object.entries(holding).every(([side, o]) => isSide(side) && (o === null || isName(o))))) throw bad('holding', holding);
   if (!isObject(v.objects) || Object.keys(v.objects).length > MAX_SCENE_OBJECTS) throw bad('objects', v.objects);
   const objects: SceneMessage['objects'] = {};
   for (const [name, pose] of Object.entries(v.objects)) {
@@ -438,10 +478,11 @@ function checkSceneMessage(v: Record<string, unknown>): SceneMessage {
   }
   if (!Array.isArray(v.contacts) || v.contacts.length > MAX_SCENE_CONTACTS) throw bad('contacts', v.contacts);
   const contacts = v.contacts.map((c: unknown, i): Contact => {
-    if (!(isObject(c) && isString(c.bone) && isName(c.object) && isVector(c.p, 3) && isVector(c.n, 3))) throw bad(`contacts[${i}]`, c);
-    return { bone: c.bone, object: c.object, p: c.p as Vec3, n: c.n as Vec3 };
+    const hand = isObject(c) ? c.hand ?? null : null;
+    if (!(isObject(c) && isString(c.bone) && isName(c.object) && isVector(c.p, 3) && isVector(c.n, 3) && (hand === null || isSide(hand)))) throw bad(`contacts[${i}]`, c);
+    return { bone: c.bone, object: c.object, p: c.p as Vec3, n: c.n as Vec3, hand };
   });
-  return { type: 'scene', held: v.held as string | null, objects, contacts };
+  return { type: 'scene', held: v.held as string | null, holding: holding as SceneMessage['holding'], objects, contacts };
 }
 
 /** Checks every field of an input message; the message names the first bad one. */
@@ -451,7 +492,8 @@ function checkInput(v: Record<string, unknown>): InputMessage {
   if (v.gesture !== null && !isString(v.gesture)) throw bad('gesture', v.gesture);
   if (!Array.isArray(v.events)) throw bad('events', v.events);
   v.events.forEach((e: unknown, i) => {
-    if (!(isObject(e) && isTime(e.t) && (e.event === 'start' || e.event === 'end') && isString(e.gesture))) throw bad(`events[${i}]`, e);
+    const hand = isObject(e) ? e.hand ?? null : null;
+    if (!(isObject(e) && isTime(e.t) && (e.event === 'start' || e.event === 'end') && isString(e.gesture) && (hand === null || hand === 'both' || isSide(hand)))) throw bad(`events[${i}]`, e);
   });
   if (!Array.isArray(v.actions)) throw bad('actions', v.actions);
   v.actions.forEach((a: unknown, i) => {
@@ -463,13 +505,18 @@ function checkInput(v: Record<string, unknown>): InputMessage {
   if (side !== null && side !== 'left' && side !== 'right') throw bad('side', v.side);
   const mirrored = v.mirrored ?? false;
   if (typeof mirrored !== 'boolean') throw bad('mirrored', v.mirrored);
+  const hands = v.hands ?? null;
+  if (hands !== null && !(Array.isArray(hands) && hands.length === 2 && hands.every((h) => isObject(h) && isSide(h.side) && oneOf(TRACKING_STATES, h.tracking) && (h.gesture === null || isString(h.gesture))))) {
+    throw bad('hands', hands);
+  }
   const events = v.events as GestureEvent[];
   const actions = v.actions as ActionEvent[];
   return {
     type: 'input', tracking: v.tracking, gesture: v.gesture as string | null,
-    events: events.map(({ t, event, gesture }) => ({ t, event, gesture })),
+    events: events.map(({ t, event, gesture, hand }) => ({ t, event, gesture, hand: hand ?? null })),
     actions: actions.map(({ t, gesture, action }) => ({ t, gesture, action })),
     accepted: v.accepted, rejected: v.rejected, side, mirrored,
+    hands: hands && (hands as HandState[]).map(({ side, tracking, gesture }) => ({ side, tracking, gesture })),
   };
 }
 

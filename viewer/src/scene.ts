@@ -1,6 +1,6 @@
 // The three.js scene: up to three hands side by side (one per skinning method), lit so that
 // creases and volume read, with optional heat map, wireframe and skeleton overlays; or, with a
-// manipulation scene, one hand among the objects in their common world. Geometry comes from
+// manipulation scene, one hand (or a server's two) among the objects in their common world. Geometry comes from
 // the engine; this file only draws it.
 
 import * as THREE from 'three';
@@ -135,6 +135,8 @@ export class HandScene {
   private readonly ground: THREE.Mesh;
   private views: HandView[] = [];
   private parents: Int32Array = new Int32Array(0);
+  /** The second hand of a server driving two (its topology's hand 1), and its skeleton's parents; drawn in the world beside the first. */
+  private second: { view: HandView; parents: Int32Array } | null = null;
   private spacing = 0.15;
   private framed = false;
   private shownCount = 0;
@@ -149,6 +151,8 @@ export class HandScene {
   private readonly xrCamera = new THREE.PerspectiveCamera(70, 1, 0.01, 20);
   showSkeleton = false;
   lastFrame: Frame | null = null;
+  /** The second hand's latest frame shown, null without one. */
+  secondFrame: Frame | null = null;
 
   constructor(readonly canvas: HTMLCanvasElement) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
@@ -180,6 +184,20 @@ export class HandScene {
   }
 
   setTopology(topology: Topology): void {
+    if (this.second) {
+      // A new session (its first hand's topology) or the second hand's replaced.
+      this.scene.remove(this.second.view.group);
+      this.second.view.dispose();
+      this.second = null;
+      this.secondFrame = null;
+    }
+    if (topology.hand === 1) {
+      this.second = { view: new HandView(topology), parents: topology.parents };
+      this.second.view.group.visible = false; // until its first frame
+      this.place(this.second.view);
+      this.scene.add(this.second.view.group);
+      return;
+    }
     for (const v of this.views) {
       this.scene.remove(v.group);
       v.dispose();
@@ -205,8 +223,13 @@ export class HandScene {
     }
     this.objects = scene && new SceneObjects(scene);
     if (this.objects) this.scene.add(this.objects.group);
-    for (const v of this.views) this.place(v);
+    for (const v of this.hands()) this.place(v);
     this.framed = false;
+  }
+
+  /** Every hand view: the first hand's three, and the second hand's. */
+  private hands(): HandView[] {
+    return this.second ? [...this.views, this.second.view] : this.views;
   }
 
   /**
@@ -216,7 +239,7 @@ export class HandScene {
    */
   setWorld(on: boolean, side: Side): void {
     this.world = on ? side : null;
-    for (const v of this.views) this.place(v);
+    for (const v of this.hands()) this.place(v);
   }
 
   /** Turns and mirrors a hand for the scene, the world or viewing. */
@@ -242,9 +265,10 @@ export class HandScene {
    * hand (DQB in a split view: three hands side by side would not be where the objects are).
    */
   showFrame(frame: Frame): void {
+    if (frame.header.second) return this.showSecond(frame);
     if (this.views.length === 0 || frame.header.vertexCount !== this.views[0].mesh.geometry.getAttribute('position').count) return;
     this.lastFrame = frame;
-    const world = this.objects !== null || this.world !== null;
+    const world = this.objects !== null || this.world !== null || this.second !== null;
     const count = world ? 1 : frame.meshes.length;
     const first = world ? Math.max(0, frame.header.methods.indexOf('dqb')) : 0;
     this.views.forEach((view, i) => {
@@ -269,13 +293,23 @@ export class HandScene {
     }
   }
 
+  /** Shows the second hand's frame (DQB, or its one method), placed as the first hand is in the world. */
+  private showSecond(frame: Frame): void {
+    const second = this.second;
+    if (!second || frame.header.vertexCount !== second.view.mesh.geometry.getAttribute('position').count) return;
+    this.secondFrame = frame;
+    second.view.update(frame, Math.max(0, frame.header.methods.indexOf('dqb')), second.parents, this.heat);
+    second.view.group.visible = true;
+    second.view.bones.visible = second.view.jointDots.visible = this.showSkeleton;
+  }
+
   /** Visible hands and their methods, left to right. */
   visibleMethods(): (Method | null)[] {
     return this.views.filter((v) => v.group.visible).map((v) => v.method);
   }
 
   setWireframe(on: boolean): void {
-    for (const v of this.views) v.mesh.material.wireframe = on;
+    for (const v of this.hands()) v.mesh.material.wireframe = on;
   }
 
   /**

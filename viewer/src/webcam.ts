@@ -65,6 +65,8 @@ export class Webcam {
   private readonly side = new SideFilter();
   /** Where a hand at arm's length before the camera's centre lands in the engine's world (m). */
   anchor: Vec3 = [0, 0, 0];
+  /** Send both hands (the engine drives two: the hello's `second_hand`), else the one followed. */
+  both = false;
   readonly state: WebcamState = { on: false, status: 'off', frames: 0, detected: 0, sent: 0, hands: [], detectMs: 0, fps: 0, width: 0, height: 0 };
 
   constructor(
@@ -160,8 +162,13 @@ export class Webcam {
     this.state.hands = followed >= 0 ? [sides[followed], ...sides.filter((_, i) => i !== followed)] : [];
     if (followed >= 0) {
       this.state.detected++;
-      const record = landmarkRecord(performance.now() / 1000, sides[followed], world[followed] ?? [], image[followed] ?? [], video.videoWidth / video.videoHeight, this.anchor);
-      if (record && this.sender.send(record)) this.state.sent++;
+      const t = performance.now() / 1000;
+      // Two hands told apart by their labels each drive the engine's hand of their side.
+      const sent = this.both && sides.length === 2 && sides[0] !== sides[1] ? [0, 1] : [followed];
+      for (const k of sent) {
+        const record = landmarkRecord(t, sides[k], world[k] ?? [], image[k] ?? [], video.videoWidth / video.videoHeight, this.anchor);
+        if (record && this.sender.send(record)) this.state.sent++;
+      }
     }
     this.drawPreview(video, image);
     this.changed(this.state);

@@ -1,6 +1,6 @@
 // WebXR live input: in an immersive session with hand tracking, each XR frame's 25 joint poses
-// of one tracked hand go to the engine as a record (`/input`), and the engine's hand is drawn
-// where the user's hand is. The Enter VR / Enter AR buttons show only where the browser offers
+// of one tracked hand (of each, when the engine drives two) go to the engine as a record
+// (`/input`), and the engine's hands are drawn where the user's are. The Enter VR / Enter AR buttons show only where the browser offers
 // the mode; leaving the session gives the desktop view back (three.js restores the canvas).
 
 import type { WebGLRenderer } from 'three';
@@ -23,12 +23,14 @@ export interface XRState {
   mode: XRMode | null;
   /** Records the sender took (a closed socket drops them) in all sessions. */
   sent: number;
-  /** The side of the hand last sent in this session; null before its first record. */
+  /** The side of the hand last sent in this session (of two, the right one); null before its first record. */
   side: Side | null;
+  /** Whether both hands are sent (the engine drives two). */
+  both: boolean;
 }
 
 const MODES = { vr: 'immersive-vr', ar: 'immersive-ar' } as const;
-/** The sides in order of preference: the engine drives one hand, the right when tracked. */
+/** The sides in order of preference: an engine driving one hand takes the right when tracked. */
 const SIDES: readonly Side[] = ['right', 'left'];
 
 export class XRInput {
@@ -36,6 +38,8 @@ export class XRInput {
   mode: XRMode | null = null;
   side: Side | null = null;
   sent = 0;
+  /** Send every tracked hand (the engine drives two: the hello's `second_hand`), else the preferred one. */
+  both = false;
   /** Time (s) of the last record: the engine wants it strictly increasing. */
   private lastT = -Infinity;
 
@@ -66,7 +70,7 @@ export class XRInput {
   }
 
   state(): XRState {
-    return { supported: { ...this.supported }, active: this.active, mode: this.mode, sent: this.sent, side: this.side };
+    return { supported: { ...this.supported }, active: this.active, mode: this.mode, sent: this.sent, side: this.side, both: this.both };
   }
 
   /** Starts a session that must track hands (a browser that cannot refuses it: `error`). */
@@ -85,23 +89,27 @@ export class XRInput {
 
   /**
    * Sends the frame's tracked hand, the right one when all its joints are tracked, else the
-   * left; the render loop calls it with the XR frame (none outside a session).
+   * left (with `both`, each hand all of whose joints are tracked); the render loop calls it
+   * with the XR frame (none outside a session).
    */
   update(time: number, frame: XRFrame | undefined): void {
     const space = this.renderer.xr.getReferenceSpace();
     const t = time / 1000;
     if (!frame || !space || t <= this.lastT) return;
+    let first: Side | null = null;
     for (const side of SIDES) {
       const hand = Array.from(frame.session.inputSources).find((s) => s.handedness === side)?.hand;
       const joints = hand && jointRecords(frame, hand, space);
       if (!joints) continue;
       this.lastT = t;
       if (this.sender.send({ t, hand: side, joints })) this.sent++;
-      if (side !== this.side) {
-        this.side = side;
-        this.events.changed();
-      }
-      return;
+      first ??= side;
+      if (!this.both) break;
+    }
+    // The side reported is the first sent (the right one when both are).
+    if (first !== null && first !== this.side) {
+      this.side = first;
+      this.events.changed();
     }
   }
 }

@@ -59,6 +59,24 @@ async function restartServer(whileDown = async () => {}) {
   await waitState(page, `s.connected && s.framesReceived > ${before + 3} && s.frame.methods.length === 3`, 90_000);
 }
 
+/**
+ * A `dqhand demo` with `args` of its own and a page on it, for one describe block: started
+ * before its tests (the page handed to `opened`), closed and stopped after them.
+ */
+function ownServer(args: string[], opened: (p: Page) => void): void {
+  let own: Server | null = null;
+  let ownPage: Page | null = null;
+  beforeAll(async () => {
+    own = await startServer({ args });
+    ownPage = await newPage(browser);
+    opened(ownPage);
+    await ownPage.goto(own.url);
+  });
+  afterAll(async () => {
+    await ownPage?.close();
+    await own?.stop();
+  });
+}
 
 beforeAll(async () => {
   server = await startServer();
@@ -299,20 +317,9 @@ describe('the Input panel, on input messages put into the real stream', () => {
 const RECORDING = path.join(root, 'crates/dqhand/data/recordings/gestures-joints.jsonl');
 
 describe('the viewer page with a recorded input', () => {
-  let inputServer: Server | null = null;
   let inputPage: Page | null = null;
-
-  beforeAll(async () => {
-    // `demo --input` must exist: a renamed or missing option fails here (the demo exits).
-    inputServer = await startServer({ args: ['--input', RECORDING] });
-    inputPage = await newPage(browser);
-    await inputPage.goto(inputServer.url);
-  });
-
-  afterAll(async () => {
-    await inputPage?.close();
-    await inputServer?.stop();
-  });
+  // `demo --input` must exist: a renamed or missing option fails here (the demo exits).
+  ownServer(['--input', RECORDING], (p) => (inputPage = p));
 
   test('shows the source, tracking, the recognised gesture and its events, and the sliders follow the hand', async () => {
     const p = inputPage!;
@@ -347,20 +354,9 @@ describe('the viewer page with a recorded input', () => {
 });
 
 describe('the viewer page with a scene', () => {
-  let sceneServer: Server | null = null;
   let p: Page;
-
-  beforeAll(async () => {
-    // No --input: the demo makes a scripted grasp of each object and plays it.
-    sceneServer = await startServer({ args: ['--scene', 'grasp'] });
-    p = await newPage(browser);
-    await p.goto(sceneServer.url);
-  });
-
-  afterAll(async () => {
-    await p?.close();
-    await sceneServer?.stop();
-  });
+  // No --input: the demo makes a scripted grasp of each object and plays it.
+  ownServer(['--scene', 'grasp'], (page) => (p = page));
 
   test('draws the table and the objects where the engine puts them, with the hand among them', async () => {
     // One predicate for state and page: other pages share the two cores, and this one may answer slowly.
@@ -402,6 +398,31 @@ describe('the viewer page with a scene', () => {
     await expect.poll(drawn, { timeout: 30_000, interval: 500 }).toBeGreaterThan(2000);
     // Two polls of up to 30 s and the settles: more than the default 120 s when a whole
     // suite has loaded the two cores (it timed out once there, never alone).
+  }, 240_000);
+});
+
+describe('the viewer page with two hands in a scene', () => {
+  let p: Page;
+  type TwoState = { errors: string[]; visible: string[]; secondHand: { side: string; wrist: number[] | null; sequence: number | null } | null; input: { hands: { side: string; tracking: string }[] | null; log: string[] } | null };
+  const twoState = (): Promise<TwoState> => p.evaluate(() => (window as unknown as { dqhand: { state(): TwoState } }).dqhand.state());
+
+  // The two-hands scene drives two hands; with no input it plays its scripted carry and hand-over.
+  ownServer(['--scene', 'two-hands'], (page) => (p = page));
+
+  test('draws the second hand, reports both hands and shows the box held by both', async () => {
+    await waitState(p, 's.connected && s.secondHand !== null && s.secondHand.side === "left" && s.secondHand.sequence !== null && s.visible.length === 1', 90_000);
+    expect(await p.locator('#model-line').textContent()).toContain('left hand');
+    // The scripted carry: both hands tracked, the box in both, events naming their hand.
+    await waitState(p, 'document.getElementById("held").textContent === "box in both hands" && s.input.hands.every((h) => h.tracking === "tracking")', 120_000);
+    const s = await twoState();
+    expect(s.input!.hands!.map((h) => h.side)).toEqual(['right', 'left']);
+    // The two wrists are apart (each hand where its side's records put it).
+    const wrists = await p.evaluate(() => {
+      const st = (window as unknown as { dqhand: { state(): { frame: { wrist: number[] }; secondHand: { wrist: number[] } } } }).dqhand.state();
+      return [st.frame.wrist, st.secondHand.wrist];
+    });
+    expect(Math.abs(wrists[0][0] - wrists[1][0])).toBeGreaterThan(0.2);
+    expect(s.errors).toEqual([]);
   }, 240_000);
 });
 

@@ -3,7 +3,7 @@
 
 import { readFileSync } from 'node:fs';
 import { describe, expect, test } from 'vitest';
-import { InputLog, learningText, LOG_LENGTH } from '../src/input';
+import { heldText, InputLog, learningText, LOG_LENGTH } from '../src/input';
 import {
   binaryKind, decodeFrame, decodeText, decodeTopology, encodeCommand, frameByteLength, type Hello, type InputMessage, MAX_SCENE_CONTACTS,
   MAX_SCENE_TRIANGLES, type LearningMessage, ProtocolError, type SceneMessage,
@@ -21,7 +21,7 @@ describe('frame', () => {
     const f = decodeFrame(buffer);
     expect(f.header).toMatchObject({
       sequence: 7, vertexCount: 2, jointCount: 2, dofCount: 3, methods: ['lb', 'dqb'], distortion: true,
-      engineUs: 123.5, engineFps: 120, time: 1.25, duration: 21, playing: true, limits: true,
+      engineUs: 123.5, engineFps: 120, time: 1.25, duration: 21, playing: true, limits: true, second: false,
     });
     expect(Array.from(f.header.wrist)).toEqual([0.1, 0.2, 0.3, 0, 0, 0, 1].map(Math.fround));
     expect(Array.from(f.angles)).toEqual([0.5, -0.25, 1]);
@@ -52,6 +52,12 @@ describe('frame', () => {
     for (const [b, message] of cases) expect(() => decodeFrame(b)).toThrow(message);
     expect(() => decodeFrame(buffer.slice(0, 20))).toThrow(ProtocolError);
   });
+
+  test('flag bit 1 marks the second hand\'s frame', () => {
+    const bytes = new Uint8Array(fixture('frame-v1.bin')).slice();
+    bytes[6] |= 2;
+    expect(decodeFrame(bytes.buffer).header).toMatchObject({ second: true, distortion: true, sequence: 7 });
+  });
 });
 
 describe('topology', () => {
@@ -62,6 +68,15 @@ describe('topology', () => {
     expect(t.vertexCount).toBe(4);
     expect(Array.from(t.indices)).toEqual([0, 1, 2, 2, 1, 3]);
     expect(Array.from(t.parents)).toEqual([-1, 0, 1]);
+    expect(t.hand).toBe(0);
+  });
+
+  test('the second hand\'s topology says hand 1; any other hand is refused', () => {
+    const bytes = new Uint8Array(fixture('topology-v1.bin')).slice();
+    bytes[6] = 1;
+    expect(decodeTopology(bytes.slice().buffer).hand).toBe(1);
+    bytes[6] = 2;
+    expect(() => decodeTopology(bytes.buffer)).toThrow(/unknown to version 1/);
   });
 
   test('refuses an index past the vertices and a joint that is its own parent', () => {
@@ -103,11 +118,30 @@ describe('live input', () => {
   const text = (edit: Record<string, unknown> = {}) => JSON.stringify({ ...good, ...edit });
 
   test('an input message is parsed with every field', () => {
-    expect(decodeText(text())).toEqual(good);
+    expect(decodeText(text())).toEqual({ ...good, events: good.events.map((e) => ({ ...e, hand: null })), hands: null });
     const quiet = decodeText(text({ tracking: 'lost', gesture: null, events: [], actions: [] })) as InputMessage;
     expect(quiet).toMatchObject({ tracking: 'lost', gesture: null, events: [], actions: [], accepted: 1234 });
     // An older server says nothing of the side: none, not mirrored.
     expect(decodeText(text({ side: undefined, mirrored: undefined }))).toMatchObject({ side: null, mirrored: false });
+  });
+
+  test('with two hands, each hand\'s state and the hand of each event are parsed, and logged', () => {
+    const hands = [{ side: 'right', tracking: 'tracking', gesture: 'fist' }, { side: 'left', tracking: 'lost', gesture: null }];
+    const events = [{ t: 2, event: 'start', gesture: 'fist', hand: 'right' }, { t: 2.5, event: 'start', gesture: 'hands_together', hand: 'both' }];
+    const m = decodeText(text({ hands, events, actions: [] })) as InputMessage;
+    expect(m.hands).toEqual(hands);
+    expect(m.events).toEqual(events);
+    const log = new InputLog();
+    log.add(m);
+    expect(log.lines).toEqual(['2.50  both start hands_together', '2.00  right start fist']);
+    for (const [edit, message] of [
+      [{ hands: [hands[0]] }, /hands/],
+      [{ hands: [hands[0], { ...hands[1], side: 'middle' }] }, /hands/],
+      [{ hands: [hands[0], { ...hands[1], tracking: 'gone' }] }, /hands/],
+      [{ events: [{ ...events[0], hand: 'third' }] }, /events\[0\]/],
+    ] as const) {
+      expect(() => decodeText(text(edit))).toThrow(message);
+    }
   });
 
   test('a recording message is parsed, and a malformed one refused naming the field', () => {
@@ -166,6 +200,15 @@ describe('live input', () => {
     for (const [t, message] of cases) {
       expect(() => decodeText(t)).toThrow(ProtocolError);
       expect(() => decodeText(t)).toThrow(message);
+    }
+  });
+
+  test('the hello\'s second hand is null, absent (an older server: null) or its side and mesh', () => {
+    const second = { side: 'left', description: 'built-in left hand', vertices: 100, triangles: 196 };
+    expect(decodeText(JSON.stringify({ type: 'hello', version: 1 }))).toMatchObject({ second_hand: null });
+    expect(decodeText(JSON.stringify({ type: 'hello', version: 1, second_hand: second }))).toMatchObject({ second_hand: second });
+    for (const bad of [{ ...second, side: 'both' }, { ...second, vertices: -1 }, 'left']) {
+      expect(() => decodeText(JSON.stringify({ type: 'hello', version: 1, second_hand: bad }))).toThrow(/second_hand/);
     }
   });
 
@@ -263,15 +306,29 @@ describe('scene', () => {
   });
 
   const good: SceneMessage = {
-    type: 'scene', held: 'ball',
+    type: 'scene', held: 'ball', holding: null,
     objects: { ball: { p: [0.1, 0.9, -0.3], q: [0, 0, 0, 1] }, teapot: { p: [0.15, 0.75, -0.35], q: [0, 0.383, 0, 0.924] } },
-    contacts: [{ bone: 'thumb-tip', object: 'ball', p: [0.1, 0.93, -0.3], n: [0, 1, 0] }],
+    contacts: [{ bone: 'thumb-tip', object: 'ball', p: [0.1, 0.93, -0.3], n: [0, 1, 0], hand: null }],
   };
   const message = (edit: Record<string, unknown> = {}) => JSON.stringify({ ...good, ...edit });
 
   test('a scene message is parsed with every field', () => {
     expect(decodeText(message())).toEqual(good);
     expect(decodeText(message({ held: null, contacts: [] }))).toMatchObject({ held: null, contacts: [] });
+    expect(heldText(good)).toBe('ball');
+  });
+
+  test('with two hands, what each hand holds and the hand of each contact are parsed and shown', () => {
+    const contacts = [{ ...good.contacts[0], hand: 'left' }];
+    const both = decodeText(message({ holding: { left: 'ball', right: 'ball' }, contacts })) as SceneMessage;
+    expect(both.holding).toEqual({ left: 'ball', right: 'ball' });
+    expect(both.contacts[0].hand).toBe('left');
+    expect(heldText(both)).toBe('ball in both hands');
+    expect(heldText({ held: 'ball', holding: { left: null, right: 'ball' } })).toBe('left: —, right: ball');
+    expect(heldText({ held: null, holding: { left: null, right: null } })).toBe('—');
+    expect(() => decodeText(message({ holding: { middle: 'ball' } }))).toThrow(/holding/);
+    expect(() => decodeText(message({ holding: { left: 3 } }))).toThrow(/holding/);
+    expect(() => decodeText(message({ contacts: [{ ...good.contacts[0], hand: 'both' }] }))).toThrow(/contacts\[0\]/);
   });
 
   test('a malformed scene message is refused, naming the field', () => {

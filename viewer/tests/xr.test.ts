@@ -47,12 +47,11 @@ const canvasPlace = () => page.evaluate(() => {
 });
 
 
-beforeAll(async () => {
-  server = await startServer();
-  browser = await launchBrowser();
-  page = await newPage(browser);
-  await page.addInitScript({ path: IWER_BUNDLE });
-  await page.addInitScript(() => {
+/** A page of `browser` with the emulated headset injected before its own script. */
+async function emulatedPage(): Promise<Page> {
+  const p = await newPage(browser);
+  await p.addInitScript({ path: IWER_BUNDLE });
+  await p.addInitScript(() => {
     const w = window as unknown as Emulated;
     const device = new w.IWER.XRDevice(w.IWER.metaQuest3);
     device.primaryInputMode = 'hand';
@@ -60,6 +59,13 @@ beforeAll(async () => {
     device.installRuntime({ forceInstall: true });
     w.iwer = device;
   });
+  return p;
+}
+
+beforeAll(async () => {
+  server = await startServer();
+  browser = await launchBrowser();
+  page = await emulatedPage();
   await page.goto(server.url);
   await waitState(page, 's.connected && s.framesReceived > 3');
 });
@@ -172,4 +178,50 @@ describe('the WebXR input, with an emulated headset tracking hands', () => {
     await page.evaluate(() => (window as unknown as Emulated).iwer.activeSession!.end());
     await waitState(page, '!s.xr.active');
   });
+});
+
+describe('the WebXR input to a server driving two hands', () => {
+  let twoServer: Awaited<ReturnType<typeof startServer>> | null = null;
+  let p: Page;
+  type TwoState = State & {
+    input: { tracking: string; hands: { side: string; tracking: string }[] | null } | null;
+    xr: State['xr'] & { both: boolean };
+    secondHand: { side: string; wrist: number[] | null; sequence: number | null } | null;
+  };
+  const twoState = (): Promise<TwoState> => p.evaluate(() => (window as unknown as { dqhand: { state(): TwoState } }).dqhand.state());
+
+  beforeAll(async () => {
+    // Two hands in the built-in two-hands scene; --udp so that no scripted recording plays
+    // (the headset is the only input).
+    twoServer = await startServer({ args: ['--hands', '2', '--udp', '0'] });
+    p = await emulatedPage();
+    await p.goto(twoServer.url);
+    await waitState(p, 's.connected && s.framesReceived > 3 && s.secondHand !== null && s.secondHand.sequence !== null', 90_000);
+  }, 180_000);
+
+  afterAll(async () => {
+    await p?.close();
+    await twoServer?.stop();
+  });
+
+  test('both hands are sent, and each engine hand follows the user\'s hand of its side', async () => {
+    expect((await twoState()).secondHand!.side).toBe('left');
+    await p.click('#enter-vr');
+    await waitState(p, 's.xr.active && s.xr.both && s.input && s.input.hands && s.input.hands.every((h) => h.tracking === "tracking")', 60_000);
+    // IWER's hands are at (±0.25, 1.5, -0.4): the first engine hand at the right one, the second at the left.
+    await waitState(p, 'Math.hypot(s.frame.wrist[0] - 0.25, s.frame.wrist[1] - 1.5, s.frame.wrist[2] + 0.4) < 0.15 && Math.hypot(s.secondHand.wrist[0] + 0.25, s.secondHand.wrist[1] - 1.5, s.secondHand.wrist[2] + 0.4) < 0.15', 60_000);
+    expect((await twoState()).input!.hands!.map((h) => h.side)).toEqual(['right', 'left']);
+    // Moving the left hand moves the second engine hand, not the first.
+    const before = await twoState();
+    await p.evaluate(() => ((window as unknown as Emulated).iwer.hands.left!.position.x -= 0.1));
+    await waitState(p, `Math.abs(s.secondHand.wrist[0] - ${before.secondHand!.wrist![0] - 0.1}) < 0.01`, 60_000);
+    expect(Math.abs((await twoState()).frame!.wrist[0] - before.frame!.wrist[0])).toBeLessThan(0.01);
+    // Both drawn where they are: on each half of the headset's view.
+    await settle(p);
+    const { strips, width, height } = await canvasStats(p, 2);
+    for (const n of strips) expect(n / ((width * height) / 2)).toBeGreaterThan(0.005);
+    expect((await twoState()).errors).toEqual([]);
+    await p.evaluate(() => (window as unknown as Emulated).iwer.activeSession!.end());
+    await waitState(p, '!s.xr.active');
+  }, 240_000);
 });

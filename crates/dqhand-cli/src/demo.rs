@@ -16,6 +16,7 @@ use dqhand::input::Record;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
 use dqhand::interaction::{GestureLoop, ManipulationLoop};
+use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::Method;
 use dqhand_stream::LiveInput;
@@ -79,11 +80,37 @@ pub struct Args {
     /// Gesture definitions to recognise instead of the built-in ones.
     #[arg(long)]
     gestures_file: Option<PathBuf>,
-    /// Manipulate a scene: a built-in one (`grasp`, `objects`) or a scene JSON file. Without
-    /// --input or --udp a scripted grasp of each of its objects plays (made at start).
+    /// Manipulate a scene: a built-in one (`grasp`, `objects`, `two-hands`) or a scene JSON
+    /// file. Without --input or --udp a scripted grasp of each of its objects plays (made at
+    /// start; in `two-hands` with two hands, its box carried between them and its bar handed
+    /// over).
     #[arg(long)]
     scene: Option<String>,
+    /// Hands the live input drives: 1, or 2 (a left and a right one, each built as itself,
+    /// in a scene: --scene, else the built-in `two-hands`). Default: 2 in the `two-hands`
+    /// scene, else 1.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
+    hands: Option<u8>,
+    /// The left hand of two: `builtin` (the built-in hand built as a left one, at the
+    /// defaults) or a skinned glTF of a left hand. --model is then the right hand.
+    #[arg(long, default_value = "builtin")]
+    left_model: ModelSource,
 }
+
+impl Args {
+    /// Whether the live input drives two hands.
+    fn two_hands(&self) -> bool {
+        self.hands.map_or(self.scene.as_deref() == Some(TWO_HANDS_SCENE), |n| n == 2)
+    }
+
+    /// The scene manipulated, if any (two hands always have one).
+    fn scene_name(&self) -> Option<&str> {
+        self.scene.as_deref().or(self.two_hands().then_some(TWO_HANDS_SCENE))
+    }
+}
+
+/// The built-in scene made for two hands.
+const TWO_HANDS_SCENE: &str = "two-hands";
 
 /// What a played input reads: a recording file, or records made at start.
 enum Played {
@@ -93,8 +120,10 @@ enum Played {
 
 /// The recording `demo --scene` plays when no input is given: every object of the scene
 /// grasped from above in turn by the demo's hand (`dqhand synthesize --scene` writes the same
-/// for the built-in hand), made now in memory; `None` for a scene without objects.
-fn scripted_grasps(model: &Arc<dqhand::model::Model>, name: &str, scene: &Scene) -> anyhow::Result<Option<Arc<[Record]>>> {
+/// for the built-in hand), or with a `left` hand in the `two-hands` scene its box carried
+/// between both hands and its bar handed over; made now in memory; `None` for a scene without
+/// objects.
+fn scripted_grasps(model: &Arc<Model>, left: Option<&Arc<Model>>, name: &str, scene: &Scene) -> anyhow::Result<Option<Arc<[Record]>>> {
     if scene.objects.is_empty() {
         println!("input: {name} has no object to grasp, so nothing plays (give --input or --udp, or send records to /input)");
         return Ok(None);
@@ -102,7 +131,10 @@ fn scripted_grasps(model: &Arc<dqhand::model::Model>, name: &str, scene: &Scene)
     let start = Instant::now();
     print!("scene {name}: making a scripted grasp of each object to play (synthetic, from the hand's own kinematics)... ");
     std::io::Write::flush(&mut std::io::stdout())?;
-    let (_, scripts) = crate::synthesize::scripted_grasps(model, name, scene, Side::default()).with_context(|| name.to_owned())?;
+    let scripts = match left {
+        Some(left) if name == TWO_HANDS_SCENE => crate::synthesize::two_handed([left, model], scene)?.1,
+        _ => crate::synthesize::scripted_grasps(model, name, scene, Side::default()).with_context(|| name.to_owned())?.1,
+    };
     let records: Arc<[Record]> = scripts.iter().flat_map(|s| s.records.iter().copied()).collect();
     println!("{} records in {} ms", records.len(), start.elapsed().as_millis());
     Ok(Some(records))
@@ -126,7 +158,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let listener = TcpListener::bind(address).with_context(|| format!("cannot listen on {address} (try another --port)"))?;
     let bound = listener.local_addr()?;
     let model = Arc::new(model);
-    let feed = live_input(args, &model, bound.ip())?;
+    let left = args.two_hands().then(|| args.left_model.left().load().with_context(|| format!("--left-model {}", args.left_model))).transpose()?.map(Arc::new);
+    let feed = live_input(args, &model, left.as_ref(), bound.ip())?;
     let url = format!("http://{}/", if bound.ip().is_unspecified() { SocketAddr::new([127, 0, 0, 1].into(), bound.port()) } else { bound });
     println!("{}", model.description);
     if bound.ip().is_loopback() {
@@ -139,14 +172,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if !args.no_open {
         open_browser(&url);
     }
-    let shared = server::Shared { model, joint_model: args.joint_model, assets: Some(assets), fps: args.fps, feed: Some(feed) };
+    let second = left.map(|l| (l, Side::Left));
+    let shared = server::Shared { model, second, joint_model: args.joint_model, assets: Some(assets), fps: args.fps, feed: Some(feed) };
     server::serve(listener, shared)?;
     Ok(())
 }
 
 /// The live input: the recording played, or the UDP port, or only the `/input` WebSocket
-/// (always open), each record recognised and every viewer following.
-fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> anyhow::Result<Arc<Feed>> {
+/// (always open), each record recognised and every viewer following; with a `left` model,
+/// of two hands.
+fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: IpAddr) -> anyhow::Result<Arc<Feed>> {
     let gestures = gesture_set(args.gestures_file.as_deref(), true)?.expect("recognition on");
     let mut config = args.common.config()?;
     if args.common.config.is_none() {
@@ -154,10 +189,10 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
         config.actions.retain(|a| gestures.gestures().iter().any(|g| g.name() == a.gesture));
     }
     let mapper = Some(args.common.mapper(args.joint_model)?);
-    let scene = args.scene.as_deref().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
+    let scene = args.scene_name().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
     let played = match (&args.input, &scene, args.udp) {
         (Some(path), _, _) => Some(Played::File(path.clone())),
-        (None, Some((name, scene)), None) => scripted_grasps(model, name, scene)?.map(Played::Records),
+        (None, Some((name, scene)), None) => scripted_grasps(model, left, name, scene)?.map(Played::Records),
         (None, _, _) => None,
     };
     if let (Some(Played::File(input)), Some(record)) = (&played, &args.record) {
@@ -175,7 +210,7 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     };
     let source = match (&played, &udp) {
         (Some(Played::File(path)), _) => path.display().to_string(),
-        (Some(Played::Records(_)), _) => format!("scripted grasps in scene {} (synthetic)", args.scene.as_deref().unwrap_or_default()),
+        (Some(Played::Records(_)), _) => format!("scripted grasps in scene {} (synthetic)", args.scene_name().unwrap_or_default()),
         (None, Some(socket)) => format!("udp {}", socket.local_addr()?),
         (None, None) => "WebSocket /input".to_owned(),
     };
@@ -183,9 +218,17 @@ fn live_input(args: &Args, model: &Arc<dqhand::model::Model>, host: IpAddr) -> a
     let input = match scene {
         None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?, source.clone(), announce)?,
         Some((name, scene)) => {
-            let manip = ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default()).with_context(|| name.to_owned())?;
+            let manip = match left {
+                None => ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default()),
+                Some(left) => {
+                    let hands = [(Arc::clone(left), mapper.clone()), (Arc::clone(model), mapper)];
+                    ManipulationLoop::two_handed(hands, args.joint_model, config, Some(gestures), &scene, GraspParams::default())
+                }
+            }
+            .with_context(|| name.to_owned())?;
             crate::warn_all(&manip.objects().warnings().iter().map(|w| format!("{name}: {w}")).collect::<Vec<_>>());
-            println!("scene: {name}, {} objects ({})", manip.names().len(), manip.names().join(", "));
+            let hands = if left.is_some() { "two hands, left and right" } else { "one hand" };
+            println!("scene: {name}, {} objects ({}), {hands}", manip.names().len(), manip.names().join(", "));
             LiveInput::with_scene(manip, source.clone(), announce).with_context(|| name.to_owned())?
         }
     };

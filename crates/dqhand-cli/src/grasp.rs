@@ -17,9 +17,8 @@ use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::grasp::GraspParams;
 use dqhand::input::{Record, Tracking};
-use dqhand::hand::HandParams;
 use dqhand::interaction::{ManipulatingHand, ManipulationLoop};
-use dqhand::kinematics::{JointModel, Side};
+use dqhand::kinematics::JointModel;
 use dqhand::scene::Scene;
 use dqhand::skin::{Method, MethodSet, SkinLayer};
 use serde_json::{json, Map, Value};
@@ -66,11 +65,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut manip = match &args.left_model {
         None => ManipulationLoop::new(model, joint_model, mapper, config, gestures, &scene, GraspParams::default())?,
         Some(left) => {
-            let left = match left {
-                ModelSource::Builtin(params) => ModelSource::Builtin(HandParams { side: Side::Left, ..*params }),
-                file => file.clone(),
-            };
-            let left = Arc::new(left.load().with_context(|| format!("--left-model {left}"))?);
+            let left = Arc::new(left.left().load().with_context(|| format!("--left-model {left}"))?);
             ManipulationLoop::two_handed([(left, mapper.clone()), (model, mapper)], joint_model, config, gestures, &scene, GraspParams::default())?
         }
     };

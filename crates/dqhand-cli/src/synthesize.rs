@@ -118,13 +118,12 @@ pub fn scripted_grasps(model: &Arc<Model>, name: &str, scene: &Scene, side: Side
     Ok((tasks, scripts))
 }
 
-/// The built-in `two-hands` scene played by a left hand and `right`: the box carried 20 cm
-/// away between them, then the bar handed over (each hand carrying it 12 cm), on one clock with a
-/// tracking loss between; the objects' names and the scripts.
-fn two_handed(right: &Arc<Model>, scene: &Scene) -> anyhow::Result<(Vec<String>, Vec<Script>)> {
-    let left = dqhand::hand::build(&HandParams { side: Side::Left, ..HandParams::default() })?;
+/// The built-in `two-hands` scene played by `hands`, a left and a right one: the box carried
+/// 20 cm away between them, then the bar handed over (each hand carrying it 12 cm), on one
+/// clock with a tracking loss between; the objects' names and the scripts.
+pub fn two_handed(hands: [&Arc<Model>; 2], scene: &Scene) -> anyhow::Result<(Vec<String>, Vec<Script>)> {
     let objects = ObjectColliders::new(scene)?;
-    let hands = [&left, &**right];
+    let hands = hands.map(|h| &**h);
     // The box goes away from the user, clear of the bar.
     let mut scripts = vec![
         grasp_script::carry_between(hands, "two-hands", &objects, "box", 0.12, glam::Vec3::new(0.0, 0.0, -0.2))?,
@@ -141,7 +140,8 @@ fn manipulation(args: &Args, name: &str) -> anyhow::Result<()> {
     let scene = Scene::named(name)?;
     let model = Arc::new(dqhand::hand::build(&HandParams::default())?);
     let (tasks, scripts) = if name == "two-hands" {
-        two_handed(&model, &scene)?
+        let left = Arc::new(dqhand::hand::build(&HandParams { side: Side::Left, ..HandParams::default() })?);
+        two_handed([&left, &model], &scene)?
     } else {
         let (tasks, scripts) = scripted_grasps(&model, name, &scene, args.side.unwrap_or_default())?;
         (tasks.into_iter().map(|t| t.object).collect(), scripts)

@@ -4,13 +4,14 @@
 //!
 //! Topology (`DQHT`):
 //! ```text
-//! 0  u32 magic "DQHT"   4 u16 version   6 u16 reserved
+//! 0  u32 magic "DQHT"   4 u16 version   6 u16 hand (0 the first, 1 the second)
 //! 8  u32 vertex count   12 u32 index count   16 u32 joint count
 //! 20 u32 indices[index count]   then i32 parent[joint count] (−1 for a root)
 //! ```
 //! Frame (`DQHF`):
 //! ```text
-//! 0  u32 magic "DQHF"   4 u16 version   6 u16 flags (bit 0: distortion arrays follow)
+//! 0  u32 magic "DQHF"   4 u16 version   6 u16 flags (bit 0: distortion arrays follow;
+//!                                                   bit 1: of the second hand)
 //! 8  u32 sequence number   12 u32 vertex count   16 u32 joint count   20 u32 DOF count
 //! 24 u8 mesh count (1–3)   25 u8 method per mesh (0 LB, 1 QB, 2 DQB; 255 unused) ×3
 //! 28 f32 engine time of this frame (pose + skin + distortion), µs
@@ -21,6 +22,10 @@
 //!    then per mesh: f32 positions[3 · vertex count], f32 normals[3 · vertex count],
 //!                   (flag 0) f32 distortion[vertex count]
 //! ```
+//!
+//! A server driving two hands (`dqhand demo --hands 2`) sends the second hand's topology after
+//! the first's and, each step, the second hand's frame after the first's; its hello's
+//! `second_hand` describes it (null with one hand).
 //!
 //! With a scene (`dqhand demo --scene`) two JSON texts join them. The hello's `scene` (null
 //! without one; [`scene_hello`]): the table's top and each object's shape in its own frame,
@@ -64,6 +69,8 @@ pub const FRAME_HEADER_BYTES: usize = 76;
 pub const TOPOLOGY_HEADER_BYTES: usize = 20;
 /// Frame flag: a distortion array follows each mesh's normals.
 pub const FLAG_DISTORTION: u16 = 1;
+/// Frame flag: the frame is of the second hand (the hello's `second_hand`).
+pub const FLAG_SECOND_HAND: u16 = 2;
 /// Method code of a mesh slot the frame does not use.
 const UNUSED_METHOD: u8 = 255;
 /// State bit: the timeline is playing.
@@ -86,6 +93,8 @@ pub struct FrameHeader {
     pub methods: MethodSet,
     /// Whether each mesh carries a distortion array.
     pub distortion: bool,
+    /// Whether the frame is of the second hand.
+    pub second: bool,
     /// Engine time spent on this frame, µs.
     pub engine_us: f32,
     /// Frames per second the engine is sending to this client.
@@ -141,7 +150,8 @@ impl<'a> FrameWriter<'a> {
         let h = &header;
         out.extend_from_slice(&FRAME_MAGIC.to_le_bytes());
         out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&(if h.distortion { FLAG_DISTORTION } else { 0 }).to_le_bytes());
+        let flags = if h.distortion { FLAG_DISTORTION } else { 0 } | if h.second { FLAG_SECOND_HAND } else { 0 };
+        out.extend_from_slice(&flags.to_le_bytes());
         for v in [h.sequence, h.vertex_count, h.joint_count, h.dof_count] {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -246,7 +256,7 @@ impl FrameView {
     /// does not match the header.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };
-        let flags = r.start(FRAME_MAGIC, "frame", FLAG_DISTORTION)?;
+        let flags = r.start(FRAME_MAGIC, "frame", FLAG_DISTORTION | FLAG_SECOND_HAND)?;
         let (sequence, vertex_count, joint_count, dof_count) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
         let codes = r.take(4)?;
         let mesh_count = usize::from(codes[0]);
@@ -272,6 +282,7 @@ impl FrameView {
             dof_count,
             methods,
             distortion: flags & FLAG_DISTORTION != 0,
+            second: flags & FLAG_SECOND_HAND != 0,
             engine_us: s[0],
             engine_fps: s[1],
             time: s[2],
@@ -298,6 +309,8 @@ impl FrameView {
 /// The mesh and skeleton structure sent once per connection.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Topology {
+    /// Which hand: 0 the first, 1 the second (the hello's `second_hand`).
+    pub hand: u16,
     /// Vertices of the mesh.
     pub vertex_count: u32,
     /// Triangle corners, three per triangle.
@@ -313,7 +326,7 @@ impl Topology {
         let mut out = Vec::with_capacity(TOPOLOGY_HEADER_BYTES + 4 * (self.indices.len() + self.parents.len()));
         out.extend_from_slice(&TOPOLOGY_MAGIC.to_le_bytes());
         out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&0u16.to_le_bytes());
+        out.extend_from_slice(&self.hand.to_le_bytes());
         for n in [self.vertex_count, self.indices.len() as u32, self.parents.len() as u32] {
             out.extend_from_slice(&n.to_le_bytes());
         }
@@ -329,7 +342,8 @@ impl Topology {
     /// range or a parent that is not another joint.
     pub fn parse(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader { bytes, at: 0 };
-        r.start(TOPOLOGY_MAGIC, "topology", 0)?;
+        // The hand field is read as flags: 0 or 1, any other value refused.
+        let hand = r.start(TOPOLOGY_MAGIC, "topology", 1)?;
         let (vertex_count, index_count, joint_count) = (r.u32()?, r.u32()? as usize, r.u32()? as usize);
         let indices = (0..index_count).map(|_| r.u32()).collect::<Result<Vec<_>>>()?;
         if let Some(i) = indices.iter().find(|&&i| i >= vertex_count) {
@@ -343,7 +357,7 @@ impl Topology {
             })
             .collect::<Result<Vec<_>>>()?;
         r.end()?;
-        Ok(Self { vertex_count, indices, parents })
+        Ok(Self { hand, vertex_count, indices, parents })
     }
 }
 
@@ -414,18 +428,33 @@ const BOX_TRIANGLES: [u32; 36] = [
 ];
 
 /// A `scene` message: the object held, the objects' poses and the contacts after the loop's
-/// last step (see the module documentation).
+/// last step (see the module documentation). With two hands, `held` is the first hand's (in
+/// the loop's order) that holds something, `holding` says what each side holds, and each
+/// contact names its hand's side.
 #[must_use]
 pub fn scene_message(manip: &ManipulationLoop) -> String {
     let names = manip.names();
-    let hand = &manip.hands()[0];
-    let joints = hand.rendered().skeleton().joints();
+    let two = manip.hands().len() > 1;
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({ "p": p.to_array(), "q": q.to_array() }))).collect();
-    let contacts: Vec<Value> = hand
-        .contacts()
+    let contacts: Vec<Value> = manip
+        .hands()
         .iter()
+        .flat_map(|hand| {
+            let joints = hand.rendered().skeleton().joints();
+            hand.contacts().iter().map(move |c| {
+                let mut contact = json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() });
+                if two {
+                    contact["hand"] = hand.side().name().into();
+                }
+                contact
+            })
+        })
         .take(MAX_SCENE_CONTACTS)
-        .map(|c| json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() }))
         .collect();
-    json!({ "type": "scene", "held": hand.held().map(|i| &manip.names()[i]), "objects": objects, "contacts": contacts }).to_string()
+    let held = manip.hands().iter().find_map(|h| h.held()).map(|i| &names[i]);
+    let mut message = json!({ "type": "scene", "held": held, "objects": objects, "contacts": contacts });
+    if two {
+        message["holding"] = manip.hands().iter().map(|h| (h.side().name().to_owned(), h.held().map(|i| names[i].clone()).into())).collect::<Map<String, Value>>().into();
+    }
+    message.to_string()
 }

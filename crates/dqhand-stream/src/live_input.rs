@@ -16,6 +16,21 @@
 //! other side, shows it mirrored (x → −x in the world), which a viewer undoes to draw it where
 //! the user's hand is.
 //!
+//! A scene's loop may have two hands ([`ManipulationLoop::two_handed`]): viewers are shown the
+//! right one as their first hand and the left one as their second
+//! ([`Session::follow_second`]). Then the top-level fields are the right hand's, `hands` gives
+//! each hand's side, tracking and gesture (right first), each event names its `hand` (`both`
+//! for a gesture of both hands, [`dqhand::gesture::TwoHandRecognizer`]), and the viewers'
+//! actions and the gestures learned live are the right hand's:
+//!
+//! ```json
+//! {"type": "input", "tracking": "tracking", "gesture": "open_palm", "side": "right", "mirrored": false,
+//!  "hands": [{"side": "right", "tracking": "tracking", "gesture": "open_palm"},
+//!            {"side": "left", "tracking": "tracking", "gesture": "open_palm"}],
+//!  "events": [{"t": 3.5, "event": "start", "gesture": "both_palms_open", "hand": "both"}],
+//!  "actions": [], "accepted": 480, "rejected": 0}
+//! ```
+//!
 //! With a scene, viewers are also sent `scene` messages ([`super::frame::scene_message`]):
 //! at once when the object held changes, otherwise at most every [`SCENE_PERIOD`] while the
 //! scene moves.
@@ -34,7 +49,7 @@ use serde_json::{json, Value};
 
 use crate::frame::{check_scene, scene_hello, scene_message};
 use crate::{Action, Session, ViewerAction};
-use dqhand::gesture::{Event, EventKind, Events, GestureSet, HandFeatures};
+use dqhand::gesture::{Event, EventKind, Events, GestureSet, HandFeatures, TwoHandEvent};
 use dqhand::hand::Side;
 use dqhand::input::{Record, Rejection, Tracking};
 use dqhand::interaction::{CommandTable, GestureLoop, ManipulationLoop};
@@ -69,11 +84,13 @@ struct State {
     actions: Option<CommandTable<ViewerAction>>,
     /// Poses taken or stepped: a viewer whose last one is older follows the new one.
     posed: u64,
-    log: VecDeque<Entry>,
-    /// Entries ever logged: the sequence number of the next one.
-    logged: u64,
+    log: Log,
     /// The names of the gestures recognised, in the set's order.
     gestures: Vec<String>,
+    /// The names of the gestures of both hands recognised (two hands with recognition on).
+    two_hand: Vec<String>,
+    /// The time of the last record taken (two-hand gesture events are logged at it).
+    last_time: f64,
     /// Changes of the gestures recognised so far: a viewer told of fewer is sent a hello.
     gesture_changes: u64,
     /// The hand's features being recorded for learning a gesture ([`LiveInput::capture`]).
@@ -99,39 +116,79 @@ enum Driver {
 /// A scene's loop and what its viewers have been told.
 struct SceneState {
     manip: ManipulationLoop,
+    /// The loop's hand shown first and the one shown second (the right and the left one of
+    /// two; the only one, twice, of one).
+    shown: [usize; 2],
     /// The input's clock at the last step.
     stepped: f64,
     /// Steps that changed what a scene message says.
     version: u64,
-    /// The objects' poses, the contact count and the object held as of `version`.
+    /// The objects' poses, the contact count and each hand's object held as of `version`.
     poses: Vec<(Quat, Vec3)>,
     contacts: usize,
-    held: Option<usize>,
+    held: [Option<usize>; 2],
     /// The scene message of `message.0`, built once for every viewer.
     message: (u64, String),
 }
 
 impl SceneState {
-    /// One step of the loop at `now`, noting whether the scene message changed. Allocates nothing.
-    fn step(&mut self, now: f64) {
-        self.manip.step(now);
+    /// One step of the loop at `now`, noting whether the scene message changed; returns the
+    /// gestures of both hands begun or ended. Allocates nothing.
+    fn step(&mut self, now: f64) -> [Option<TwoHandEvent>; 2] {
+        let events = self.manip.step(now);
         self.stepped = now;
-        let (poses, contacts) = (self.manip.poses(), self.manip.hands()[0].contacts().len());
-        let held = self.manip.hands()[0].held();
+        let hands = self.manip.hands();
+        let (poses, contacts) = (self.manip.poses(), hands.iter().map(|h| h.contacts().len()).sum());
+        let mut held = [None; 2];
+        for (h, hand) in held.iter_mut().zip(hands) {
+            *h = hand.held();
+        }
+        let mut two = events.two_hand();
+        let changed = [two.next(), two.next()];
         if poses != self.poses.as_slice() || contacts + self.contacts > 0 || held != self.held {
             self.poses.copy_from_slice(poses);
             (self.contacts, self.held) = (contacts, held);
             self.version += 1;
         }
+        changed
+    }
+
+    /// Whether the loop has two hands.
+    fn two(&self) -> bool {
+        self.manip.hands().len() > 1
     }
 }
 
 impl Driver {
-    /// The gesture loop (a scene's: the one under its manipulation loop).
-    fn gestures(&self) -> &GestureLoop {
+    /// The gesture loop of the hand shown first, or second (`k` = 1; a loop of one hand: the
+    /// first) (a scene's: the one under its manipulation loop).
+    fn gestures(&self, k: usize) -> &GestureLoop {
         match self {
             Driver::Gestures(g) => g,
-            Driver::Scene(s) => s.manip.hands()[0].input(),
+            Driver::Scene(s) => s.manip.hands()[s.shown[k]].input(),
+        }
+    }
+
+    /// Whether two hands are shown.
+    fn two(&self) -> bool {
+        matches!(self, Driver::Scene(s) if s.two())
+    }
+
+    /// The gesture loops of the hands shown (one or two).
+    fn loops(&self) -> impl Iterator<Item = &GestureLoop> {
+        (0..1 + usize::from(self.two())).map(|k| self.gestures(k))
+    }
+
+    /// Records taken and refused by every hand.
+    fn counts(&self) -> (u64, u64) {
+        self.loops().fold((0, 0), |(a, r), g| (a + g.pipeline().accepted(), r + g.pipeline().rejections().total()))
+    }
+
+    /// The hand shown a record of `side` drives (0 the first, 1 the second).
+    fn shown_of(&self, side: Side) -> usize {
+        match self {
+            Driver::Scene(s) if s.two() => usize::from(s.manip.hand_of(side) == s.shown[1]),
+            _ => 0,
         }
     }
 
@@ -150,20 +207,52 @@ impl Driver {
         Ok(())
     }
 
-    /// The pose viewers show: the tracked one, or with a scene the rendered one.
-    fn pose(&self) -> &Pose {
+    /// The pose viewers show of the hand shown `k`-th: the tracked one, or with a scene the
+    /// rendered one.
+    fn pose(&self, k: usize) -> &Pose {
         match self {
             Driver::Gestures(g) => g.pipeline().pose(),
-            Driver::Scene(s) => s.manip.hands()[0].constraint().rendered(),
+            Driver::Scene(s) => s.manip.hands()[s.shown[k]].constraint().rendered(),
         }
     }
 }
 
 #[derive(Clone, Copy, Debug)]
 enum Entry {
-    Event { t: f64, event: EventKind, gesture: usize },
+    /// A gesture of the hand shown `hand`-th (0 or 1) begun or ended.
+    Event { t: f64, event: EventKind, gesture: usize, hand: usize },
+    /// A gesture of both hands begun or ended.
+    TwoHand { t: f64, event: EventKind, gesture: usize },
     Action { t: f64, gesture: usize, action: Action },
     Scene { t: f64, gesture: usize, command: SceneCommand },
+}
+
+/// The latest entries for the viewers, and how many were ever logged.
+struct Log {
+    entries: VecDeque<Entry>,
+    /// Entries ever logged: the sequence number of the next one.
+    logged: u64,
+}
+
+impl Log {
+    fn add(&mut self, entry: Entry) {
+        if self.entries.len() == LOG_CAPACITY {
+            self.entries.pop_front();
+        }
+        self.entries.push_back(entry);
+        self.logged += 1;
+    }
+
+    /// The gestures of both hands that `step` began or ended, at `t`.
+    fn two_hand(&mut self, t: f64, events: [Option<TwoHandEvent>; 2]) {
+        for e in events.into_iter().flatten() {
+            let (event, gesture) = match e {
+                TwoHandEvent::Start(g) => (EventKind::Start, g),
+                TwoHandEvent::End(g) => (EventKind::End, g),
+            };
+            self.add(Entry::TwoHand { t, event, gesture });
+        }
+    }
 }
 
 /// What one viewer has taken from the input so far.
@@ -177,8 +266,8 @@ pub struct InputView {
     /// The next log entry to read.
     next: u64,
     sent: Option<Sent>,
-    /// The scene version last sent, the object held then, and when (the input's clock).
-    scene: Option<(u64, Option<usize>, f64)>,
+    /// The scene version last sent, the objects held then, and when (the input's clock).
+    scene: Option<(u64, [Option<usize>; 2], f64)>,
 }
 
 /// The state a viewer was last told, and when (the input's clock).
@@ -187,6 +276,8 @@ struct Sent {
     tracking: Tracking,
     side: Option<Side>,
     gesture: Option<usize>,
+    /// The second hand's tracking and gesture, with two hands.
+    second: Option<(Tracking, Option<usize>)>,
     accepted: u64,
     rejected: u64,
     at: f64,
@@ -224,27 +315,32 @@ impl LiveInput {
     pub fn with_scene(manip: ManipulationLoop, source: impl Into<String>, announce: bool) -> Result<Self> {
         check_scene(&manip)?;
         let scene = Some(scene_hello(&manip));
-        let state = SceneState { poses: manip.poses().to_vec(), contacts: 0, held: None, stepped: 0.0, version: 0, message: (u64::MAX, String::new()), manip };
+        let shown = if manip.hands().len() > 1 { [manip.hand_of(Side::Right), manip.hand_of(Side::Left)] } else { [0, 0] };
+        let state = SceneState { poses: manip.poses().to_vec(), contacts: 0, held: [None; 2], stepped: 0.0, version: 0, message: (u64::MAX, String::new()), shown, manip };
         Self::driving(Driver::Scene(Box::new(state)), scene, source.into(), announce)
     }
 
     fn driving(driver: Driver, scene: Option<Value>, source: String, announce: bool) -> Result<Self> {
-        let gesture_loop = driver.gestures();
+        let gesture_loop = driver.gestures(0);
         let gestures = gesture_loop.gestures().map_or_else(Vec::new, names);
+        let two_hand = match &driver {
+            Driver::Scene(s) => s.manip.two_hand_gestures().map_or_else(Vec::new, |r| r.gestures().iter().map(|g| g.name.clone()).collect()),
+            Driver::Gestures(_) => Vec::new(),
+        };
         let actions = match gesture_loop.gestures() {
             Some(set) => Some(CommandTable::new(&ViewerAction::resolve(&gesture_loop.pipeline().config().actions)?, set)?),
             None => None,
         };
         let joint_model = gesture_loop.pipeline().retargeter().rig().model();
-        let log = VecDeque::with_capacity(LOG_CAPACITY);
-        let state = State { driver, actions, posed: 0, log, logged: 0, gestures, gesture_changes: 0, capture: None };
+        let log = Log { entries: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
+        let state = State { driver, actions, posed: 0, log, gestures, two_hand, last_time: 0.0, gesture_changes: 0, capture: None };
         Ok(Self { source, announce, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
     }
 
     /// The gestures recognised now (`None`: recognition is off).
     #[must_use]
     pub fn gesture_set(&self) -> Option<GestureSet> {
-        self.lock().driver.gestures().gestures().cloned()
+        self.lock().driver.gestures(0).gestures().cloned()
     }
 
     /// Recognises `set` from now on (a gesture learned live): the viewers' actions and a
@@ -262,7 +358,7 @@ impl LiveInput {
         state.actions = actions;
         state.gestures = gestures;
         state.gesture_changes += 1;
-        state.log.clear();
+        state.log.entries.clear();
         Ok(())
     }
 
@@ -319,10 +415,15 @@ impl LiveInput {
 
     fn active(&self) -> bool {
         self.announce || {
-            let state = self.lock();
-            let pipeline = state.driver.gestures().pipeline();
-            pipeline.accepted() + pipeline.rejections().total() > 0
+            let (accepted, rejected) = self.lock().driver.counts();
+            accepted + rejected > 0
         }
+    }
+
+    /// Whether the input drives two hands (viewers then show a second one).
+    #[must_use]
+    pub fn two_hands(&self) -> bool {
+        self.lock().driver.two()
     }
 
     /// Takes one record arriving now (and steps a scene's loop); `taken` sees it, its
@@ -337,32 +438,30 @@ impl LiveInput {
         // Read under the lock, so that the records taken have increasing arrival times.
         let arrival = self.clock();
         let record = &Record { arrival: Some(arrival), ..*record };
-        let State { driver, actions, posed, log, logged, capture, .. } = &mut *guard;
-        let mut add = |entry| {
-            if log.len() == LOG_CAPACITY {
-                log.pop_front();
-            }
-            log.push_back(entry);
-            *logged += 1;
-        };
+        let State { driver, actions, posed, log, capture, last_time, .. } = &mut *guard;
+        let hand = driver.shown_of(record.side);
         let events = driver.push(record)?;
         for e in events.clone() {
-            add(Entry::Event { t: e.t, event: e.event, gesture: e.index });
+            log.add(Entry::Event { t: e.t, event: e.event, gesture: e.index, hand });
         }
-        let action = actions.as_mut().and_then(|table| table.update(record.time, events));
+        // The viewers' actions and a capture for learning are the first hand's.
+        let action = actions.as_mut().filter(|_| hand == 0).and_then(|table| table.update(record.time, events));
         taken(record);
         *posed += 1;
-        if let Some(c) = capture.as_mut().filter(|c| arrival <= c.until && c.frames.len() < c.frames.capacity()) {
-            c.frames.push((record.time, driver.gestures().features()));
+        *last_time = record.time;
+        if let Some(c) = capture.as_mut().filter(|c| hand == 0 && arrival <= c.until && c.frames.len() < c.frames.capacity()) {
+            c.frames.push((record.time, driver.gestures(0).features()));
         }
-        if let (Some(action), Some(gesture)) = (action, driver.gestures().gesture_index()) {
-            add(Entry::Action { t: record.time, gesture, action });
+        if let (Some(action), Some(gesture)) = (action, driver.gestures(0).gesture_index()) {
+            log.add(Entry::Action { t: record.time, gesture, action });
         }
         if let Driver::Scene(s) = driver {
-            if let (Some(command), Some(gesture)) = (s.manip.command(), s.manip.hands()[0].input().gesture_index()) {
-                add(Entry::Scene { t: record.time, gesture, command });
+            let pushed = s.manip.hands()[s.manip.hand_of(record.side)].input();
+            if let (Some(command), Some(gesture)) = (s.manip.command(), pushed.gesture_index()) {
+                log.add(Entry::Scene { t: record.time, gesture, command });
             }
-            s.step(arrival);
+            let two_hand = s.step(arrival);
+            log.two_hand(record.time, two_hand);
         }
         Ok(())
     }
@@ -387,8 +486,8 @@ impl LiveInput {
     #[must_use]
     pub fn summary(&self) -> (u64, u64, Vec<String>) {
         let state = self.lock();
-        let pipeline = state.driver.gestures().pipeline();
-        (pipeline.accepted(), pipeline.rejections().total(), pipeline.rejections().summary().collect())
+        let (accepted, rejected) = state.driver.counts();
+        (accepted, rejected, state.driver.loops().flat_map(|g| g.pipeline().rejections().summary()).collect())
     }
 
     /// A viewer's view of the input, from now on (earlier events are not replayed to it).
@@ -396,7 +495,7 @@ impl LiveInput {
     pub fn view(&self) -> InputView {
         let announced = self.active();
         let state = self.lock();
-        InputView { announced, gesture_changes: state.gesture_changes, version: 0, next: state.logged, sent: None, scene: None }
+        InputView { announced, gesture_changes: state.gesture_changes, version: 0, next: state.log.logged, sent: None, scene: None }
     }
 
     /// Brings one viewer up to date, once per frame: marks the hand lost after the grace
@@ -413,14 +512,16 @@ impl LiveInput {
                 }
             }
             Driver::Scene(s) if arrival - s.stepped >= STEP_PERIOD => {
-                s.step(arrival);
+                let two_hand = s.step(arrival);
+                state.log.two_hand(state.last_time, two_hand);
                 state.posed += 1;
             }
             Driver::Scene(_) => {}
         }
-        let gesture_loop = state.driver.gestures();
+        let gesture_loop = state.driver.gestures(0);
         let pipeline = gesture_loop.pipeline();
-        let (accepted, rejected) = (pipeline.accepted(), pipeline.rejections().total());
+        let (accepted, rejected) = state.driver.counts();
+        let two = state.driver.two();
         let mut update = InputUpdate::default();
         if !view.announced {
             if accepted + rejected == 0 {
@@ -434,15 +535,26 @@ impl LiveInput {
             update.hello = true;
         }
         if state.posed != view.version {
-            session.follow(state.driver.pose(), self.joint_model);
+            session.follow(state.driver.pose(0), self.joint_model);
+            if two {
+                session.follow_second(state.driver.pose(1), self.joint_model);
+            }
             view.version = state.posed;
         }
-        let first = state.logged - state.log.len() as u64;
-        let new = state.log.iter().skip(view.next.saturating_sub(first) as usize);
+        let first = state.log.logged - state.log.entries.len() as u64;
+        let new = state.log.entries.iter().skip(view.next.saturating_sub(first) as usize);
         let (mut events, mut actions) = (Vec::new(), Vec::new());
+        let side = |k: usize| state.driver.gestures(k).pipeline().retargeter().side().name();
         for entry in new {
             match *entry {
-                Entry::Event { t, event, gesture } => events.push(json!(Event { t, event, gesture: &state.gestures[gesture], index: gesture })),
+                Entry::Event { t, event, gesture, hand } => {
+                    let mut e = json!(Event { t, event, gesture: &state.gestures[gesture], index: gesture });
+                    if two {
+                        e["hand"] = side(hand).into();
+                    }
+                    events.push(e);
+                }
+                Entry::TwoHand { t, event, gesture } => events.push(json!({ "t": t, "event": event, "gesture": state.two_hand[gesture], "index": gesture, "hand": "both" })),
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
                     actions.push(json!({ "t": t, "gesture": state.gestures[gesture], "action": action }));
@@ -450,33 +562,39 @@ impl LiveInput {
                 Entry::Scene { t, gesture, command } => actions.push(json!({ "t": t, "gesture": state.gestures[gesture], "action": command })),
             }
         }
-        view.next = state.logged;
+        view.next = state.log.logged;
         let gesture = gesture_loop.gesture_index();
-        let sent = Sent { tracking: pipeline.tracking(), side: pipeline.side(), gesture, accepted, rejected, at: arrival };
+        let second = two.then(|| state.driver.gestures(1)).map(|g| (g.pipeline().tracking(), g.gesture_index()));
+        let sent = Sent { tracking: pipeline.tracking(), side: pipeline.side(), gesture, second, accepted, rejected, at: arrival };
         let due = match view.sent {
             None => true,
             Some(last) => {
                 last.tracking != sent.tracking
                     || last.side != sent.side
                     || last.gesture != sent.gesture
+                    || last.second != sent.second
                     || (last.accepted, last.rejected) != (accepted, rejected) && arrival - last.at >= COUNTER_PERIOD.as_secs_f64()
             }
         };
         if due || !events.is_empty() || !actions.is_empty() {
-            update.message = Some(
-                json!({
-                    "type": "input",
-                    "tracking": sent.tracking.as_str(),
-                    "gesture": gesture.map(|g| &state.gestures[g]),
-                    "side": sent.side.map(Side::name),
-                    "mirrored": sent.side.is_some_and(|s| s != pipeline.retargeter().side()),
-                    "events": events,
-                    "actions": actions,
-                    "accepted": accepted,
-                    "rejected": rejected,
-                })
-                .to_string(),
-            );
+            let mut message = json!({
+                "type": "input",
+                "tracking": sent.tracking.as_str(),
+                "gesture": gesture.map(|g| &state.gestures[g]),
+                "side": sent.side.map(Side::name),
+                "mirrored": sent.side.is_some_and(|s| s != pipeline.retargeter().side()),
+                "events": events,
+                "actions": actions,
+                "accepted": accepted,
+                "rejected": rejected,
+            });
+            if let Some((tracking, gesture)) = sent.second {
+                message["hands"] = json!([
+                    { "side": side(0), "tracking": sent.tracking.as_str(), "gesture": sent.gesture.map(|g| &state.gestures[g]) },
+                    { "side": side(1), "tracking": tracking.as_str(), "gesture": gesture.map(|g| &state.gestures[g]) },
+                ]);
+            }
+            update.message = Some(message.to_string());
             view.sent = Some(sent);
         }
         if let Driver::Scene(s) = &mut state.driver {

@@ -14,6 +14,7 @@ use crate::frame::{FrameHeader, FrameWriter, Topology, STATE_LIMITS, STATE_PLAYI
 use crate::{Action, Command, LearnRequest, LiveInput};
 use dqhand::engine::Engine;
 use dqhand::gesture::{gesture, Sequence, GESTURES};
+use dqhand::hand::Side;
 use dqhand::kinematics::{HandRig, JointModel, Limits, Pose};
 use dqhand::math::DualQuat;
 use dqhand::metrics::VertexDistortion;
@@ -38,17 +39,16 @@ pub enum Applied {
 }
 
 /// The state of one connected viewer: the pose source (edits, the timeline, a move to a
-/// gesture) of its own [`Engine`], and the view.
+/// gesture) of its own [`Engine`], and the view; with a live input of two hands, the second
+/// hand too, which follows that input only.
 pub struct Session {
-    engine: Engine,
+    hand: ShownHand,
     pose: Pose,
+    /// The second hand, its side and its pose (the live input's other hand).
+    second: Option<(ShownHand, Side, Pose)>,
     /// The wrist set by the user, kept over sequence playback (which leaves the wrist alone).
     wrist: Option<DualQuat>,
     heatmap: bool,
-    /// One distortion buffer per method, in [`Method::ALL`] order.
-    distortion: [Vec<f32>; 3],
-    vertex_distortion: VertexDistortion,
-    joints: Vec<[f32; 3]>,
     timeline: Sequence,
     time: f32,
     playing: bool,
@@ -56,31 +56,91 @@ pub struct Session {
     sequence: u32,
 }
 
-impl Session {
-    /// A session on `model` with the `joint_model`'s DOFs, showing DQB and playing the
-    /// bundled gesture sequence.
-    ///
-    /// # Errors
-    /// As [`Engine::new`]: [`dqhand::Error::MissingJoint`] if the model's skeleton lacks
-    /// the WebXR hand joints, [`dqhand::Error::JointFrame`] if its joint frames are not WebXR's.
-    pub fn new(model: Arc<Model>, joint_model: JointModel) -> Result<Self> {
+/// One hand drawn by a viewer: its engine and the buffers its frames are written from.
+struct ShownHand {
+    engine: Engine,
+    /// One distortion buffer per method, in [`Method::ALL`] order.
+    distortion: [Vec<f32>; 3],
+    vertex_distortion: VertexDistortion,
+    joints: Vec<[f32; 3]>,
+}
+
+impl ShownHand {
+    fn new(model: Arc<Model>, joint_model: JointModel) -> Result<Self> {
         let mesh = &model.mesh;
         let n = mesh.vertex_count();
         let vertex_distortion = VertexDistortion::new(&mesh.positions(), mesh.indices());
         let engine = Engine::new(model, joint_model)?;
+        let joints = vec![[0.0; 3]; engine.kinematics().skeleton().len()];
+        Ok(Self { engine, distortion: Method::ALL.map(|_| vec![0.0; n]), vertex_distortion, joints })
+    }
+
+    fn topology(&self, hand: u16) -> Topology {
+        Topology {
+            hand,
+            vertex_count: self.engine.model().mesh.vertex_count() as u32,
+            indices: self.engine.model().mesh.indices().to_vec(),
+            parents: self.engine.kinematics().skeleton().joints().iter().map(|j| j.parent).collect(),
+        }
+    }
+
+    /// Poses and skins `pose` with the methods in view (and their distortion with the heat
+    /// map on) and writes its frame, on `header`'s scalars, into `out`. Allocates nothing once
+    /// `out` has held a frame.
+    fn render(&mut self, pose: &Pose, mut header: FrameHeader, out: &mut Vec<u8>) {
+        let start = Instant::now();
+        self.engine.step(pose);
+        let methods = self.engine.skin().methods();
+        if header.distortion {
+            for &m in methods.as_slice() {
+                self.vertex_distortion.compute(self.engine.deformed(m).expect("the methods in view are skinned").positions(), &mut self.distortion[m.index()]);
+            }
+        }
+        for (j, w) in self.joints.iter_mut().zip(self.engine.kinematics().world()) {
+            *j = w.translation.into();
+        }
+        let (rotation, translation) = pose.wrist.unwrap_or(self.engine.kinematics().rig().rest_wrist()).to_rotation_translation();
+        header.wrist[..3].copy_from_slice(&translation.to_array());
+        header.wrist[3..].copy_from_slice(&rotation.to_array());
+        header.engine_us = start.elapsed().as_secs_f32() * 1e6;
+        header.vertex_count = self.engine.model().mesh.vertex_count() as u32;
+        header.joint_count = self.joints.len() as u32;
+        header.dof_count = pose.angles.len() as u32;
+        header.methods = methods;
+        let mut w = FrameWriter::begin(out, header);
+        w.floats(&pose.angles).floats(self.joints.as_flattened());
+        for &m in methods.as_slice() {
+            let deformed = self.engine.deformed(m).expect("the methods in view are skinned");
+            w.floats(deformed.positions().as_flattened()).floats(deformed.normals().as_flattened());
+            if header.distortion {
+                w.floats(&self.distortion[m.index()]);
+            }
+        }
+        w.finish();
+    }
+}
+
+impl Session {
+    /// A session on `model` with the `joint_model`'s DOFs, showing DQB and playing the
+    /// bundled gesture sequence; with `second`, a second hand (of the other side) that
+    /// follows the live input ([`Self::follow_second`]).
+    ///
+    /// # Errors
+    /// As [`Engine::new`]: [`dqhand::Error::MissingJoint`] if a model's skeleton lacks
+    /// the WebXR hand joints, [`dqhand::Error::JointFrame`] if its joint frames are not WebXR's.
+    pub fn new(model: Arc<Model>, second: Option<(Arc<Model>, Side)>, joint_model: JointModel) -> Result<Self> {
+        let second = second.map(|(m, side)| ShownHand::new(m, joint_model).map(|h| (h, side, Pose::rest(joint_model.dof_count())))).transpose()?;
         Ok(Self {
+            hand: ShownHand::new(model, joint_model)?,
             pose: Pose::rest(joint_model.dof_count()),
+            second,
             wrist: None,
             heatmap: false,
-            distortion: Method::ALL.map(|_| vec![0.0; n]),
-            vertex_distortion,
-            joints: vec![[0.0; 3]; engine.kinematics().skeleton().len()],
             timeline: Sequence::gestures(joint_model),
             time: 0.0,
             playing: true,
             transition: None,
             sequence: 0,
-            engine,
         })
     }
 
@@ -89,7 +149,7 @@ impl Session {
     #[must_use]
     pub fn hello(&self, max_message_bytes: usize, input: Option<&LiveInput>) -> String {
         let model = self.joint_model();
-        let (description, mesh) = (&self.engine.model().description, &self.engine.model().mesh);
+        let (description, mesh) = (&self.hand.engine.model().description, &self.hand.engine.model().mesh);
         let dofs: Vec<_> = model
             .dofs()
             .map(|d| json!({ "name": d.name(), "joint": d.joint, "min_deg": d.min_deg, "max_deg": d.max_deg }))
@@ -100,7 +160,11 @@ impl Session {
             "description": description,
             "vertices": mesh.vertex_count(),
             "triangles": mesh.triangle_count(),
-            "joints": self.engine.kinematics().skeleton().names().collect::<Vec<_>>(),
+            "joints": self.hand.engine.kinematics().skeleton().names().collect::<Vec<_>>(),
+            "second_hand": self.second.as_ref().map(|(h, side, _)| {
+                let model = h.engine.model();
+                json!({ "side": side.name(), "description": model.description, "vertices": model.mesh.vertex_count(), "triangles": model.mesh.triangle_count() })
+            }),
             "joint_model": model.as_str(),
             "joint_models": JointModel::ALL.map(JointModel::as_str),
             "dofs": dofs,
@@ -115,14 +179,11 @@ impl Session {
         .to_string()
     }
 
-    /// The mesh and skeleton structure, sent once after the first hello.
+    /// The mesh and skeleton structure of each hand (the second hand's after the first's),
+    /// sent once after the first hello.
     #[must_use]
-    pub fn topology(&self) -> Topology {
-        Topology {
-            vertex_count: self.engine.model().mesh.vertex_count() as u32,
-            indices: self.engine.model().mesh.indices().to_vec(),
-            parents: self.engine.kinematics().skeleton().joints().iter().map(|j| j.parent).collect(),
-        }
+    pub fn topologies(&self) -> Vec<Topology> {
+        std::iter::once(self.hand.topology(0)).chain(self.second.as_ref().map(|(h, _, _)| h.topology(1))).collect()
     }
 
     /// The pose shown now.
@@ -138,7 +199,17 @@ impl Session {
     }
 
     fn rig(&self) -> &HandRig {
-        self.engine.kinematics().rig()
+        self.hand.engine.kinematics().rig()
+    }
+
+    /// Each hand's engine: the first, then the second if any.
+    fn engines(&mut self) -> impl Iterator<Item = &mut Engine> {
+        std::iter::once(&mut self.hand.engine).chain(self.second.as_mut().map(|(h, _, _)| &mut h.engine))
+    }
+
+    /// Shows `methods` on every hand.
+    fn set_methods(&mut self, methods: MethodSet) {
+        self.engines().for_each(|e| e.set_methods(methods));
     }
 
     /// What a pose without a wrist stands for.
@@ -160,7 +231,7 @@ impl Session {
                     dqhand::Error::Methods(why) => Error::Command(format!("view: {why}")),
                     other => other.into(),
                 })?;
-                self.engine.set_methods(set);
+                self.set_methods(set);
             }
             Command::JointModel { name } => {
                 let model: JointModel = name.parse()?;
@@ -172,7 +243,7 @@ impl Session {
             Command::Angle { dof, deg } => {
                 let i = self.joint_model().dof_index(dof)?;
                 let d = self.joint_model().dofs().nth(i).expect("index from the model");
-                let (lo, hi) = match self.engine.kinematics().limits() {
+                let (lo, hi) = match self.hand.engine.kinematics().limits() {
                     Limits::Anatomical => (d.min_deg, d.max_deg),
                     Limits::Off => (-180.0, 180.0),
                 };
@@ -216,7 +287,10 @@ impl Session {
                 self.sample_timeline();
             }
             Command::Heatmap { on } => self.heatmap = *on,
-            Command::Limits { on } => self.engine.kinematics_mut().set_limits(if *on { Limits::Anatomical } else { Limits::Off }),
+            Command::Limits { on } => {
+                let limits = if *on { Limits::Anatomical } else { Limits::Off };
+                self.engines().for_each(|e| e.kinematics_mut().set_limits(limits));
+            }
             Command::Rest {} => {
                 self.stop();
                 self.wrist = None;
@@ -237,17 +311,26 @@ impl Session {
         self.pose.wrist = pose.wrist;
     }
 
+    /// Shows `pose` (of `model`) on the second hand, if the session has one. Allocates nothing.
+    pub fn follow_second(&mut self, pose: &Pose, model: JointModel) {
+        let to = self.joint_model();
+        if let Some((_, _, shown)) = &mut self.second {
+            model.carry_angles(&pose.angles, to, &mut shown.angles);
+            shown.wrist = pose.wrist;
+        }
+    }
+
     /// Applies a gesture command to the view: `next_method` shows the method after the first
     /// one in view alone, `split_view` shows LB, QB and DQB side by side, `toggle_heatmap`
     /// turns the distortion heat map on or off.
     pub fn act(&mut self, action: Action) {
         match action {
             Action::NextMethod => {
-                let first = self.engine.skin().methods().as_slice()[0];
+                let first = self.methods().as_slice()[0];
                 let next = Method::ALL[(first.index() + 1) % Method::ALL.len()];
-                self.engine.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
+                self.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
             }
-            Action::SplitView => self.engine.set_methods(MethodSet::ALL),
+            Action::SplitView => self.set_methods(MethodSet::ALL),
             Action::ToggleHeatmap => self.heatmap = !self.heatmap,
         }
     }
@@ -261,7 +344,7 @@ impl Session {
     /// The methods in view.
     #[must_use]
     pub fn methods(&self) -> MethodSet {
-        self.engine.skin().methods()
+        self.hand.engine.skin().methods()
     }
 
     fn stop(&mut self) {
@@ -271,7 +354,15 @@ impl Session {
 
     fn set_joint_model(&mut self, model: JointModel) -> Result<()> {
         let old = self.joint_model();
-        self.engine.set_joint_model(model)?;
+        for engine in self.engines() {
+            engine.set_joint_model(model)?;
+        }
+        if let Some((_, _, second)) = &mut self.second {
+            let mut pose = Pose::rest(model.dof_count());
+            old.carry_angles(&second.angles, model, &mut pose.angles);
+            pose.wrist = second.wrist;
+            *second = pose;
+        }
         let mut pose = Pose::rest(model.dof_count());
         old.carry_angles(&self.pose.angles, model, &mut pose.angles);
         pose.wrist = self.wrist;
@@ -308,47 +399,33 @@ impl Session {
     ///
     /// * `engine_fps` — the rate the transport is achieving, reported to the page.
     pub fn render(&mut self, engine_fps: f32, out: &mut Vec<u8>) {
-        let start = Instant::now();
-        self.engine.step(&self.pose);
-        let methods = self.engine.skin().methods();
-        if self.heatmap {
-            for &m in methods.as_slice() {
-                self.vertex_distortion.compute(self.engine.deformed(m).expect("the methods in view are skinned").positions(), &mut self.distortion[m.index()]);
-            }
-        }
-        for (j, w) in self.joints.iter_mut().zip(self.engine.kinematics().world()) {
-            *j = w.translation.into();
-        }
-        let engine_us = start.elapsed().as_secs_f32() * 1e6;
-        let (rotation, translation) = self.pose.wrist.unwrap_or(self.rest_wrist()).to_rotation_translation();
-        let mut wrist = [0.0; 7];
-        wrist[..3].copy_from_slice(&translation.to_array());
-        wrist[3..].copy_from_slice(&rotation.to_array());
-        let header = FrameHeader {
-            sequence: self.sequence,
-            vertex_count: self.engine.model().mesh.vertex_count() as u32,
-            joint_count: self.joints.len() as u32,
-            dof_count: self.pose.angles.len() as u32,
-            methods,
+        let header = self.header(engine_fps);
+        self.hand.render(&self.pose, header, out);
+    }
+
+    /// As [`Self::render`], the second hand's frame, if the session has a second hand
+    /// (`false`: none, `out` untouched).
+    pub fn render_second(&mut self, engine_fps: f32, out: &mut Vec<u8>) -> bool {
+        // No second hand takes no sequence number: the transport counts the frames it sends.
+        let Some(header) = self.second.is_some().then(|| FrameHeader { second: true, ..self.header(engine_fps) }) else { return false };
+        let (hand, _, pose) = self.second.as_mut().expect("checked above");
+        hand.render(pose, header, out);
+        true
+    }
+
+    /// The scalars of the next frame (its sequence number taken).
+    fn header(&mut self, engine_fps: f32) -> FrameHeader {
+        let sequence = self.sequence;
+        self.sequence = self.sequence.wrapping_add(1);
+        FrameHeader {
+            sequence,
             distortion: self.heatmap,
-            engine_us,
             engine_fps,
             time: self.time,
             duration: self.timeline.duration(),
-            state: if self.playing { STATE_PLAYING } else { 0 } | if self.engine.kinematics().limits() == Limits::Anatomical { STATE_LIMITS } else { 0 },
-            wrist,
-        };
-        self.sequence = self.sequence.wrapping_add(1);
-        let mut w = FrameWriter::begin(out, header);
-        w.floats(&self.pose.angles).floats(self.joints.as_flattened());
-        for &m in methods.as_slice() {
-            let deformed = self.engine.deformed(m).expect("the methods in view are skinned");
-            w.floats(deformed.positions().as_flattened()).floats(deformed.normals().as_flattened());
-            if self.heatmap {
-                w.floats(&self.distortion[m.index()]);
-            }
+            state: if self.playing { STATE_PLAYING } else { 0 } | if self.hand.engine.kinematics().limits() == Limits::Anatomical { STATE_LIMITS } else { 0 },
+            ..FrameHeader::default()
         }
-        w.finish();
     }
 }
 

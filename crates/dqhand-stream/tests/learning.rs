@@ -17,7 +17,7 @@ use dqhand_stream::{Applied, Command, LearnRequest, LiveInput, Session};
 
 #[test]
 fn learn_commands_are_checked() {
-    let mut s = Session::new(Arc::new(build(&HandParams { vertices: 1000, ..HandParams::default() }).unwrap()), JointModel::Full).unwrap();
+    let mut s = Session::new(Arc::new(build(&HandParams { vertices: 1000, ..HandParams::default() }).unwrap()), None, JointModel::Full).unwrap();
     let mut applied = |json: &str| Command::parse(json).and_then(|c| s.apply(&c).map_err(|e| e.to_string()));
     assert_eq!(applied(r#"{"type":"learn","name":"finger-gun_2"}"#).unwrap(), Applied::Learn(LearnRequest { name: "finger-gun_2".into(), seconds: 4.0, not: false }));
     assert_eq!(applied(r#"{"type":"learn","name":"gun","seconds":2.5,"not":true}"#).unwrap(), Applied::Learn(LearnRequest { name: "gun".into(), seconds: 2.5, not: true }));
@@ -81,7 +81,7 @@ fn a_capture_records_the_hand_features_and_a_new_set_is_taken_mid_input() {
     let examples: Vec<Example> = frames.iter().map(|(_, f)| Example { features: *f, class: 1 }).chain(others).collect();
     let classifier = train(vec!["other".into(), "mine".into()], shape_features(), &examples, &TrainingParams { epochs: 1, hidden: 4, ..TrainingParams::default() }).unwrap();
     set.insert_learned("mine", classifier).unwrap();
-    let mut session = Session::new(model.clone(), JointModel::Full).unwrap();
+    let mut session = Session::new(model.clone(), None, JointModel::Full).unwrap();
     let mut view = input.view();
     assert!(!input.update(&mut session, &mut view).hello);
     input.set_gestures(set.clone()).unwrap();

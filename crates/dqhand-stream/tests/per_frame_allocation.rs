@@ -25,7 +25,7 @@ use allocations::allocations;
 #[test]
 fn a_viewer_session_frame_allocates_nothing() {
     let model = Arc::new(build(&HandParams { vertices: 2000, ..HandParams::default() }).unwrap());
-    let mut session = Session::new(model, JointModel::Full).unwrap();
+    let mut session = Session::new(model, None, JointModel::Full).unwrap();
     for c in [r#"{"type":"view","methods":["lb","qb","dqb"]}"#, r#"{"type":"heatmap","on":true}"#] {
         session.apply(&Command::parse(c).unwrap()).unwrap();
     }
@@ -47,6 +47,24 @@ fn a_viewer_session_frame_allocates_nothing() {
 }
 
 #[test]
+fn a_two_hand_session_frame_allocates_nothing() {
+    let model = |side| Arc::new(build(&HandParams { vertices: 2000, side, ..HandParams::default() }).unwrap());
+    let mut session = Session::new(model(Side::Right), Some((model(Side::Left), Side::Left)), JointModel::Full).unwrap();
+    session.apply(&Command::parse(r#"{"type":"heatmap","on":true}"#).unwrap()).unwrap();
+    let (mut first, mut second) = (Vec::new(), Vec::new());
+    let pose = dqhand::kinematics::Pose::rest(JointModel::Full.dof_count());
+    session.render(120.0, &mut first);
+    assert!(session.render_second(120.0, &mut second));
+    let before = allocations();
+    for _ in 0..30 {
+        session.follow_second(&pose, JointModel::Full);
+        session.render(120.0, &mut first);
+        session.render_second(120.0, &mut second);
+    }
+    assert_eq!(allocations() - before, 0, "allocations during 30 frames of two hands");
+}
+
+#[test]
 fn a_live_record_and_a_viewer_update_without_news_allocate_nothing() {
     let model = Arc::new(build(&HandParams { vertices: 2000, ..HandParams::default() }).unwrap());
     let synthetic = generate(&SyntheticParams { seed: 9, holds: 4, idle_s: 1.0, ..SyntheticParams::default() }).unwrap();
@@ -54,7 +72,7 @@ fn a_live_record_and_a_viewer_update_without_news_allocate_nothing() {
     let config = InputConfig { grace_s: 1e6, ..InputConfig::default() };
     let gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, None, config, Some(GestureSet::builtin())).unwrap();
     let input = LiveInput::new(gesture_loop, "test", true).unwrap();
-    let mut session = Session::new(model, JointModel::Full).unwrap();
+    let mut session = Session::new(model, None, JointModel::Full).unwrap();
     let mut view = input.view();
     let taken = push_live(&input, &synthetic.records);
     assert!(taken > 300, "{taken} records taken");

@@ -46,6 +46,7 @@ fn sample_frame() -> (FrameHeader, Vec<u8>) {
         dof_count: 3,
         methods: MethodSet::new(&[Method::Lb, Method::Dqb]).unwrap(),
         distortion: true,
+        second: false,
         engine_us: 123.5,
         engine_fps: 120.0,
         time: 1.25,
@@ -82,10 +83,15 @@ fn frame_format_matches_the_golden_vector_and_reads_back() {
 
 #[test]
 fn topology_format_matches_the_golden_vector_and_reads_back() {
-    let topology = Topology { vertex_count: 4, indices: vec![0, 1, 2, 2, 1, 3], parents: vec![None, Some(0), Some(1)] };
+    let topology = Topology { hand: 0, vertex_count: 4, indices: vec![0, 1, 2, 2, 1, 3], parents: vec![None, Some(0), Some(1)] };
     let bytes = topology.encode();
     golden("topology-v1.bin", &bytes);
     assert_eq!(Topology::parse(&bytes).unwrap(), topology);
+    // The second hand's says so; there is no third.
+    let second = Topology { hand: 1, ..topology.clone() };
+    assert_eq!(Topology::parse(&second.encode()).unwrap(), second);
+    let third = Topology { hand: 2, ..topology }.encode();
+    assert!(Topology::parse(&third).unwrap_err().to_string().contains("unknown to version 1"));
 }
 
 #[test]
@@ -123,9 +129,9 @@ fn malformed_messages_are_refused_with_the_reason() {
     gap[25] = 255;
     refuse(&gap, "method code 255");
 
-    let topology = Topology { vertex_count: 2, indices: vec![0, 1, 2], parents: vec![None] }.encode();
+    let topology = Topology { hand: 0, vertex_count: 2, indices: vec![0, 1, 2], parents: vec![None] }.encode();
     assert!(Topology::parse(&topology).unwrap_err().to_string().contains("index 2 with 2 vertices"));
-    let own_parent = Topology { vertex_count: 3, indices: vec![0, 1, 2], parents: vec![Some(0)] }.encode();
+    let own_parent = Topology { hand: 0, vertex_count: 3, indices: vec![0, 1, 2], parents: vec![Some(0)] }.encode();
     assert!(Topology::parse(&own_parent).unwrap_err().to_string().contains("parent 0"));
     assert!(Topology::parse(&frame).unwrap_err().to_string().contains("wrong magic"));
 }
@@ -134,11 +140,11 @@ proptest! {
     #[test]
     fn frames_round_trip(
         vertices in 0u32..20, joints in 0u32..5, dofs in 0u32..6, meshes in 1usize..=3,
-        distortion: bool, sequence: u32, time in 0f32..100.0, seed in 0u32..1000,
+        distortion: bool, second: bool, sequence: u32, time in 0f32..100.0, seed in 0u32..1000,
     ) {
         let order: Vec<Method> = (0..meshes).map(|i| Method::ALL[(i + seed as usize) % 3]).collect();
         let methods = MethodSet::new(&order).unwrap();
-        let header = FrameHeader { sequence, vertex_count: vertices, joint_count: joints, dof_count: dofs, methods, distortion, time, ..FrameHeader::default() };
+        let header = FrameHeader { sequence, vertex_count: vertices, joint_count: joints, dof_count: dofs, methods, distortion, second, time, ..FrameHeader::default() };
         let values: Vec<f32> = (0..(header.byte_len() - 76) / 4).map(|i| (i as f32 + seed as f32) * 0.5).collect();
         let mut out = Vec::new();
         let mut w = FrameWriter::begin(&mut out, header);
@@ -166,7 +172,7 @@ fn frame(session: &mut Session) -> FrameView {
 }
 
 fn paused() -> Session {
-    let mut s = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let mut s = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     s.apply(&Command::Pause {}).unwrap();
     s.apply(&Command::Rest {}).unwrap();
     s
@@ -266,7 +272,7 @@ fn a_gesture_is_reached_smoothly() {
 
 #[test]
 fn the_timeline_plays_loops_and_seeks() {
-    let mut s = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let mut s = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     let tour = Sequence::gestures(JointModel::Full);
     assert_eq!(tour.duration(), GESTURES.len() as f32 * 1.5);
     s.advance(2.0);
@@ -319,7 +325,7 @@ fn switching_the_joint_model_keeps_the_shared_angles() {
 
 #[test]
 fn hello_describes_the_model_and_its_controls() {
-    let s = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let s = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     let hello: serde_json::Value = serde_json::from_str(&s.hello(4096, None)).unwrap();
     assert_eq!(hello["type"], "hello");
     assert_eq!(hello["vertices"], 3000);
@@ -330,7 +336,7 @@ fn hello_describes_the_model_and_its_controls() {
     assert_eq!((pip["min_deg"].as_f64(), pip["max_deg"].as_f64()), (Some(0.0), Some(110.0)));
     assert_eq!(hello["gestures"].as_array().unwrap().len(), GESTURES.len());
     assert_eq!(hello["methods"], serde_json::json!(["lb", "qb", "dqb"]));
-    let topology = Topology::parse(&s.topology().encode()).unwrap();
+    let topology = Topology::parse(&s.topologies()[0].encode()).unwrap();
     assert_eq!(topology.indices.len(), 3 * HAND.mesh.triangle_count());
     assert_eq!(topology.parents.iter().filter(|p| p.is_none()).count(), 1);
 }
@@ -387,7 +393,7 @@ fn vertex_distortion_is_the_mean_change_of_the_edges_at_each_vertex() {
 /// have take the input's angles, by name, and its wrist; the timeline stops.
 #[test]
 fn following_an_input_of_another_joint_model_takes_the_shared_angles() {
-    let mut s = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let mut s = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     s.apply(&command(r#"{"type":"joint_model","name":"paper"}"#)).unwrap();
     let mut input = Pose::rest(JointModel::Full.dof_count());
     for (k, a) in input.angles.iter_mut().enumerate() {

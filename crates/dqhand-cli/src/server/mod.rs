@@ -15,6 +15,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use dqhand::kinematics::JointModel;
+use dqhand::hand::Side;
 use dqhand::model::Model;
 
 use crate::feed::Feed;
@@ -33,6 +34,9 @@ const HEAD_DEADLINE: Duration = Duration::from_secs(5);
 pub struct Shared {
     /// The skinned hand every viewer poses (read-only; each viewer has its own pose).
     pub model: Arc<Model>,
+    /// The second hand and its side, when the live input drives two (`demo --hands 2`):
+    /// every viewer shows it following the input's other hand.
+    pub second: Option<(Arc<Model>, Side)>,
     /// The joint model a new viewer starts with.
     pub joint_model: JointModel,
     /// The built page (`viewer/dist`), canonical; `None` serves the stream only.

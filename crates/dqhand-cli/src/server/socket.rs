@@ -41,14 +41,16 @@ pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> 
 /// Completes the handshake and streams until the client leaves.
 pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -> std::io::Result<()> {
     let mut ws = upgrade(stream, request, accept)?;
-    let mut session = match Session::new(shared.model.clone(), shared.joint_model) {
+    let mut session = match Session::new(shared.model.clone(), shared.second.clone(), shared.joint_model) {
         Ok(s) => s,
         Err(e) => return send_error(&mut ws, &e.to_string()).map_err(io),
     };
     let input = shared.feed.as_deref().map(|f| &f.input);
     let mut view = input.map(LiveInput::view);
     ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?;
-    ws.send(Message::binary(session.topology().encode())).map_err(io)?;
+    for topology in session.topologies() {
+        ws.send(Message::binary(topology.encode())).map_err(io)?;
+    }
 
     let period = Duration::from_secs_f64(1.0 / shared.fps);
     let (mut sent, mut acked) = (0u32, 0u32);
@@ -131,11 +133,16 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                 ws.send(Message::text(message)).map_err(io)?;
             }
         }
-        session.render(rate.tick(now), &mut frame);
+        let fps = rate.tick(now);
+        session.render(fps, &mut frame);
         // tungstenite takes ownership of each message: one buffer per frame is the transport's
         // cost (the engine's own buffers are reused).
         ws.send(Message::binary(std::mem::take(&mut frame))).map_err(io)?;
         sent = sent.wrapping_add(1);
+        if session.render_second(fps, &mut frame) {
+            ws.send(Message::binary(std::mem::take(&mut frame))).map_err(io)?;
+            sent = sent.wrapping_add(1);
+        }
         next_frame += period;
         if next_frame < now {
             next_frame = now; // after a stall, resume the rate instead of bursting to catch up

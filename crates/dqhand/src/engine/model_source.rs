@@ -27,6 +27,16 @@ impl ModelSource {
             ModelSource::File(path) => load_gltf(path),
         }
     }
+
+    /// The source of a left hand: the built-in hand built as a left one; a file as it is
+    /// (it must hold a left hand: a loop of two hands refuses two of one side).
+    #[must_use]
+    pub fn left(&self) -> ModelSource {
+        match self {
+            ModelSource::Builtin(params) => ModelSource::Builtin(HandParams { side: crate::hand::Side::Left, ..*params }),
+            file => file.clone(),
+        }
+    }
 }
 
 impl core::str::FromStr for ModelSource {
