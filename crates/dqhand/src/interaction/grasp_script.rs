@@ -13,7 +13,7 @@ use glam::{Affine3A, Mat3, Quat, Vec3};
 use parry3d::query::Ray;
 
 use super::synthetic::joint_set;
-use crate::collision::{ObjectCollider, ObjectColliders};
+use crate::collision::{ObjectCollider, ObjectColliders, TableTop};
 use crate::gesture::gesture;
 use crate::kinematics::Side;
 use crate::input::{HandData, Record, TrackedJoint};
@@ -26,6 +26,9 @@ use crate::{Error, Result, SceneProblem};
 const PRESS_M: f32 = 0.01;
 /// Where the hand starts and ends, back from the grasp along the approach, m.
 const STANDOFF_M: f32 = 0.2;
+/// How far above the table's top a scripted grasp keeps the hand's joints (about a finger's
+/// half thickness, m).
+const TABLE_CLEARANCE_M: f32 = 0.01;
 /// Carrying speed, m/s.
 const CARRY_SPEED: f32 = 0.5;
 
@@ -266,6 +269,21 @@ impl HandPath {
         centre - d + d * (toi + PRESS_M)
     }
 
+    /// `palm` raised until the open hand there, and closed, is clear of the table's top by
+    /// [`TABLE_CLEARANCE_M`] (a hand taking a ball from the side, thumb up, cannot have its
+    /// little finger in the table).
+    fn above_table(&mut self, palm: Vec3, table: Option<TableTop>) -> Vec3 {
+        let Some(table) = table else { return palm };
+        let lowest = [0.0, 1.0].map(|c| {
+            let mut pose = self.closing.pose(c);
+            pose.wrist = Some(DualQuat::from_rotation_translation(self.rotation, palm - self.rotation * self.frame.palm));
+            self.hand.pose(&pose);
+            self.hand.world().iter().map(|w| w.translation.y).fold(f32::INFINITY, f32::min)
+        });
+        let deficit = table.height + TABLE_CLEARANCE_M - lowest[0].min(lowest[1]);
+        palm + Vec3::Y * deficit.max(0.0)
+    }
+
     /// A keyframe `dt` after the last (at 0 for the first): palm at `p`, closed by `c`.
     /// Returns its time.
     fn key(&mut self, dt: f64, p: Vec3, c: f32) -> f64 {
@@ -324,6 +342,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     let d = task.approach.normalize();
     let mut path = HandPath::new(&model, side, d, task.fingers, task.pinch)?;
     let grasp_at = path.reach(object, d, task.aim, true);
+    let grasp_at = path.above_table(grasp_at, objects.table());
     let start = grasp_at - d * STANDOFF_M;
     let lifted = grasp_at + Vec3::Y * task.lift;
     let carried = lifted + task.carry;
