@@ -131,3 +131,14 @@ export function chosenHand(labels: readonly ('Left' | 'Right')[]): number {
   const right = labels.findIndex((l) => userSide(l) === 'right');
   return right >= 0 ? right : labels.length > 0 ? 0 : -1;
 }
+
+/**
+ * The hands of a frame to send (indices into its `sides`): to an engine driving two (`both`),
+ * every hand when two are seen with different sides, each driving the engine's hand of its
+ * side; else only `followed` (none when it is −1). Two hands labelled alike are one hand seen
+ * twice as far as the engine can tell: sending both would make one engine hand jump between them.
+ */
+export function handsToSend(sides: readonly Side[], followed: number, both: boolean): number[] {
+  if (followed < 0) return [];
+  return both && sides.length === 2 && sides[0] !== sides[1] ? [0, 1] : [followed];
+}

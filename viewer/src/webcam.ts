@@ -5,7 +5,7 @@
 // vite.config.ts), loaded on the first press: nothing comes from the network, and no frame
 // or landmark leaves the page except to the local engine.
 
-import { chosenHand, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from './landmarks';
+import { chosenHand, handsToSend, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from './landmarks';
 import type { Side } from './protocol';
 import type { InputSender } from './sender';
 
@@ -163,9 +163,7 @@ export class Webcam {
     if (followed >= 0) {
       this.state.detected++;
       const t = performance.now() / 1000;
-      // Two hands told apart by their labels each drive the engine's hand of their side.
-      const sent = this.both && sides.length === 2 && sides[0] !== sides[1] ? [0, 1] : [followed];
-      for (const k of sent) {
+      for (const k of handsToSend(sides, followed, this.both)) {
         const record = landmarkRecord(t, sides[k], world[k] ?? [], image[k] ?? [], video.videoWidth / video.videoHeight, this.anchor);
         if (record && this.sender.send(record)) this.state.sent++;
       }

@@ -2,7 +2,7 @@
 // the axes written out here from their definitions.
 
 import { describe, expect, test } from 'vitest';
-import { CAMERA_FOV_DEG, HAND_DISTANCE_M, SIDE_CHANGE_FRAMES, SideFilter, chosenHand, handTranslation, landmarkRecord, userSide, type Point, type Vec3 } from '../src/landmarks';
+import { CAMERA_FOV_DEG, HAND_DISTANCE_M, SIDE_CHANGE_FRAMES, SideFilter, chosenHand, handTranslation, handsToSend, landmarkRecord, userSide, type Point, type Vec3 } from '../src/landmarks';
 
 /** A right hand's 21 landmarks about their mean, as MediaPipe's world landmarks of a palm facing the camera, fingers up (m, camera axes: y down). */
 function rightHandFacingCamera(): Point[] {
@@ -89,5 +89,16 @@ describe('which hand', () => {
     expect(f.update('left')).toBe('left');
     f.reset();
     expect(f.update('right')).toBe('right');
+  });
+});
+
+describe('the hands a camera frame sends', () => {
+  test('to an engine of two hands, both when their labels differ; else the one followed', () => {
+    expect(handsToSend(['left', 'right'], 1, true)).toEqual([0, 1]);
+    expect(handsToSend(['left', 'right'], 1, false)).toEqual([1]);
+    // Labelled alike: one of them, or the engine's one hand would jump between two.
+    expect(handsToSend(['right', 'right'], 0, true)).toEqual([0]);
+    expect(handsToSend(['left'], 0, true)).toEqual([0]);
+    expect(handsToSend([], -1, true)).toEqual([]);
   });
 });
