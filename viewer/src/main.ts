@@ -394,6 +394,8 @@ window.dqhand = {
     },
   }),
   send: (command: Command) => connection.send(command),
+  /** Draws the second hand or leaves it out, to see what it draws. */
+  showSecondHand: (on: boolean) => scene.showSecondHand(on),
   setting: (command: Command) => connection.setting(command),
   /**
    * Camera: 'default', 'side' or a direction, optionally close on a joint (by name) or on a

@@ -469,7 +469,8 @@ function checkSceneMessage(v: Record<string, unknown>): SceneMessage {
   const bad = (field: string, value: unknown) => new ProtocolError(`scene message: ${field} ${show(value)}`);
   if (v.held !== null && !isName(v.held)) throw bad('held', v.held);
   const holding = v.holding ?? null;
-  if (holding !== null && !(isObject(holding) && Object.entries(holding).every(([side, o]) => isSide(side) && (o === null || isName(o))))) throw bad('holding', holding);
+  const heldBy = (o: unknown) => o === null || isName(o);
+  if (holding !== null && !(isObject(holding) && Object.keys(holding).length === 2 && heldBy(holding.left) && heldBy(holding.right))) throw bad('holding', holding);
   if (!isObject(v.objects) || Object.keys(v.objects).length > MAX_SCENE_OBJECTS) throw bad('objects', v.objects);
   const objects: SceneMessage['objects'] = {};
   for (const [name, pose] of Object.entries(v.objects)) {
@@ -482,7 +483,8 @@ function checkSceneMessage(v: Record<string, unknown>): SceneMessage {
     if (!(isObject(c) && isString(c.bone) && isName(c.object) && isVector(c.p, 3) && isVector(c.n, 3) && (hand === null || isSide(hand)))) throw bad(`contacts[${i}]`, c);
     return { bone: c.bone, object: c.object, p: c.p as Vec3, n: c.n as Vec3, hand };
   });
-  return { type: 'scene', held: v.held as string | null, holding: holding as SceneMessage['holding'], objects, contacts };
+  const holds = holding && { left: holding.left as string | null, right: holding.right as string | null };
+  return { type: 'scene', held: v.held as string | null, holding: holds, objects, contacts };
 }
 
 /** Checks every field of an input message; the message names the first bad one. */
@@ -506,7 +508,8 @@ function checkInput(v: Record<string, unknown>): InputMessage {
   const mirrored = v.mirrored ?? false;
   if (typeof mirrored !== 'boolean') throw bad('mirrored', v.mirrored);
   const hands = v.hands ?? null;
-  if (hands !== null && !(Array.isArray(hands) && hands.length === 2 && hands.every((h) => isObject(h) && isSide(h.side) && oneOf(TRACKING_STATES, h.tracking) && (h.gesture === null || isString(h.gesture))))) {
+  const handState = (h: unknown) => isObject(h) && isSide(h.side) && oneOf(TRACKING_STATES, h.tracking) && (h.gesture === null || isString(h.gesture));
+  if (hands !== null && !(Array.isArray(hands) && hands.length === 2 && hands.every(handState) && hands[0].side !== hands[1].side)) {
     throw bad('hands', hands);
   }
   const events = v.events as GestureEvent[];

@@ -153,6 +153,8 @@ export class HandScene {
   lastFrame: Frame | null = null;
   /** The second hand's latest frame shown, null without one. */
   secondFrame: Frame | null = null;
+  /** The second hand is left out of the picture (the tests' hook, to see what it draws). */
+  private secondHidden = false;
 
   constructor(readonly canvas: HTMLCanvasElement) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
@@ -299,8 +301,14 @@ export class HandScene {
     if (!second || frame.header.vertexCount !== second.view.mesh.geometry.getAttribute('position').count) return;
     this.secondFrame = frame;
     second.view.update(frame, Math.max(0, frame.header.methods.indexOf('dqb')), second.parents, this.heat);
-    second.view.group.visible = true;
+    second.view.group.visible = !this.secondHidden;
     second.view.bones.visible = second.view.jointDots.visible = this.showSkeleton;
+  }
+
+  /** Draws the second hand or leaves it out (the tests' hook). */
+  showSecondHand(on: boolean): void {
+    this.secondHidden = !on;
+    if (this.second && this.secondFrame) this.second.view.group.visible = on;
   }
 
   /** Visible hands and their methods, left to right. */

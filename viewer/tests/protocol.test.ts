@@ -138,6 +138,7 @@ describe('live input', () => {
       [{ hands: [hands[0]] }, /hands/],
       [{ hands: [hands[0], { ...hands[1], side: 'middle' }] }, /hands/],
       [{ hands: [hands[0], { ...hands[1], tracking: 'gone' }] }, /hands/],
+      [{ hands: [hands[0], { ...hands[0], gesture: null }] }, /hands/],
       [{ events: [{ ...events[0], hand: 'third' }] }, /events\[0\]/],
     ] as const) {
       expect(() => decodeText(text(edit))).toThrow(message);
@@ -328,6 +329,8 @@ describe('scene', () => {
     expect(heldText({ held: null, holding: { left: null, right: null } })).toBe('—');
     expect(() => decodeText(message({ holding: { middle: 'ball' } }))).toThrow(/holding/);
     expect(() => decodeText(message({ holding: { left: 3 } }))).toThrow(/holding/);
+    expect(() => decodeText(message({ holding: {} }))).toThrow(/holding/);
+    expect(() => decodeText(message({ holding: { left: 'ball' } }))).toThrow(/holding/);
     expect(() => decodeText(message({ contacts: [{ ...good.contacts[0], hand: 'both' }] }))).toThrow(/contacts\[0\]/);
   });
 

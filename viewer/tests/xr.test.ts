@@ -8,10 +8,12 @@ import { createRequire } from 'node:module';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
 import type { XRDevice } from 'iwer';
-import { canvasStats, launchBrowser, newPage, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, launchBrowser, newPage, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
 /** IWER's UMD build: defines `window.IWER`. */
 const IWER_BUNDLE = createRequire(import.meta.url).resolve('iwer/build/iwer.min.js');
+/** The skin's colours, lit and shaded (the viewer's SKIN, 0xe0a98f). */
+const SKIN = { r: [120, 255], g: [70, 210], b: [70, 190] };
 /** The page's globals with the emulator: its module and the device, as the init script makes it. */
 type Emulated = { IWER: typeof import('iwer'); iwer: XRDevice };
 
@@ -216,10 +218,15 @@ describe('the WebXR input to a server driving two hands', () => {
     await p.evaluate(() => ((window as unknown as Emulated).iwer.hands.left!.position.x -= 0.1));
     await waitState(p, `Math.abs(s.secondHand.wrist[0] - ${before.secondHand!.wrist![0] - 0.1}) < 0.01`, 60_000);
     expect(Math.abs((await twoState()).frame!.wrist[0] - before.frame!.wrist[0])).toBeLessThan(0.01);
-    // Both drawn where they are: on each half of the headset's view.
-    await settle(p);
-    const { strips, width, height } = await canvasStats(p, 2);
-    for (const n of strips) expect(n / ((width * height) / 2)).toBeGreaterThan(0.005);
+    // Both drawn: the skin's pixels about double with the second hand in the picture.
+    const skin = async (on: boolean) => {
+      await p.evaluate((v) => (window as unknown as { dqhand: { showSecondHand(on: boolean): void } }).dqhand.showSecondHand(v), on);
+      await settle(p);
+      return countColour(p, SKIN);
+    };
+    const [one, both] = [await skin(false), await skin(true)];
+    expect(one).toBeGreaterThan(500);
+    expect(both).toBeGreaterThan(1.5 * one);
     expect((await twoState()).errors).toEqual([]);
     await p.evaluate(() => (window as unknown as Emulated).iwer.activeSession!.end());
     await waitState(p, '!s.xr.active');

@@ -436,12 +436,14 @@ pub fn scene_message(manip: &ManipulationLoop) -> String {
     let names = manip.names();
     let two = manip.hands().len() > 1;
     let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({ "p": p.to_array(), "q": q.to_array() }))).collect();
+    // Each hand's share of the bound: a hand touching much cannot crowd the other's out.
+    let share = MAX_SCENE_CONTACTS / manip.hands().len();
     let contacts: Vec<Value> = manip
         .hands()
         .iter()
         .flat_map(|hand| {
             let joints = hand.rendered().skeleton().joints();
-            hand.contacts().iter().map(move |c| {
+            hand.contacts().iter().take(share).map(move |c| {
                 let mut contact = json!({ "bone": joints[c.joint].name, "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array() });
                 if two {
                     contact["hand"] = hand.side().name().into();
@@ -449,7 +451,6 @@ pub fn scene_message(manip: &ManipulationLoop) -> String {
                 contact
             })
         })
-        .take(MAX_SCENE_CONTACTS)
         .collect();
     let held = manip.hands().iter().find_map(|h| h.held()).map(|i| &names[i]);
     let mut message = json!({ "type": "scene", "held": held, "objects": objects, "contacts": contacts });

@@ -487,7 +487,13 @@ impl LiveInput {
     pub fn summary(&self) -> (u64, u64, Vec<String>) {
         let state = self.lock();
         let (accepted, rejected) = state.driver.counts();
-        (accepted, rejected, state.driver.loops().flat_map(|g| g.pipeline().rejections().summary()).collect())
+        // With two hands, each line names its hand.
+        let two = state.driver.two();
+        let lines = state.driver.loops().flat_map(|g| {
+            let side = g.pipeline().retargeter().side().name();
+            g.pipeline().rejections().summary().map(move |line| if two { format!("{side} hand: {line}") } else { line })
+        });
+        (accepted, rejected, lines.collect())
     }
 
     /// A viewer's view of the input, from now on (earlier events are not replayed to it).

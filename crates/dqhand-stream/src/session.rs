@@ -354,8 +354,13 @@ impl Session {
 
     fn set_joint_model(&mut self, model: JointModel) -> Result<()> {
         let old = self.joint_model();
-        for engine in self.engines() {
-            engine.set_joint_model(model)?;
+        self.hand.engine.set_joint_model(model)?;
+        if let Some((hand, _, _)) = &mut self.second {
+            if let Err(e) = hand.engine.set_joint_model(model) {
+                // Both hands or neither: the first goes back to the model it had.
+                self.hand.engine.set_joint_model(old).expect("the joint model it had");
+                return Err(e.into());
+            }
         }
         if let Some((_, _, second)) = &mut self.second {
             let mut pose = Pose::rest(model.dof_count());

@@ -59,12 +59,24 @@ fn a_session_of_two_hands_sends_the_second_hand_after_the_first() {
     assert!(r.abs() > 0.003 && (r + l).abs() < 0.1 * r.abs(), "mean x: right {r}, left {l}");
 
     // The second hand follows its own pose only; the first keeps its own.
+    let before = frames(&mut session).0.header.wrist;
     let mut pose = Pose::rest(JointModel::Full.dof_count());
     pose.wrist = Some(DualQuat::from_rotation_translation(glam::Quat::IDENTITY, Vec3::new(-0.3, 1.0, -0.2)));
     session.follow_second(&pose, JointModel::Full);
     let (first, second) = frames(&mut session);
     assert_eq!(&second.unwrap().header.wrist[..3], &[-0.3, 1.0, -0.2]);
-    assert_ne!(&first.header.wrist[..3], &[-0.3, 1.0, -0.2]);
+    assert_eq!(first.header.wrist, before);
+
+    // The view's settings apply to both hands: the joint model (the DOF count), the methods and
+    // the joint limits.
+    for command in [r#"{"type":"joint_model","name":"paper"}"#, r#"{"type":"view","methods":["lb","dqb"]}"#, r#"{"type":"limits","on":false}"#] {
+        session.apply(&dqhand_stream::Command::parse(command).unwrap()).unwrap();
+    }
+    let (first, second) = frames(&mut session);
+    let second = second.unwrap();
+    for h in [&first.header, &second.header] {
+        assert_eq!((h.dof_count as usize, h.methods.len(), h.state & dqhand_stream::frame::STATE_LIMITS), (JointModel::Paper.dof_count(), 2, 0));
+    }
 
     // Without a second hand, no second frame and no sequence number skipped (the transport's
     // flow control counts the frames it sends).

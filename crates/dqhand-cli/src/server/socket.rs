@@ -1,6 +1,6 @@
 //! The engine stream of one viewer: hello and topology, then frames at the configured rate,
-//! with user edits read in between. Flow control keeps at most [`WINDOW`] frames unacknowledged,
-//! so a browser that falls behind gets fewer frames instead of a growing queue.
+//! with user edits read in between. Flow control keeps at most [`WINDOW`] frames of each hand
+//! unacknowledged, so a browser that falls behind gets fewer frames instead of a growing queue.
 
 use std::io::{ErrorKind, Write};
 use std::net::TcpStream;
@@ -18,7 +18,7 @@ use crate::live_learning;
 
 /// The path of the stream.
 pub const PATH: &str = "/stream";
-/// Frames sent but not yet acknowledged, at most.
+/// Frames of each hand sent but not yet acknowledged, at most.
 const WINDOW: u32 = 3;
 /// A send that cannot complete in this time (the client stopped reading) ends the connection,
 /// a file's or a stream's.
@@ -53,6 +53,8 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     }
 
     let period = Duration::from_secs_f64(1.0 / shared.fps);
+    // Frames a step sends: one per hand.
+    let per_step = 1 + u32::from(shared.second.is_some());
     let (mut sent, mut acked) = (0u32, 0u32);
     let mut last_frame = Instant::now();
     let mut next_frame = last_frame;
@@ -65,7 +67,7 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
         // Read edits until the next frame is due (or, with the window full, until an ack).
         loop {
             let now = Instant::now();
-            let window_open = sent.wrapping_sub(acked) < WINDOW;
+            let window_open = sent.wrapping_sub(acked) + per_step <= WINDOW * per_step;
             if window_open && now >= next_frame {
                 break;
             }

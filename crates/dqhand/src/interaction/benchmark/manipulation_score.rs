@@ -12,7 +12,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use glam::{Affine3A, Quat, Vec3};
+use glam::{Quat, Vec3};
 use parry3d::bounding_volume::Aabb;
 use parry3d::query::Ray;
 use serde::Serialize;
@@ -140,7 +140,8 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let (mut grasped_before_carry, mut held_through_carry) = (false, true);
     let mut released = false;
     let (mut penetration_sum, mut contact_frames) = (0.0f64, 0u32);
-    let mut in_wrist: Option<(Quat, Vec3)> = None;
+    // The hands holding the object and the object in their frame when the carry began.
+    let mut in_wrist: Option<(Vec<Quat>, (Quat, Vec3))> = None;
     let mut carrier: Option<usize> = None;
     let mut carry_offset: Option<f32> = None;
     let mut let_go: Option<Vec3> = None;
@@ -169,10 +170,33 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             match carrier.or(holder).map(|k| &hands[k]).filter(|h| h.held() == Some(object)) {
                 Some(hand) => {
                     carrier = carrier.or(holder);
-                    let wrist: &Affine3A = &hand.constraint().tracked_world()[hand.rendered().rig().wrist()];
+                    // The object in the frame of the hands holding it: one hand's tracked wrist,
+                    // or for two the mean of their turns since the carry began about their
+                    // wrists' mean (a pair's fit moves with both hands, and slip is the object
+                    // moving in the grip, not one hand's jitter against the other's; the two
+                    // wrists face each other, so their own rotations have no useful mean).
+                    let wrists: Vec<(Quat, Vec3)> = hands
+                        .iter()
+                        .filter(|h| h.held() == Some(object))
+                        .map(|h| {
+                            let (_, q, t) = h.constraint().tracked_world()[h.rendered().rig().wrist()].to_scale_rotation_translation();
+                            (q, t)
+                        })
+                        .collect();
+                    // A hand joining or leaving the hold starts a new reference.
+                    if in_wrist.as_ref().is_none_or(|(starts, _)| starts.len() != wrists.len()) {
+                        in_wrist = None;
+                    }
+                    let starts = in_wrist.as_ref().map_or_else(|| wrists.iter().map(|w| w.0).collect(), |(s, _)| s.clone());
+                    let turn = wrists.iter().zip(&starts).fold(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0), |sum, (w, s)| {
+                        let d = w.0 * s.inverse();
+                        sum + if sum.dot(d) < 0.0 { -d } else { d }
+                    });
+                    let turn = turn.normalize();
+                    let centre = wrists.iter().map(|w| w.1).sum::<Vec3>() / wrists.len() as f32;
                     let (q, p) = manip.poses()[object];
-                    let here = (wrist.to_scale_rotation_translation().1.inverse() * q, wrist.inverse().transform_point3(p));
-                    let first = *in_wrist.get_or_insert(here);
+                    let here = (turn.inverse() * q, turn.inverse() * (p - centre));
+                    let first = in_wrist.get_or_insert((starts, here)).1;
                     score.slip_m = score.slip_m.max(here.1.distance(first.1));
                     score.slip_deg = score.slip_deg.max(here.0.angle_between(first.0).to_degrees());
                     let truth = frame.clone().find(|&r| hands[manip.hand_of(script.records[r].side)].side() == hand.side()).and_then(|r| script.truth[r].wrist);
