@@ -12,7 +12,7 @@ OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_p
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -76,6 +76,13 @@ LIB_FEATURES := gltf hand interaction metrics rayon synthetic
 features:
 	$(CARGO) check --locked -p dqhand --no-default-features --lib --examples
 	for f in $(LIB_FEATURES); do $(CARGO) check --locked -p dqhand --no-default-features --features $$f --lib --examples || exit 1; done
+	$(MAKE) wasm-check
+
+# The whole library for WebAssembly (the browser engine to come builds on it): no C or C++
+# dependency, nothing x86-only outside its kernels' cfg.
+wasm-check:
+	rustup target list --installed | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+	$(CARGO) check --locked -p dqhand --target wasm32-unknown-unknown --no-default-features --features $(subst $() $(),$(comma),$(LIB_FEATURES)) --lib
 
 # The library's examples, run (cargo test only builds them).
 examples: recordings

@@ -6,7 +6,8 @@
 //!    times denser than wanted (the spacing comes from a coarse trial run's vertex count) on a
 //!    grid fine enough for the gaps between the fingers; where two sheets still share a cell,
 //!    a slightly finer grid is tried.
-//! 3. meshoptimizer's edge-collapse simplifier (crate `meshopt`, regularised for even
+//! 3. meshoptimizer's edge-collapse simplifier (crate `meshoptimizer-rs`, its pure-Rust port;
+//!    regularised for even
 //!    triangles) reduces it. Every collapse on a closed mesh removes one vertex and two
 //!    triangles, so the triangle target `2 (n − χ)` lands on exactly `n` vertices.
 //! 4. A few rounds of tangential relaxation even out the spacing; after each, every vertex is
@@ -16,6 +17,7 @@
 use fast_surface_nets::ndshape::{RuntimeShape, Shape};
 use fast_surface_nets::{surface_nets, SurfaceNetsBuffer};
 use glam::Vec3;
+use meshoptimizer_rs::{Positions, SimplifyOptions, SimplifySettings, Workspace};
 use rayon::prelude::*;
 
 use super::shape::HandShape;
@@ -137,10 +139,10 @@ fn simplify(dense: &Surface, vertices: usize) -> Result<Surface> {
     if vertices as i64 > v || target_triangles < 4 {
         return Err(Error::Tessellation(format!("cannot mesh the hand with {vertices} vertices (its dense surface has {v})")));
     }
-    let bytes = meshopt::typed_to_bytes(&dense.positions);
-    let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Tessellation(format!("meshopt: {e}")))?;
-    let options = meshopt::SimplifyOptions::Regularize;
-    let mut indices = meshopt::simplify(&dense.indices, &adapter, 3 * target_triangles as usize, 1.0, options, None);
+    let positions: Vec<[f32; 3]> = dense.positions.iter().map(|&p| p.into()).collect();
+    let settings = SimplifySettings { target_index_count: 3 * target_triangles as usize, target_error: 1.0, options: SimplifyOptions::REGULARIZE };
+    let simplified = meshoptimizer_rs::simplify(&dense.indices, Positions::from_packed(&positions), settings, &mut Workspace::default());
+    let mut indices = simplified.map_err(|e| Error::Tessellation(format!("meshoptimizer: {e}")))?.indices;
     // Keep the vertices still referenced, in first-use order.
     let mut remap = vec![u32::MAX; dense.positions.len()];
     let mut positions = Vec::with_capacity(vertices);

@@ -11,7 +11,9 @@
 //! (two of the mesh's 8-vertex chunks) blended one vertex per lane from the start, with no
 //! transpose (module `avx512`), and finished 16 lanes per register.
 
-use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
+#[cfg(target_arch = "x86_64")]
+use super::skinned_mesh::BLOCK;
+use super::skinned_mesh::{SkinnedMesh, LANES};
 
 /// Which compiled vertex loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -72,7 +74,9 @@ impl Kernel {
 
 /// The instruction set a loop is compiled for (a const parameter: one copy per set).
 const PORTABLE: u8 = 0;
+#[cfg(target_arch = "x86_64")]
 const AVX2: u8 = 1;
+#[cfg(target_arch = "x86_64")]
 const AVX512: u8 = 2;
 
 /// Stack data the vector loops load and store whole registers of, aligned to a cache line:
@@ -105,6 +109,7 @@ pub(crate) trait Blend<const W: usize> {
     const SIGNED: usize;
     /// How many leading parameters `finish` reads (the rest is padding the AVX-512 blend
     /// skips): LB 12, QB 7, DQB 8.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const USED: usize;
     /// Finishes a chunk of `L` vertices from the blended parameters `b[component][lane]`:
     /// positions, and normals when `NORMALS` (else `out.n` is left alone); products summed
@@ -119,6 +124,7 @@ pub(crate) struct Frame<'a, const W: usize> {
     /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused when `SIGNED` is 0).
     pub signs: &'a [f32],
     /// `params` and `signs` as the AVX-512 loop looks them up, updated for this frame.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub table: &'a FrameTable<W>,
     /// The loop to run (one this CPU does not run falls back to the best it does).
     pub kernel: Kernel,
