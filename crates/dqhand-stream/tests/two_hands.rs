@@ -2,6 +2,7 @@
 //! the first's, and a live input of two hands drives each by the side of its records (the
 //! right hand shown first), reporting both hands' state and what each holds.
 
+use std::collections::BTreeSet;
 use std::sync::{Arc, LazyLock};
 
 use glam::Vec3;
@@ -11,7 +12,7 @@ use dqhand::collision::ObjectColliders;
 use dqhand::gesture::GestureSet;
 use dqhand::grasp::GraspParams;
 use dqhand::hand::{build, HandParams, Side};
-use dqhand::input::{HandData, InputConfig};
+use dqhand::input::{HandData, InputConfig, Record};
 use dqhand::interaction::grasp_script;
 use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::{JointModel, Pose};
@@ -136,4 +137,43 @@ fn a_live_input_of_two_hands_drives_each_viewer_hand_by_side() {
     // Events name their hand.
     let named: Vec<&str> = inputs.iter().flat_map(|m| m["events"].as_array().unwrap()).map(|e| e["hand"].as_str().unwrap()).collect();
     assert!(named.contains(&"left") && named.contains(&"right") && named.contains(&"both"), "events named {named:?}");
+}
+
+#[test]
+fn only_the_right_hand_commands_the_view() {
+    use dqhand::interaction::synthetic::{generate, SyntheticParams};
+    // Every gesture of the library held in turn (thumbs up among them: the default `next_method`
+    // action), first by the user's left hand alone, then by the right.
+    let sequence = |side, seed| {
+        let hand = HandParams { side, ..HandParams::default() };
+        generate(&SyntheticParams { seed, hand: Some(hand), holds: 13, idle_s: 0.5, ..SyntheticParams::default() }).unwrap().records
+    };
+    let config = InputConfig { grace_s: 1e6, max_latency_s: 1e6, ..InputConfig::default() };
+    let scene = Scene::named("two-hands").unwrap();
+    let manip = ManipulationLoop::two_handed([(LEFT.clone(), None), (RIGHT.clone(), None)], JointModel::Full, config, Some(GestureSet::builtin()), &scene, GraspParams::default()).unwrap();
+    let input = LiveInput::with_scene(manip, "test", true).unwrap();
+    let mut session = two_hand_session();
+    let mut view = input.view();
+    let left = sequence(Side::Left, 3);
+    let end = left.last().unwrap().time;
+    let mut left_gestures = BTreeSet::new();
+    // Plays `records` (shifted in time) into the input, the viewer updated after each; returns
+    // the viewer actions reported, and collects the left hand's gestures.
+    fn play(input: &LiveInput, session: &mut Session, view: &mut dqhand_stream::InputView, records: &[Record], shift: f64, gestures: &mut BTreeSet<String>) -> usize {
+        let mut actions = 0;
+        for r in records {
+            input.push(&Record { time: r.time + shift, ..*r }, |_| {}).unwrap();
+            if let Some(m) = input.update(session, view).message {
+                let m: Value = serde_json::from_str(&m).unwrap();
+                gestures.extend(m["events"].as_array().unwrap().iter().filter(|e| e["hand"] == "left").map(|e| e["gesture"].as_str().unwrap().to_owned()));
+                actions += m["actions"].as_array().unwrap().len();
+            }
+        }
+        actions
+    }
+    let left_actions = play(&input, &mut session, &mut view, &left, 0.0, &mut left_gestures);
+    assert!(left_gestures.contains("thumbs_up"), "the left hand's gestures: {left_gestures:?}");
+    assert_eq!((left_actions, session.methods().as_slice()), (0, &[dqhand::skin::Method::Dqb][..]), "the left hand's thumbs up changed the view");
+    let right_actions = play(&input, &mut session, &mut view, &sequence(Side::Right, 4), end + 1.0, &mut BTreeSet::new());
+    assert!(right_actions > 0 && session.methods().as_slice() != [dqhand::skin::Method::Dqb], "the right hand's thumbs up did not change the view");
 }
