@@ -92,11 +92,13 @@ examples: recordings
 	$(CARGO) run --locked -q -p dqhand --example gestures_from_a_recording -- $(RECORDINGS)/gestures-joints.jsonl
 	$(CARGO) run --locked -q -p dqhand --features synthetic --example grasp_the_ball
 
-# Rust tests (unit, property, golden, CLI, server, doctests), the features alone and the
+# Rust tests (unit, property, golden, CLI, server, doctests; their temporary files, the
+# doctests' binaries among them, under target/ rather than a small /tmp), the features alone and the
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
 # browser tests against a real `dqhand demo`.
 test: assets viewer chromium recordings
-	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) $(CARGO) test --locked --workspace
+	mkdir -p target/tmp
+	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) TMPDIR=$(CURDIR)/target/tmp $(CARGO) test --locked --workspace
 	$(MAKE) features examples
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
