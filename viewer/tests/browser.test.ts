@@ -413,7 +413,7 @@ describe('the viewer page with two hands in a scene', () => {
     await waitState(p, 's.connected && s.secondHand !== null && s.secondHand.side === "left" && s.secondHand.sequence !== null && s.visible.length === 1', 90_000);
     expect(await p.locator('#model-line').textContent()).toContain('left hand');
     // The scripted carry: both hands tracked, the box in both, events naming their hand.
-    await waitState(p, 'document.getElementById("held").textContent === "box in both hands" && s.input.hands.every((h) => h.tracking === "tracking")', 120_000);
+    await waitState(p, 'document.getElementById("held").textContent === "box in both hands" && s.input !== null && s.input.hands !== null && s.input.hands.every((h) => h.tracking === "tracking")', 120_000);
     const s = await twoState();
     expect(s.input!.hands!.map((h) => h.side)).toEqual(['right', 'left']);
     // The two wrists are apart (each hand where its side's records put it).
