@@ -45,7 +45,7 @@ export class SceneObjects {
   private readonly normals: THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial>;
   /** The object held, as the latest scene message says. */
   held: string | null = null;
-  /** The names of the objects tinted as held, one per line. */
+  /** What the tint shows: the objects held (their names, or empty for none) one per line. */
   private tinted = '';
   contacts = 0;
   /** Scene messages shown. */
@@ -96,11 +96,11 @@ export class SceneObjects {
       solid.visible = true;
     }
     // With two hands, each one's object is tinted.
-    const held = m.holding ? [m.holding.left, m.holding.right].filter((o) => o !== null).join('\n') : m.held ?? '';
-    if (held !== this.tinted) {
-      const names = held.split('\n');
-      for (const [name, solid] of this.objects) solid.material.color.setHex(names.includes(name) ? HELD_COLOUR : solid.userData.colour);
-      this.tinted = held;
+    const held = m.holding ? [m.holding.left, m.holding.right] : [m.held];
+    const tinted = held.join('\n');
+    if (tinted !== this.tinted) {
+      for (const [name, solid] of this.objects) solid.material.color.setHex(held.includes(name) ? HELD_COLOUR : solid.userData.colour);
+      this.tinted = tinted;
     }
     this.held = m.held;
     const dots = this.dots.geometry.getAttribute('position') as THREE.BufferAttribute;

@@ -10,12 +10,11 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use dqhand::engine::{Engine, ModelSource};
 use dqhand::gesture::GESTURES;
-use dqhand::grasp::GraspParams;
 use dqhand::hand::Side;
 use dqhand::input::Record;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::JointModel;
-use dqhand::interaction::{GestureLoop, ManipulationLoop};
+use dqhand::interaction::GestureLoop;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::Method;
@@ -26,6 +25,7 @@ use crate::live::LiveRecords;
 use crate::live_learning::LiveLearning;
 use crate::recording::{gesture_set, Format, InputArgs, RecordingReader};
 use crate::server;
+use crate::synthesize::TWO_HANDS_SCENE;
 
 /// Arguments of `dqhand demo`.
 #[derive(clap::Args)]
@@ -109,8 +109,6 @@ impl Args {
     }
 }
 
-/// The built-in scene made for two hands.
-const TWO_HANDS_SCENE: &str = "two-hands";
 
 /// What a played input reads: a recording file, or records made at start.
 enum Played {
@@ -218,14 +216,7 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
     let input = match scene {
         None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?, source.clone(), announce)?,
         Some((name, scene)) => {
-            let manip = match left {
-                None => ManipulationLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures), &scene, GraspParams::default()),
-                Some(left) => {
-                    let hands = [(Arc::clone(left), mapper.clone()), (Arc::clone(model), mapper)];
-                    ManipulationLoop::two_handed(hands, args.joint_model, config, Some(gestures), &scene, GraspParams::default())
-                }
-            }
-            .with_context(|| name.to_owned())?;
+            let manip = crate::grasp::manipulation_loop(Arc::clone(model), left.cloned(), args.joint_model, mapper, config, Some(gestures), &scene).with_context(|| name.to_owned())?;
             crate::warn_all(&manip.objects().warnings().iter().map(|w| format!("{name}: {w}")).collect::<Vec<_>>());
             let hands = if left.is_some() { "two hands, left and right" } else { "one hand" };
             println!("scene: {name}, {} objects ({}), {hands}", manip.names().len(), manip.names().join(", "));

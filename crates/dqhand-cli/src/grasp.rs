@@ -16,9 +16,11 @@ use std::sync::Arc;
 use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::grasp::GraspParams;
-use dqhand::input::{Record, Tracking};
+use dqhand::gesture::GestureSet;
+use dqhand::input::{GloveMapper, InputConfig, Record, Tracking};
 use dqhand::interaction::{ManipulatingHand, ManipulationLoop};
 use dqhand::kinematics::JointModel;
+use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::{Method, MethodSet, SkinLayer};
 use serde_json::{json, Map, Value};
@@ -54,6 +56,18 @@ pub struct Args {
     left_model: Option<ModelSource>,
 }
 
+/// The loop of `model`'s hand in `scene`, or with a `left` model of two hands (`model` then the
+/// right one), each driven through `mapper` from a glove.
+///
+/// # Errors
+/// As [`ManipulationLoop::new`] and [`ManipulationLoop::two_handed`].
+pub(crate) fn manipulation_loop(model: Arc<Model>, left: Option<Arc<Model>>, joint_model: JointModel, mapper: Option<GloveMapper>, config: InputConfig, gestures: Option<GestureSet>, scene: &Scene) -> dqhand::Result<ManipulationLoop> {
+    match left {
+        None => ManipulationLoop::new(model, joint_model, mapper, config, gestures, scene, GraspParams::default()),
+        Some(left) => ManipulationLoop::two_handed([(left, mapper.clone()), (model, mapper)], joint_model, config, gestures, scene, GraspParams::default()),
+    }
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.rate.is_finite() && args.rate >= 1.0, "--rate {}: frames per second must be at least 1", args.rate);
     let scene = Scene::named(&args.scene)?;
@@ -62,13 +76,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mapper = Some(args.recording.common.mapper(joint_model)?);
     let mut reader = args.recording.reader()?;
     let (config, gestures) = (args.recording.common.config()?, args.recording.recognition.set()?);
-    let mut manip = match &args.left_model {
-        None => ManipulationLoop::new(model, joint_model, mapper, config, gestures, &scene, GraspParams::default())?,
-        Some(left) => {
-            let left = Arc::new(left.left().load().with_context(|| format!("--left-model {left}"))?);
-            ManipulationLoop::two_handed([(left, mapper.clone()), (model, mapper)], joint_model, config, gestures, &scene, GraspParams::default())?
-        }
-    };
+    let left = args.left_model.as_ref().map(|l| l.left().load().with_context(|| format!("--left-model {l}"))).transpose()?.map(Arc::new);
+    let mut manip = manipulation_loop(model, left, joint_model, mapper, config, gestures, &scene)?;
     for w in manip.objects().warnings() {
         eprintln!("dqhand: warning: {}: {w}", args.scene);
     }

@@ -23,6 +23,8 @@ use dqhand::scene::Scene;
 use glam::Vec3;
 use serde_json::{json, Value};
 
+use crate::synthesize::TWO_HANDS_SCENE;
+
 /// Share of scripted grasps to succeed.
 const SUCCESS_TARGET: f64 = 0.98;
 /// Deepest the rendered skin may go into an object, m.
@@ -233,12 +235,12 @@ fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask, config: &InputCo
 /// A two-hand run of `kind` on the `two-hands` scene by `models` (left, right); with a seed,
 /// as a headset tracks both hands. Returns the object's name and the score.
 fn measure_two(models: [&Arc<Model>; 2], kind: Kind, config: &InputConfig, headset: Option<u64>) -> anyhow::Result<(String, RunScore)> {
-    let scene = Scene::named("two-hands")?;
+    let scene = Scene::named(TWO_HANDS_SCENE)?;
     let objects = ObjectColliders::new(&scene)?;
     let pair = [&**models[0], &**models[1]];
     let (object, script, carried) = match kind {
-        Kind::Between => ("box", grasp_script::carry_between(pair, "two-hands", &objects, "box", LIFT_M, TWO_HAND_CARRY)?, TWO_HAND_CARRY),
-        _ => ("baton", grasp_script::hand_over(pair, "two-hands", &objects, "baton", 0.08, LIFT_M, HAND_OVER_CARRY)?, 2.0 * HAND_OVER_CARRY),
+        Kind::Between => ("box", grasp_script::carry_between(pair, TWO_HANDS_SCENE, &objects, "box", LIFT_M, TWO_HAND_CARRY)?, TWO_HAND_CARRY),
+        _ => ("baton", grasp_script::hand_over(pair, TWO_HANDS_SCENE, &objects, "baton", 0.08, LIFT_M, HAND_OVER_CARRY)?, 2.0 * HAND_OVER_CARRY),
     };
     let script = match headset {
         Some(seed) => HeadsetTracking::QUEST_LIKE.track(&script, seed),

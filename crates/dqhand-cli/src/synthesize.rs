@@ -118,6 +118,9 @@ pub fn scripted_grasps(model: &Arc<Model>, name: &str, scene: &Scene, side: Side
     Ok((tasks, scripts))
 }
 
+/// The built-in scene made for two hands.
+pub const TWO_HANDS_SCENE: &str = "two-hands";
+
 /// The built-in `two-hands` scene played by `hands`, a left and a right one: the box carried
 /// 20 cm away between them, then the bar handed over (each hand carrying it 12 cm), on one
 /// clock with a tracking loss between; the objects' names and the scripts.
@@ -126,8 +129,8 @@ pub fn two_handed(hands: [&Arc<Model>; 2], scene: &Scene) -> anyhow::Result<(Vec
     let hands = hands.map(|h| &**h);
     // The box goes away from the user, clear of the bar.
     let mut scripts = vec![
-        grasp_script::carry_between(hands, "two-hands", &objects, "box", 0.12, glam::Vec3::new(0.0, 0.0, -0.2))?,
-        grasp_script::hand_over(hands, "two-hands", &objects, "baton", 0.08, 0.12, glam::Vec3::new(0.0, 0.0, 0.12))?,
+        grasp_script::carry_between(hands, TWO_HANDS_SCENE, &objects, "box", 0.12, glam::Vec3::new(0.0, 0.0, -0.2))?,
+        grasp_script::hand_over(hands, TWO_HANDS_SCENE, &objects, "baton", 0.08, 0.12, glam::Vec3::new(0.0, 0.0, 0.12))?,
     ];
     let offset = scripts[0].times.end + grasp_script::TASK_GAP_S;
     scripts[1].shift(offset);
@@ -139,7 +142,7 @@ fn manipulation(args: &Args, name: &str) -> anyhow::Result<()> {
     anyhow::ensure!(matches!(args.format, Format::Joints), "--scene: scripted manipulation recordings carry joints only (--format joints)");
     let scene = Scene::named(name)?;
     let model = Arc::new(dqhand::hand::build(&HandParams::default())?);
-    let (tasks, scripts) = if name == "two-hands" {
+    let (tasks, scripts) = if name == TWO_HANDS_SCENE {
         let left = Arc::new(dqhand::hand::build(&HandParams { side: Side::Left, ..HandParams::default() })?);
         two_handed([&left, &model], &scene)?
     } else {

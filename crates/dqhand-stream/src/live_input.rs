@@ -315,7 +315,8 @@ impl LiveInput {
     pub fn with_scene(manip: ManipulationLoop, source: impl Into<String>, announce: bool) -> Result<Self> {
         check_scene(&manip)?;
         let scene = Some(scene_hello(&manip));
-        let shown = if manip.hands().len() > 1 { [manip.hand_of(Side::Right), manip.hand_of(Side::Left)] } else { [0, 0] };
+        // (A loop of one hand drives it from either side.)
+        let shown = [manip.hand_of(Side::Right), manip.hand_of(Side::Left)];
         let state = SceneState { poses: manip.poses().to_vec(), contacts: 0, held: [None; 2], stepped: 0.0, version: 0, message: (u64::MAX, String::new()), shown, manip };
         Self::driving(Driver::Scene(Box::new(state)), scene, source.into(), announce)
     }
@@ -560,7 +561,11 @@ impl LiveInput {
                     }
                     events.push(e);
                 }
-                Entry::TwoHand { t, event, gesture } => events.push(json!({ "t": t, "event": event, "gesture": state.two_hand[gesture], "index": gesture, "hand": "both" })),
+                Entry::TwoHand { t, event, gesture } => {
+                    let mut e = json!(Event { t, event, gesture: &state.two_hand[gesture], index: gesture });
+                    e["hand"] = "both".into();
+                    events.push(e);
+                }
                 Entry::Action { t, gesture, action } => {
                     session.act(action);
                     actions.push(json!({ "t": t, "gesture": state.gestures[gesture], "action": action }));

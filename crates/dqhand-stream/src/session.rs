@@ -354,24 +354,22 @@ impl Session {
 
     fn set_joint_model(&mut self, model: JointModel) -> Result<()> {
         let old = self.joint_model();
+        // `pose`'s angles in `model`'s DOFs, with `wrist`.
+        let carried = |pose: &Pose, wrist: Option<DualQuat>| {
+            let mut to = Pose::rest(model.dof_count());
+            old.carry_angles(&pose.angles, model, &mut to.angles);
+            Pose { wrist, ..to }
+        };
         self.hand.engine.set_joint_model(model)?;
-        if let Some((hand, _, _)) = &mut self.second {
+        if let Some((hand, _, pose)) = &mut self.second {
             if let Err(e) = hand.engine.set_joint_model(model) {
                 // Both hands or neither: the first goes back to the model it had.
                 self.hand.engine.set_joint_model(old).expect("the joint model it had");
                 return Err(e.into());
             }
+            *pose = carried(pose, pose.wrist);
         }
-        if let Some((_, _, second)) = &mut self.second {
-            let mut pose = Pose::rest(model.dof_count());
-            old.carry_angles(&second.angles, model, &mut pose.angles);
-            pose.wrist = second.wrist;
-            *second = pose;
-        }
-        let mut pose = Pose::rest(model.dof_count());
-        old.carry_angles(&self.pose.angles, model, &mut pose.angles);
-        pose.wrist = self.wrist;
-        self.pose = pose;
+        self.pose = carried(&self.pose, self.wrist);
         self.timeline = Sequence::gestures(model);
         self.time = self.time.min(self.timeline.duration());
         self.transition = None;

@@ -276,12 +276,17 @@ impl HandPath {
         let Some(table) = table else { return palm };
         let lowest = [0.0, 1.0].map(|c| {
             let mut pose = self.closing.pose(c);
-            pose.wrist = Some(DualQuat::from_rotation_translation(self.rotation, palm - self.rotation * self.frame.palm));
+            pose.wrist = Some(self.wrist_at(palm));
             self.hand.pose(&pose);
             self.hand.world().iter().map(|w| w.translation.y).fold(f32::INFINITY, f32::min)
         });
         let deficit = table.height + TABLE_CLEARANCE_M - lowest[0].min(lowest[1]);
         palm + Vec3::Y * deficit.max(0.0)
+    }
+
+    /// The wrist that puts the palm at `palm`.
+    fn wrist_at(&self, palm: Vec3) -> DualQuat {
+        DualQuat::from_rotation_translation(self.rotation, palm - self.rotation * self.frame.palm)
     }
 
     /// A keyframe `dt` after the last (at 0 for the first): palm at `p`, closed by `c`.
@@ -302,7 +307,7 @@ impl HandPath {
         let s = if Some(k + 1) == linear { s.clamp(0.0, 1.0) as f32 } else { smooth(s) };
         let palm = p0.lerp(p1, s);
         let mut pose = self.closing.pose(c0 + (c1 - c0) * s);
-        pose.wrist = Some(DualQuat::from_rotation_translation(self.rotation, palm - self.rotation * self.frame.palm));
+        pose.wrist = Some(self.wrist_at(palm));
         self.hand.pose(&pose);
         let world: &[Affine3A] = self.hand.world();
         let positions = self.joints.read(world);

@@ -183,20 +183,19 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
                             (q, t)
                         })
                         .collect();
-                    // A hand joining or leaving the hold starts a new reference.
+                    let centre = wrists.iter().map(|w| w.1).sum::<Vec3>() / wrists.len() as f32;
+                    let (q, p) = manip.poses()[object];
+                    // A hand joining or leaving the hold starts a new reference (no turn yet).
                     if in_wrist.as_ref().is_none_or(|(starts, _)| starts.len() != wrists.len()) {
-                        in_wrist = None;
+                        in_wrist = Some((wrists.iter().map(|w| w.0).collect(), (q, p - centre)));
                     }
-                    let starts = in_wrist.as_ref().map_or_else(|| wrists.iter().map(|w| w.0).collect(), |(s, _)| s.clone());
-                    let turn = wrists.iter().zip(&starts).fold(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0), |sum, (w, s)| {
+                    let (starts, first) = in_wrist.as_ref().expect("set above");
+                    let turn = wrists.iter().zip(starts).fold(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0), |sum, (w, s)| {
                         let d = w.0 * s.inverse();
                         sum + if sum.dot(d) < 0.0 { -d } else { d }
                     });
                     let turn = turn.normalize();
-                    let centre = wrists.iter().map(|w| w.1).sum::<Vec3>() / wrists.len() as f32;
-                    let (q, p) = manip.poses()[object];
                     let here = (turn.inverse() * q, turn.inverse() * (p - centre));
-                    let first = in_wrist.get_or_insert((starts, here)).1;
                     score.slip_m = score.slip_m.max(here.1.distance(first.1));
                     score.slip_deg = score.slip_deg.max(here.0.angle_between(first.0).to_degrees());
                     let truth = frame.clone().find(|&r| hands[manip.hand_of(script.records[r].side)].side() == hand.side()).and_then(|r| script.truth[r].wrist);
