@@ -5,8 +5,9 @@
 //! the end of it only, so nothing fast or thin is passed through):
 //! 1. **Wrist.** The hand's proxies, its fingers as last rendered, move rigidly from the last
 //!    rendered wrist to the tracked one (a screw: rotation about the wrist, translation of
-//!    it); parry's nonlinear shape cast gives the first time of impact with any object or
-//!    the table, and the wrist stops just before it (a gap of [`STOP_DISTANCE`], so that the
+//!    it); parry's nonlinear shape cast (against a mesh, [`ProxyMeshCast`]'s advancement)
+//!    gives the first time of impact with any object or the table, and the wrist stops just
+//!    before it (a gap of [`STOP_DISTANCE`], so that the
 //!    next frame's cast starts clear of the surface: a cast that starts touching may let the
 //!    hand sink), the palm (or a finger) on the surface. After [`SNAP_AFTER_S`] held back,
 //!    the wrist jumps to a tracked pose whose hand is free again (the user has gone round the
@@ -29,6 +30,7 @@ use glam::{Affine3A, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{self, NonlinearRigidMotion};
 
+use super::proxy_mesh_cast::ProxyMeshCast;
 use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectColliders, FINGERS};
 use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
@@ -50,9 +52,9 @@ const STILL_M: f32 = 1e-6;
 /// finger that has not converged stays where it safely is.
 const MAX_ADVANCES: usize = 40;
 
-/// How much farther than it can move a proxy must be from a mesh object for its cast to be
-/// skipped (m): parry's GJK distance to the Utah teapot's thin triangles is off by up to 6 mm
-/// (it reports 4–8 mm where a capsule is 2 mm clear); no cast is skipped on such an answer.
+/// How much farther than it can move a proxy must be from a mesh object's hull for its cast to
+/// be skipped (m): parry's GJK distance in metres to small faces can be centimetres long (see
+/// `proxy_mesh_cast`'s `UNIT`); no cast is skipped on such an answer.
 const MESH_DISTANCE_SLACK: f32 = 0.01;
 
 /// Seconds the rendered wrist may be held back before it jumps to a free tracked pose.
@@ -138,6 +140,7 @@ pub struct ContactConstraint {
     last_contacts: Vec<Contact>,
     closure: [Closure; 5],
     near: Vec<usize>,
+    mesh_cast: ProxyMeshCast,
 }
 
 impl ContactConstraint {
@@ -212,6 +215,7 @@ impl ContactConstraint {
         let n = skeleton.len();
         let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
         Self {
+            mesh_cast: ProxyMeshCast::new(&proxies),
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
@@ -348,7 +352,7 @@ impl ContactConstraint {
         }
         self.uncast = 0.0;
         let mut toi: f32 = 1.0;
-        for p in self.proxies.colliders() {
+        for (i, p) in self.proxies.colliders().iter().enumerate() {
             let offset = to_wrist * world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
@@ -363,9 +367,11 @@ impl ContactConstraint {
             // would test every triangle the swept box meets).
             let reach = (linvel.length() + angvel.length() * radius) * toi;
             for (_, o) in objects.near(&swept, 0.0, held) {
-                // parry's distance to a mesh's thin triangles can be several millimetres long.
-                let slack = if o.mesh.is_some() { MESH_DISTANCE_SLACK } else { 0.0 };
-                let gap = o.distance_at_least(&from, &*p.shape, reach + slack);
+                // A mesh's own advancement starts with its distance: the hull's is enough here.
+                let (gap, slack) = match o.surface.as_trimesh() {
+                    Some(_) => (o.hull_distance(&from, &*p.shape).unwrap_or(0.0), MESH_DISTANCE_SLACK),
+                    None => (o.distance_at_least(&from, &*p.shape, reach), 0.0),
+                };
                 // (A query parry cannot answer reads as infinitely far: then cast.)
                 if gap > reach + slack && gap.is_finite() {
                     continue;
@@ -377,8 +383,12 @@ impl ContactConstraint {
                 if misses_hull {
                     continue;
                 }
-                if let Ok(Some(hit)) = query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false) {
-                    toi = toi.min(hit.time_of_impact);
+                let hit = match o.surface.as_trimesh() {
+                    Some(mesh) => self.mesh_cast.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
+                    None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
+                };
+                if let Some(hit) = hit {
+                    toi = toi.min(hit);
                 }
             }
         }
