@@ -73,8 +73,9 @@ const GJK_ERROR: f32 = 1e-4;
 enum CastShape {
     /// A capsule's axis and radius (m, the joint's frame): distances are exact.
     Capsule { a: Vec3, b: Vec3, radius: f32 },
-    /// Any other convex shape, scaled to [`UNIT`]s for parry's GJK.
-    Scaled(Arc<dyn Shape>),
+    /// Any other convex shape, scaled to [`UNIT`]s for parry's GJK, and its box in the joint's
+    /// frame (m) for a cheap bound.
+    Scaled(Arc<dyn Shape>, Aabb),
 }
 
 /// The unit normal of `tri`'s plane (by its winding).
@@ -94,7 +95,29 @@ impl CastShape {
         if let Some(c) = shape.as_capsule() {
             return Some(Self::Capsule { a: c.segment.a, b: c.segment.b, radius: c.radius });
         }
-        shape.scale_dyn(Vec3::splat(UNIT), 16).map(|scaled| Self::Scaled(Arc::from(scaled)))
+        shape.scale_dyn(Vec3::splat(UNIT), 16).map(|scaled| Self::Scaled(Arc::from(scaled), shape.compute_local_aabb()))
+    }
+
+    /// A lower bound of the distance to `tri` at `pose` (the mesh's frame), far cheaper than
+    /// the distance: a capsule's bounding sphere's; for a hull, the larger of the gap between its
+    /// box and the triangle's box in the joint's frame and the gap along the triangle's normal.
+    fn bound(&self, pose: &Pose, tri: &Triangle) -> f32 {
+        match self {
+            Self::Capsule { a, b, radius } => {
+                let centre = *pose * ((*a + *b) / 2.0);
+                triangle_closest(centre, [tri.a, tri.b, tri.c]).distance(centre) - (a.distance(*b) / 2.0 + radius)
+            }
+            Self::Scaled(_, aabb) => {
+                let to_local = pose.inverse();
+                let [a, b, c] = [to_local * tri.a, to_local * tri.b, to_local * tri.c];
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                let boxes = (aabb.mins - hi).max(lo - aabb.maxs).max(Vec3::ZERO).length();
+                let n = (b - a).cross(c - a).normalize_or_zero();
+                let reach = (aabb.half_extents() * n.abs()).element_sum();
+                let along = (a - aabb.center()).dot(n).abs() - reach;
+                boxes.max(along)
+            }
+        }
     }
 
     /// The signed distance to `tri` (negative inside), the triangle's normal there towards the
@@ -116,7 +139,7 @@ impl CastShape {
                 };
                 (length - radius, normal, p - normal * *radius)
             }
-            Self::Scaled(shape) => {
+            Self::Scaled(shape, _) => {
                 let pose = Pose::from_parts(pose.translation * UNIT, pose.rotation);
                 let tri = Triangle::new(tri.a * UNIT, tri.b * UNIT, tri.c * UNIT);
                 match query::contact(&pose, &**shape, &Pose::identity(), &tri, f32::MAX) {
@@ -156,12 +179,9 @@ impl ProxyMeshCast {
         }
         let local_pose = |t: f32| mesh_pose.inv_mul(&motion.position_at_time(t));
         let start = local_pose(0.0);
-        let sphere = shape.compute_local_bounding_sphere();
-        let centre = start * sphere.center;
         self.candidates.clear();
         self.candidates.extend(mesh.bvh().intersect_aabb(&swept.transform_by(&mesh_pose.inverse())).map(|triangle| {
-            let tri = mesh.triangle(triangle);
-            let bound = triangle_closest(centre, [tri.a, tri.b, tri.c]).distance(centre) - sphere.radius;
+            let bound = cast.bound(&start, &mesh.triangle(triangle));
             Candidate { triangle, bound, at: 0.0, rate: speed, left: false }
         }));
         // Nearest first: a contact at the start is then found after few exact distances.
@@ -277,7 +297,7 @@ mod tests {
         let mesh = crate::scene::ObjectMesh::builtin("objects/teapot.obj").expect("the built-in teapot");
         let v: Vec<Vec3> = mesh.vertices.iter().map(|v| *v * 0.6).collect();
         let capsule = SharedShape::capsule(Vec3::new(0.0, -0.015, 0.0), Vec3::new(0.0, 0.015, 0.0), 0.008);
-        let scaled = CastShape::Scaled(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales")));
+        let scaled = CastShape::Scaled(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales")), capsule.compute_local_aabb());
         let exact = CastShape::of(&*capsule).expect("a capsule");
         let (mut in_metres, mut in_units) = (0.0f32, 0.0f32);
         for (k, t) in mesh.triangles.iter().enumerate().step_by(7) {
