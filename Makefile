@@ -12,7 +12,7 @@ OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_p
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -84,6 +84,23 @@ wasm-check:
 	rustup target list --installed | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
 	$(CARGO) check --locked -p dqhand --target wasm32-unknown-unknown --no-default-features --features $(subst $() $(),$(comma),$(LIB_FEATURES)) --lib
 
+# The engine in WebAssembly (crates/dqhand-wasm) for Node and for the browser's ES modules, in
+# target/wasm/{node,web}: bound by wasm-bindgen-cli at exactly Cargo.lock's wasm-bindgen
+# version (the two must match), built once into .tools/ (npm's wasm-pack downloads binaries).
+WASM_BINDGEN_VERSION := $(shell awk '$$0 == "name = \"wasm-bindgen\"" { getline; gsub(/[^0-9.]/, ""); print }' Cargo.lock)
+WASM_BINDGEN := $(CURDIR)/.tools/wasm-bindgen-$(WASM_BINDGEN_VERSION)/bin/wasm-bindgen
+WASM_OUT := target/wasm32-unknown-unknown/release/dqhand_wasm.wasm
+
+$(WASM_BINDGEN):
+	$(CARGO) install --locked wasm-bindgen-cli --version $(WASM_BINDGEN_VERSION) --root $(CURDIR)/.tools/wasm-bindgen-$(WASM_BINDGEN_VERSION)
+
+wasm: $(WASM_BINDGEN)
+	rustup target list --installed | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+	$(CARGO) build --locked --release -p dqhand-wasm --target wasm32-unknown-unknown
+	$(WASM_BINDGEN) --target nodejs --out-dir target/wasm/node $(WASM_OUT)
+	$(WASM_BINDGEN) --target web --out-dir target/wasm/web $(WASM_OUT)
+	@ls -l target/wasm/web/dqhand_wasm_bg.wasm | awk '{ printf "dqhand_wasm_bg.wasm: %d bytes, ", $$5 }'; gzip -9c target/wasm/web/dqhand_wasm_bg.wasm | wc -c | awk '{ print $$1 " gzipped" }'
+
 # The library's examples, run (cargo test only builds them).
 examples: recordings
 	mkdir -p out/examples
@@ -96,7 +113,7 @@ examples: recordings
 # doctests' binaries among them, under target/ rather than a small /tmp), the features alone and the
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
 # browser tests against a real `dqhand demo`.
-test: assets viewer chromium recordings
+test: assets viewer chromium recordings wasm
 	mkdir -p target/tmp
 	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) TMPDIR=$(CURDIR)/target/tmp $(CARGO) test --locked --workspace
 	$(MAKE) features examples

@@ -1,0 +1,132 @@
+//! dqhand's engine for JavaScript, in WebAssembly: the built-in anatomical hand, its forward
+//! kinematics and LB, QB or DQB skinning (paper Figure 1, the kinematics and skin layers), with
+//! no server. The same library as the native `dqhand`, compiled for `wasm32-unknown-unknown`
+//! and bound with wasm-bindgen; `make wasm` builds it into `target/wasm/` and a Node test checks
+//! its frames against the native command's.
+//!
+//! ```js
+//! import { Hand, wasmMemory } from "./dqhand_wasm.js";
+//! const hand = Hand.builtin(0.19, 0.085, "right", "full");
+//! const angles = new Float32Array(hand.dofCount);
+//! angles[hand.dofNames().indexOf("index-finger-phalanx-proximal.flex")] = 1.2;
+//! hand.step(angles);
+//! // A view of the skinned positions in the module's memory: no copy. Take it again after a
+//! // call that may grow the memory (a new hand), which detaches old views.
+//! const positions = new Float32Array(wasmMemory().buffer, hand.positionsPtr(), 3 * hand.vertexCount);
+//! ```
+
+use std::sync::Arc;
+
+use dqhand::engine::Engine;
+use dqhand::hand::{build, HandParams};
+use dqhand::kinematics::{JointModel, Pose, Side};
+use dqhand::skin::{Method, MethodSet};
+use wasm_bindgen::prelude::*;
+
+/// A hand: its engine, the pose it was last given and the method it skins with.
+#[wasm_bindgen]
+pub struct Hand {
+    engine: Engine,
+    joint_model: JointModel,
+    pose: Pose,
+    method: Method,
+}
+
+/// The library's error as a JavaScript `Error` with its one-line message.
+fn js(e: dqhand::Error) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+#[wasm_bindgen]
+impl Hand {
+    /// The built-in hand of `length` (wrist crease to middle fingertip, m) and `breadth` (across
+    /// the metacarpal heads, m), `"left"` or `"right"`, posed by joint model `"paper"` (18
+    /// angles, the paper's Table 1) or `"full"` (23), in the rest pose, skinned with DQB.
+    ///
+    /// # Errors
+    /// A side or joint model that is none of those, or measurements that are not a hand's.
+    pub fn builtin(length: f32, breadth: f32, side: &str, joint_model: &str) -> Result<Hand, JsError> {
+        let side = match side {
+            "left" => Side::Left,
+            "right" => Side::Right,
+            other => return Err(JsError::new(&format!("side {other:?}: expected \"left\" or \"right\""))),
+        };
+        let joint_model = joint_model.parse::<JointModel>().map_err(js)?;
+        let model = build(&HandParams { length, breadth, side, ..HandParams::default() }).map_err(js)?;
+        let engine = Engine::new(Arc::new(model), joint_model).map_err(js)?;
+        Ok(Hand { engine, joint_model, pose: Pose::rest(joint_model.dof_count()), method: Method::Dqb })
+    }
+
+    /// How many joint angles a pose has.
+    #[wasm_bindgen(getter, js_name = dofCount)]
+    pub fn dof_count(&self) -> usize {
+        self.pose.angles.len()
+    }
+
+    /// The angles' names, `"<bone>.<flex|abd>"`, in the order [`Self::step`] takes them.
+    #[wasm_bindgen(js_name = dofNames)]
+    pub fn dof_names(&self) -> Vec<String> {
+        self.joint_model.dofs().map(|d| d.name().to_string()).collect()
+    }
+
+    /// The mesh's vertex count.
+    #[wasm_bindgen(getter, js_name = vertexCount)]
+    pub fn vertex_count(&self) -> usize {
+        self.engine.model().mesh.vertex_count()
+    }
+
+    /// The mesh's triangles, three vertex indices each (a copy: they never change).
+    pub fn indices(&self) -> Vec<u32> {
+        self.engine.model().mesh.indices().to_vec()
+    }
+
+    /// Skins with `"lb"`, `"qb"` or `"dqb"` from the next [`Self::step`] on (and now).
+    ///
+    /// # Errors
+    /// Another name.
+    #[wasm_bindgen(js_name = setMethod)]
+    pub fn set_method(&mut self, method: &str) -> Result<(), JsError> {
+        self.method = method.parse::<Method>().map_err(js)?;
+        self.engine.set_methods(MethodSet::new(&[self.method]).map_err(js)?);
+        self.engine.step(&self.pose);
+        Ok(())
+    }
+
+    /// Poses `angles` (radians, in [`Self::dof_names`]' order, clamped to the hand's anatomical
+    /// limits) and skins the mesh: one kinematics pass, one skinning pass, nothing allocated.
+    ///
+    /// # Errors
+    /// Another angle count than [`Self::dof_count`], or an angle that is not finite; the hand
+    /// keeps its last pose then.
+    pub fn step(&mut self, angles: &[f32]) -> Result<(), JsError> {
+        if angles.len() != self.pose.angles.len() {
+            return Err(JsError::new(&format!("angles: {} given, the {} joint model has {}", angles.len(), self.joint_model.as_str(), self.pose.angles.len())));
+        }
+        if let Some(i) = angles.iter().position(|a| !a.is_finite()) {
+            return Err(JsError::new(&format!("angles[{i}] ({}): not a finite number", angles[i])));
+        }
+        self.pose.angles.copy_from_slice(angles);
+        self.engine.step(&self.pose);
+        Ok(())
+    }
+
+    /// Where the skinned positions start in [`wasm_memory`]: `3 * vertexCount` floats, x y z per
+    /// vertex, metres, rewritten in place by each [`Self::step`].
+    #[wasm_bindgen(js_name = positionsPtr)]
+    pub fn positions_ptr(&self) -> *const f32 {
+        self.engine.deformed(self.method).map_or(std::ptr::null(), |d| d.positions().as_ptr().cast())
+    }
+
+    /// Where the skinned unit normals start in [`wasm_memory`], laid out as the positions.
+    #[wasm_bindgen(js_name = normalsPtr)]
+    pub fn normals_ptr(&self) -> *const f32 {
+        self.engine.deformed(self.method).map_or(std::ptr::null(), |d| d.normals().as_ptr().cast())
+    }
+}
+
+/// The module's memory, which [`Hand::positions_ptr`] and [`Hand::normals_ptr`] point into
+/// (`wasmMemory`: the module's own export is already called `memory`).
+#[wasm_bindgen(js_name = wasmMemory)]
+pub fn wasm_memory() -> JsValue {
+    wasm_bindgen::memory()
+}
