@@ -10,8 +10,8 @@
 //! const angles = new Float32Array(hand.dofCount);
 //! angles[hand.dofNames().indexOf("index-finger-phalanx-proximal.flex")] = 1.2;
 //! hand.step(angles);
-//! // A view of the skinned positions in the module's memory: no copy. Take it again after a
-//! // call that may grow the memory (a new hand), which detaches old views.
+//! // A view of the skinned positions in the module's memory: no copy. Take it again after any
+//! // call but `step` (one that allocates may grow the memory, which detaches old views).
 //! const positions = new Float32Array(wasmMemory().buffer, hand.positionsPtr(), 3 * hand.vertexCount);
 //! ```
 
@@ -86,8 +86,9 @@ impl Hand {
     /// Another name.
     #[wasm_bindgen(js_name = setMethod)]
     pub fn set_method(&mut self, method: &str) -> Result<(), JsError> {
-        self.method = method.parse::<Method>().map_err(js)?;
-        self.engine.set_methods(MethodSet::new(&[self.method]).map_err(js)?);
+        let method = method.parse::<Method>().map_err(js)?;
+        self.engine.set_methods(MethodSet::new(&[method]).map_err(js)?);
+        self.method = method;
         self.engine.step(&self.pose);
         Ok(())
     }
@@ -111,16 +112,29 @@ impl Hand {
     }
 
     /// Where the skinned positions start in [`wasm_memory`]: `3 * vertexCount` floats, x y z per
-    /// vertex, metres, rewritten in place by each [`Self::step`].
+    /// vertex, metres, rewritten in place by each [`Self::step`]. Take the view again after any
+    /// other call (a first `setMethod` to a method allocates its buffer, and any allocation may
+    /// grow the memory, which detaches every view).
+    ///
+    /// # Errors
+    /// None in practice: the hand is skinned from its construction on.
     #[wasm_bindgen(js_name = positionsPtr)]
-    pub fn positions_ptr(&self) -> *const f32 {
-        self.engine.deformed(self.method).map_or(std::ptr::null(), |d| d.positions().as_ptr().cast())
+    pub fn positions_ptr(&self) -> Result<*const f32, JsError> {
+        Ok(self.skinned()?.positions().as_ptr().cast())
     }
 
     /// Where the skinned unit normals start in [`wasm_memory`], laid out as the positions.
+    ///
+    /// # Errors
+    /// As [`Self::positions_ptr`].
     #[wasm_bindgen(js_name = normalsPtr)]
-    pub fn normals_ptr(&self) -> *const f32 {
-        self.engine.deformed(self.method).map_or(std::ptr::null(), |d| d.normals().as_ptr().cast())
+    pub fn normals_ptr(&self) -> Result<*const f32, JsError> {
+        Ok(self.skinned()?.normals().as_ptr().cast())
+    }
+
+    /// The mesh as the current method last skinned it.
+    fn skinned(&self) -> Result<&dqhand::skin::Deformed, JsError> {
+        self.engine.deformed(self.method).ok_or_else(|| JsError::new(&format!("method {}: not skinned yet", self.method)))
     }
 }
 

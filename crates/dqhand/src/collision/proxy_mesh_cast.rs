@@ -13,8 +13,10 @@
 //! the proxy on its own, with a stepping search for each one the proxy starts touching: 4–60 ms
 //! frames on the teapot while the hand was held back on it. Here a triangle the proxy starts
 //! touching (within [`TOLERANCE`]) stops it at once unless the motion takes the touching point
-//! away from it; then it is left out until the proxy is clear of it by [`REARM`] (parry's
-//! "directional" cast: a finger resting on the lid may lift off it).
+//! away from it; then it may not stop the proxy until the proxy is clear of it by [`REARM`]
+//! (parry's "directional" cast: a finger resting on the lid may lift off it), but it still does
+//! if the proxy goes deeper into it than it started (a roll that lifts one end of a finger lying
+//! on it and sinks the other).
 
 use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
@@ -46,8 +48,9 @@ struct Candidate {
     at: f32,
     /// How fast the bound falls after `at` (m per unit of time).
     rate: f32,
-    /// Touched at the start by a motion leaving it.
+    /// Touched at the start by a motion leaving it, at this distance (m).
     left: bool,
+    start: f32,
 }
 
 /// A hand's proxies as the advancement queries them, and its buffers, kept between frames
@@ -182,7 +185,7 @@ impl ProxyMeshCast {
         self.candidates.clear();
         self.candidates.extend(mesh.bvh().intersect_aabb(&swept.transform_by(&mesh_pose.inverse())).map(|triangle| {
             let bound = cast.bound(&start, &mesh.triangle(triangle));
-            Candidate { triangle, bound, at: 0.0, rate: speed, left: false }
+            Candidate { triangle, bound, at: 0.0, rate: speed, left: false, start: 0.0 }
         }));
         // Nearest first: a contact at the start is then found after few exact distances.
         self.candidates.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound));
@@ -200,9 +203,23 @@ impl ProxyMeshCast {
                     if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
                         // Its touching point moves off it: a proxy may leave what it rests on.
                         c.left = (motion.linvel + motion.angvel.cross(x - pivot)).dot(n) >= 0.0;
+                        c.start = distance;
                     }
+                    // The plane through its nearest point, square to `n`, holds the triangle on
+                    // its far side; the proxy closes on that plane no faster than this (when
+                    // they overlap there is no such plane: the whole speed).
+                    c.rate = if distance >= 0.0 { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
                     if c.left {
+                        // Left, it may still not go deeper than it started (a turn can lift the
+                        // touching point and sink another end of the proxy).
+                        let floor = c.start.min(0.0) - TOLERANCE;
+                        if distance < floor {
+                            return Some(t);
+                        }
                         if distance <= REARM {
+                            if c.rate > 0.0 {
+                                next = next.min(t + (distance - floor) / c.rate);
+                            }
                             continue;
                         }
                         c.left = false;
@@ -210,9 +227,6 @@ impl ProxyMeshCast {
                     if distance <= TOLERANCE {
                         return Some(t);
                     }
-                    // The plane through its nearest point, square to `n`, holds the triangle on
-                    // its far side; the proxy closes on that plane no faster than this.
-                    c.rate = (turning - motion.linvel.dot(n)).clamp(0.0, speed);
                 }
                 if c.rate > 0.0 {
                     next = next.min(c.at + (c.bound - TOLERANCE) / c.rate);
@@ -286,6 +300,19 @@ mod tests {
         // It stops short by at most what parry's distance may be off by, never past the floor.
         let t = cast(&cube, Vec3::new(0.0, 0.03, 0.0), Vec3::new(0.0, -0.04, 0.0), Vec3::ZERO).expect("it hits");
         assert!(t <= 0.5 && (0.5 - t) * 0.04 <= GJK_ERROR + 2.0 * TOLERANCE, "{t}");
+    }
+
+    #[test]
+    fn a_capsule_lying_on_the_floor_and_rolled_end_over_end_stops_as_its_far_end_sinks() {
+        // Lying along z on the floor, turned about x through its centre: one end rises (the
+        // touching point found first may be there), the other sinks. It must stop at once.
+        let capsule = SharedShape::capsule(Vec3::new(0.0, 0.0, -0.02), Vec3::new(0.0, 0.0, 0.02), 0.01);
+        for turn in [1.0, -1.0] {
+            let t = cast(&capsule, Vec3::new(0.05, 0.01, 0.0), Vec3::ZERO, Vec3::new(turn, 0.0, 0.0));
+            // At most a few steps in: the sinking end goes no deeper than the tolerance.
+            let t = t.expect("it stops");
+            assert!(0.02 * (t).sin() <= 2.0 * TOLERANCE, "turned {t} rad before stopping");
+        }
     }
 
     /// Why hull proxies are queried in [`UNIT`]s: against the Utah teapot's millimetre

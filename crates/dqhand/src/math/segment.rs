@@ -5,9 +5,15 @@ use glam::Vec3;
 /// Distance from `x` to the segment `a`–`b` (to `a` if the segment has no length).
 #[must_use]
 pub fn segment_distance(x: Vec3, a: Vec3, b: Vec3) -> f32 {
+    x.distance(segment_closest(x, a, b))
+}
+
+/// The point of the segment `a`–`b` closest to `x` (`a` if the segment has no length).
+#[must_use]
+pub fn segment_closest(x: Vec3, a: Vec3, b: Vec3) -> Vec3 {
     let ab = b - a;
     let t = ((x - a).dot(ab) / ab.length_squared().max(1e-18)).clamp(0.0, 1.0);
-    x.distance(a + t * ab)
+    a + t * ab
 }
 
 /// The closest points of the segments `p0`–`p1` and `q0`–`q1` (Ericson, *Real-Time Collision
@@ -32,8 +38,8 @@ pub fn segment_segment_closest(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (Vec3,
         } else {
             let b = d1.dot(d2);
             let denom = a * e - b * b;
-            // Parallel segments: any s will do, 0 is as good as another.
-            let s = if denom > EPS * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            // Parallel segments (to f32's precision): any s will do, 0 is as good as another.
+            let s = if denom > 1e-6 * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
             let t = (b * s + f) / e;
             if t < 0.0 {
                 ((-c / a).clamp(0.0, 1.0), 0.0)
@@ -47,11 +53,18 @@ pub fn segment_segment_closest(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (Vec3,
     (p0 + d1 * s, q0 + d2 * t)
 }
 
-/// The point of the triangle `a`, `b`, `c` closest to `x` (Ericson 5.1.5, by Voronoi regions).
+/// The point of the triangle `a`, `b`, `c` closest to `x` (Ericson 5.1.5, by Voronoi regions;
+/// a triangle with no area, by its edges).
 #[must_use]
 pub fn triangle_closest(x: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
     let ab = b - a;
     let ac = c - a;
+    if ab.cross(ac).length_squared() <= 1e-12 * ab.length_squared() * ac.length_squared() {
+        return [segment_closest(x, a, b), segment_closest(x, b, c), segment_closest(x, c, a)]
+            .into_iter()
+            .min_by(|p, q| p.distance_squared(x).total_cmp(&q.distance_squared(x)))
+            .unwrap_or(a);
+    }
     let ap = x - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
@@ -164,5 +177,16 @@ mod tests {
         }
         // Both cases were met: segments through the triangle and clear of it.
         assert!(crossing > 5 && crossing < 295, "{crossing} crossings");
+    }
+
+    #[test]
+    fn a_triangle_without_area_is_its_edges() {
+        let (a, c) = (Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0));
+        for tri in [[a, a, c], [a, c, (a + c) / 2.0]] {
+            let q = triangle_closest(Vec3::new(0.5, 1.0, 0.0), tri);
+            assert!(q.distance(Vec3::new(0.5, 0.0, 0.0)) < 1e-6, "{q}");
+            let (_, q) = segment_triangle_closest(Vec3::new(2.0, 1.0, 0.0), Vec3::new(2.0, -1.0, 0.0), tri);
+            assert!(q.distance(c) < 1e-6, "{q}");
+        }
     }
 }
