@@ -344,4 +344,65 @@ mod tests {
         assert!(in_metres > 0.005, "parry in metres is off by {in_metres} m at most");
         assert!(in_units < GJK_ERROR, "parry in centimetres is off by {in_units} m");
     }
+
+    /// The exact distance from the convex polyhedron `points`/`triangles` (placed at `pose`) to
+    /// `tri`, 0 where they meet: the nearest of its edges to the triangle and of the triangle's
+    /// edges to its faces (two convex polyhedra are nearest at such a pair), or 0 when a corner
+    /// of the triangle is inside it. Written from the definition; shares nothing with GJK.
+    fn polyhedron_triangle(points: &[Vec3], triangles: &[[u32; 3]], pose: &Pose, tri: &Triangle) -> f32 {
+        let p: Vec<Vec3> = points.iter().map(|&x| *pose * x).collect();
+        let corners = [tri.a, tri.b, tri.c];
+        let inside = |x: Vec3| triangles.iter().all(|t| (p[t[1] as usize] - p[t[0] as usize]).cross(p[t[2] as usize] - p[t[0] as usize]).dot(x - p[t[0] as usize]) <= 0.0);
+        if corners.iter().any(|&x| inside(x)) {
+            return 0.0;
+        }
+        let mut best = f32::INFINITY;
+        for t in triangles {
+            let face = [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]];
+            for k in 0..3 {
+                let (a, b) = segment_triangle_closest(face[k], face[(k + 1) % 3], corners);
+                best = best.min(a.distance(b));
+                let (a, b) = segment_triangle_closest(corners[k], corners[(k + 1) % 3], face);
+                best = best.min(a.distance(b));
+            }
+        }
+        best
+    }
+
+    /// The hand's own hull proxies (the index metacarpal's and the wrist's), queried in
+    /// [`UNIT`]s, against the exact distance beside the teapot's triangles from 0.2 mm to 1 cm
+    /// away: never longer than the truth (the advancement's safety), and at most [`GJK_ERROR`]
+    /// shorter.
+    #[test]
+    fn a_hull_proxy_in_units_is_never_farther_than_the_exact_distance() {
+        let model = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
+        let mesh = crate::scene::ObjectMesh::builtin("objects/teapot.obj").expect("the built-in teapot");
+        let v: Vec<Vec3> = mesh.vertices.iter().map(|v| *v * 0.6).collect();
+        let mut checked = 0;
+        for proxy in crate::collision::fit_proxies(&model, crate::collision::PROXY_MARGIN) {
+            let name = &model.skeleton.joints()[proxy.joint].name;
+            let crate::collision::ProxyShape::ConvexHull { points, triangles } = &proxy.shape else { continue };
+            if name != "index-finger-metacarpal" && name != "wrist" {
+                continue;
+            }
+            let shape = SharedShape::convex_mesh(points.clone(), triangles).expect("a hull");
+            let cast = CastShape::of(&*shape).expect("a hull scales");
+            let (lowest, _) = points.iter().fold((f32::INFINITY, Vec3::ZERO), |(y, p), &q| if q.y < y { (q.y, q) } else { (y, p) });
+            for (k, t) in mesh.triangles.iter().enumerate().step_by(97) {
+                let tri = Triangle::new(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+                let normal = face_normal(&tri);
+                let centre = (tri.a + tri.b + tri.c) / 3.0;
+                // The hull's lowest point (its own y) turned to face the triangle, then lifted.
+                let turn = glam::Quat::from_rotation_arc(Vec3::NEG_Y, -normal);
+                let gap = 0.0002 + 0.0098 * (k % 13) as f32 / 12.0;
+                let pose = Pose::from_parts(centre + normal * gap - turn * Vec3::new(0.0, lowest, 0.0), turn);
+                let exact = polyhedron_triangle(points, triangles, &pose, &tri);
+                let (queried, _, _) = cast.to_triangle(&pose, &tri);
+                assert!(queried <= exact + 1e-6, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
+                assert!(exact - queried <= 2.0 * GJK_ERROR, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
+                checked += 1;
+            }
+        }
+        assert!(checked > 40, "{checked} placements");
+    }
 }
