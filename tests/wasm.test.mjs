@@ -1,6 +1,7 @@
 // The engine in WebAssembly (crates/dqhand-wasm, built by `make wasm` for Node) against the
 // native `dqhand skin` on the same poses: every method, positions and normals, angles inside
-// and past the anatomical limits (both clamp). Run by `make test` after the Rust tests (which
+// and past the anatomical limits (both clamp); and its gesture loop against `dqhand replay` on
+// the same recordings: the same events. Run by `make test` after the Rust tests (which
 // build target/debug/dqhand).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -13,7 +14,7 @@ import { fileURLToPath } from 'node:url';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
-const { Hand, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
+const { GestureLoop, Hand, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
 const dqhand = process.env.DQHAND_BIN ?? path.join(root, 'target', 'debug', 'dqhand');
 const out = mkdtempSync(path.join(tmpdir(), 'dqhand-wasm-'));
 
@@ -95,4 +96,30 @@ test('bad input is a one-line Error naming it, and the hand keeps its last pose'
   assert.throws(() => Hand.builtin(-1, 0.085, 'left', 'full'), (e) => e instanceof Error && !e.message.includes('\n'));
   const after = new Float32Array(wasmMemory().buffer, hand.positionsPtr(), 3 * hand.vertexCount);
   assert.equal(largestGap(before, after), 0);
+});
+
+for (const name of ['gestures-joints.jsonl', 'gestures-landmarks.jsonl']) {
+  test(`the WASM gesture loop gives dqhand replay's events on ${name}, and goes on past a bad line`, () => {
+    const recording = path.join(root, 'crates', 'dqhand', 'data', 'recordings', name);
+    const expected = execFileSync(dqhand, ['replay', '--gestures', '--input', recording], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] });
+    const lines = readFileSync(recording, 'utf8').split('\n').filter((l) => l.trim() !== '');
+    const loop = new GestureLoop('right');
+    let events = '';
+    let refused = 0;
+    lines.forEach((line, i) => {
+      events += loop.push(line);
+      // A broken line after every 500th: refused with one line, and the loop goes on.
+      if (i % 500 === 499) {
+        assert.throws(() => loop.push(line.slice(0, 40)), (e) => e instanceof Error && !e.message.includes('\n'));
+        refused += 1;
+      }
+    });
+    assert.ok(refused >= 3);
+    assert.ok(expected.split('\n').length > 10, `the recording names gestures (${expected.length} bytes of events)`);
+    assert.equal(events, expected);
+  });
+}
+
+test('a gesture loop for a side that is none is refused', () => {
+  assert.throws(() => new GestureLoop('up'), /side "up"/);
 });

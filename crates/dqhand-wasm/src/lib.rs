@@ -1,8 +1,8 @@
 //! dqhand's engine for JavaScript, in WebAssembly: the built-in anatomical hand, its forward
-//! kinematics and LB, QB or DQB skinning (paper Figure 1, the kinematics and skin layers), with
-//! no server. The same library as the native `dqhand`, compiled for `wasm32-unknown-unknown`
+//! kinematics and LB, QB or DQB skinning (paper Figure 1, the kinematics and skin layers), and
+//! the gesture loop, with no server. The same library as the native `dqhand`, compiled for `wasm32-unknown-unknown`
 //! and bound with wasm-bindgen; `make wasm` builds it into `target/wasm/` and a Node test checks
-//! its frames against the native command's.
+//! its frames and gesture events against the native commands'.
 //!
 //! ```js
 //! import { Hand, wasmMemory } from "./dqhand_wasm.js";
@@ -18,7 +18,11 @@
 use std::sync::Arc;
 
 use dqhand::engine::Engine;
+use dqhand::gesture::GestureSet;
 use dqhand::hand::{build, HandParams};
+use dqhand::input::json_record::JsonRecordReader;
+use dqhand::input::{InputConfig, Record};
+use dqhand::interaction::GestureLoop;
 use dqhand::kinematics::{JointModel, Pose, Side};
 use dqhand::skin::{Method, MethodSet};
 use wasm_bindgen::prelude::*;
@@ -30,6 +34,15 @@ pub struct Hand {
     joint_model: JointModel,
     pose: Pose,
     method: Method,
+}
+
+/// `"left"` or `"right"`.
+fn side_of(side: &str) -> Result<Side, JsError> {
+    match side {
+        "left" => Ok(Side::Left),
+        "right" => Ok(Side::Right),
+        other => Err(JsError::new(&format!("side {other:?}: expected \"left\" or \"right\""))),
+    }
 }
 
 /// The library's error as a JavaScript `Error` with its one-line message.
@@ -46,11 +59,7 @@ impl Hand {
     /// # Errors
     /// A side or joint model that is none of those, or measurements that are not a hand's.
     pub fn builtin(length: f32, breadth: f32, side: &str, joint_model: &str) -> Result<Hand, JsError> {
-        let side = match side {
-            "left" => Side::Left,
-            "right" => Side::Right,
-            other => return Err(JsError::new(&format!("side {other:?}: expected \"left\" or \"right\""))),
-        };
+        let side = side_of(side)?;
         let joint_model = joint_model.parse::<JointModel>().map_err(js)?;
         let model = build(&HandParams { length, breadth, side, ..HandParams::default() }).map_err(js)?;
         let engine = Engine::new(Arc::new(model), joint_model).map_err(js)?;
@@ -143,4 +152,59 @@ impl Hand {
 #[wasm_bindgen(js_name = wasmMemory)]
 pub fn wasm_memory() -> JsValue {
     wasm_bindgen::memory()
+}
+
+/// The gesture loop (the paper's gesture interaction): records of a user's hand (WebXR or
+/// OpenXR joints, MediaPipe landmarks, as JSON lines, docs/formats.md) through the input
+/// pipeline (checks, filters, retargeting onto the built-in hand), forward kinematics, the finger
+/// features and the recogniser of the built-in gestures: the same loop as `dqhand replay`.
+#[wasm_bindgen(js_name = GestureLoop)]
+pub struct Gestures {
+    inner: GestureLoop,
+    side: Side,
+    record: Record,
+}
+
+#[wasm_bindgen(js_class = GestureLoop)]
+impl Gestures {
+    /// A loop driving the built-in `side` hand (`"left"` or `"right"`: also the side of records
+    /// that do not say), recognising the built-in gestures.
+    ///
+    /// # Errors
+    /// Another side.
+    #[wasm_bindgen(constructor)]
+    pub fn new(side: &str) -> Result<Gestures, JsError> {
+        let side = side_of(side)?;
+        let model = build(&HandParams { side, ..HandParams::default() }).map_err(js)?;
+        let inner = GestureLoop::new(Arc::new(model), JointModel::Full, None, InputConfig::default(), Some(GestureSet::builtin())).map_err(js)?;
+        Ok(Gestures { inner, side, record: Record { time: 0.0, side, hand: None, tracker: None, arrival: None } })
+    }
+
+    /// One record (a line of a recording): the gesture events it starts or ends, as JSON
+    /// lines, `dqhand replay`'s output (empty when none).
+    ///
+    /// # Errors
+    /// A record that cannot be read or is refused (its problem on one line); the loop goes on
+    /// as the native one does.
+    pub fn push(&mut self, line: &str) -> Result<String, JsError> {
+        let mut reader = JsonRecordReader::new(line.as_bytes(), self.side, Vec::new());
+        let read = reader.next_record(&mut self.record).map_err(|e| JsError::new(&e.to_string()))?;
+        let Some(read) = read else { return Ok(String::new()) };
+        if let Err(rejection) = read {
+            let message = rejection.to_string();
+            self.inner.reject(rejection);
+            return Err(JsError::new(&message));
+        }
+        match self.inner.push(&self.record) {
+            Ok(events) => {
+                let mut out = String::new();
+                for event in events {
+                    out.push_str(&serde_json::to_string(&event).map_err(|e| JsError::new(&e.to_string()))?);
+                    out.push('\n');
+                }
+                Ok(out)
+            }
+            Err(rejection) => Err(JsError::new(&rejection.to_string())),
+        }
+    }
 }
