@@ -20,7 +20,7 @@ use std::sync::Arc;
 use dqhand::engine::Engine;
 use dqhand::gesture::GestureSet;
 use dqhand::hand::{build, HandParams};
-use dqhand::input::json_record::JsonRecordReader;
+use dqhand::input::json_record::parse_record;
 use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::GestureLoop;
 use dqhand::kinematics::{JointModel, Pose, Side};
@@ -187,10 +187,10 @@ impl Gestures {
     /// A record that cannot be read or is refused (its problem on one line); the loop goes on
     /// as the native one does.
     pub fn push(&mut self, line: &str) -> Result<String, JsError> {
-        let mut reader = JsonRecordReader::new(line.as_bytes(), self.side, Vec::new());
-        let read = reader.next_record(&mut self.record).map_err(|e| JsError::new(&e.to_string()))?;
-        let Some(read) = read else { return Ok(String::new()) };
-        if let Err(rejection) = read {
+        if line.trim().is_empty() {
+            return Ok(String::new());
+        }
+        if let Err(rejection) = parse_record::<&str>(line.trim(), self.side, &[], &mut self.record) {
             let message = rejection.to_string();
             self.inner.reject(rejection);
             return Err(JsError::new(&message));

@@ -367,8 +367,9 @@ impl ContactConstraint {
             // would test every triangle the swept box meets).
             let reach = (linvel.length() + angvel.length() * radius) * toi;
             for (_, o) in objects.near(&swept, 0.0, held) {
+                let mesh = o.surface.as_trimesh();
                 // A mesh's own advancement starts with its distance: the hull's is enough here.
-                let (gap, slack) = match o.surface.as_trimesh() {
+                let (gap, slack) = match mesh {
                     Some(_) => (o.hull_distance(&from, &*p.shape).unwrap_or(0.0), MESH_DISTANCE_SLACK),
                     None => (o.distance_at_least(&from, &*p.shape, reach), 0.0),
                 };
@@ -383,7 +384,7 @@ impl ContactConstraint {
                 if misses_hull {
                     continue;
                 }
-                let hit = match o.surface.as_trimesh() {
+                let hit = match mesh {
                     Some(mesh) => self.mesh_cast.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };

@@ -48,9 +48,8 @@ struct Candidate {
     at: f32,
     /// How fast the bound falls after `at` (m per unit of time).
     rate: f32,
-    /// Touched at the start by a motion leaving it, at this distance (m).
-    left: bool,
-    start: f32,
+    /// Touched at the start by a motion leaving it: the distance it was touched at (m).
+    left: Option<f32>,
 }
 
 /// A hand's proxies as the advancement queries them, and its buffers, kept between frames
@@ -185,7 +184,7 @@ impl ProxyMeshCast {
         self.candidates.clear();
         self.candidates.extend(mesh.bvh().intersect_aabb(&swept.transform_by(&mesh_pose.inverse())).map(|triangle| {
             let bound = cast.bound(&start, &mesh.triangle(triangle));
-            Candidate { triangle, bound, at: 0.0, rate: speed, left: false, start: 0.0 }
+            Candidate { triangle, bound, at: 0.0, rate: speed, left: None }
         }));
         // Nearest first: a contact at the start is then found after few exact distances.
         self.candidates.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound));
@@ -196,23 +195,22 @@ impl ProxyMeshCast {
             // The earliest time another triangle's bound can come down to the tolerance.
             let mut next = end;
             for c in &mut self.candidates {
-                if c.left || c.bound - c.rate * (t - c.at) <= DUE * TOLERANCE {
+                if c.left.is_some() || c.bound - c.rate * (t - c.at) <= DUE * TOLERANCE {
                     let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangle(c.triangle));
                     (c.bound, c.at) = (distance, t);
                     let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
                     if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
                         // Its touching point moves off it: a proxy may leave what it rests on.
-                        c.left = (motion.linvel + motion.angvel.cross(x - pivot)).dot(n) >= 0.0;
-                        c.start = distance;
+                        c.left = ((motion.linvel + motion.angvel.cross(x - pivot)).dot(n) >= 0.0).then_some(distance);
                     }
                     // The plane through its nearest point, square to `n`, holds the triangle on
                     // its far side; the proxy closes on that plane no faster than this (when
                     // they overlap there is no such plane: the whole speed).
                     c.rate = if distance >= 0.0 { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
-                    if c.left {
+                    if let Some(start) = c.left {
                         // Left, it may still not go deeper than it started (a turn can lift the
                         // touching point and sink another end of the proxy).
-                        let floor = c.start.min(0.0) - TOLERANCE;
+                        let floor = start.min(0.0) - TOLERANCE;
                         if distance < floor {
                             return Some(t);
                         }
@@ -222,7 +220,7 @@ impl ProxyMeshCast {
                             }
                             continue;
                         }
-                        c.left = false;
+                        c.left = None;
                     }
                     if distance <= TOLERANCE {
                         return Some(t);
@@ -315,20 +313,25 @@ mod tests {
         }
     }
 
+    /// The Utah teapot's triangles (data from outside the project), at the size the built-in
+    /// scenes give it (scale 0.6: about 25 cm across, triangles of millimetres).
+    fn teapot_triangles() -> Vec<Triangle> {
+        let mesh = crate::scene::ObjectMesh::builtin("objects/teapot.obj").expect("the built-in teapot");
+        let v = |i: u32| mesh.vertices[i as usize] * 0.6;
+        mesh.triangles.iter().map(|t| Triangle::new(v(t[0]), v(t[1]), v(t[2]))).collect()
+    }
+
     /// Why hull proxies are queried in [`UNIT`]s: against the Utah teapot's millimetre
     /// triangles, parry's distance from a capsule in metres is centimetres off somewhere, and in
     /// centimetres within [`GJK_ERROR`] everywhere (the exact distance is the reference). If parry
     /// fixes this, the first assertion fails and the scaling can go.
     #[test]
     fn parry_distance_to_small_triangles_needs_a_larger_unit() {
-        let mesh = crate::scene::ObjectMesh::builtin("objects/teapot.obj").expect("the built-in teapot");
-        let v: Vec<Vec3> = mesh.vertices.iter().map(|v| *v * 0.6).collect();
         let capsule = SharedShape::capsule(Vec3::new(0.0, -0.015, 0.0), Vec3::new(0.0, 0.015, 0.0), 0.008);
         let scaled = CastShape::Scaled(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales")), capsule.compute_local_aabb());
         let exact = CastShape::of(&*capsule).expect("a capsule");
         let (mut in_metres, mut in_units) = (0.0f32, 0.0f32);
-        for (k, t) in mesh.triangles.iter().enumerate().step_by(7) {
-            let tri = Triangle::new(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+        for (k, tri) in teapot_triangles().into_iter().enumerate().step_by(7) {
             let centre = (tri.a + tri.b + tri.c) / 3.0;
             let normal = face_normal(&tri);
             // Beside the triangle, 1–2 cm off along its normal, tilted by the triangle's index.
@@ -376,8 +379,7 @@ mod tests {
     #[test]
     fn a_hull_proxy_in_units_is_never_farther_than_the_exact_distance() {
         let model = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
-        let mesh = crate::scene::ObjectMesh::builtin("objects/teapot.obj").expect("the built-in teapot");
-        let v: Vec<Vec3> = mesh.vertices.iter().map(|v| *v * 0.6).collect();
+        let teapot = teapot_triangles();
         let mut checked = 0;
         for proxy in crate::collision::fit_proxies(&model, crate::collision::PROXY_MARGIN) {
             let name = &model.skeleton.joints()[proxy.joint].name;
@@ -388,16 +390,15 @@ mod tests {
             let shape = SharedShape::convex_mesh(points.clone(), triangles).expect("a hull");
             let cast = CastShape::of(&*shape).expect("a hull scales");
             let (lowest, _) = points.iter().fold((f32::INFINITY, Vec3::ZERO), |(y, p), &q| if q.y < y { (q.y, q) } else { (y, p) });
-            for (k, t) in mesh.triangles.iter().enumerate().step_by(97) {
-                let tri = Triangle::new(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
-                let normal = face_normal(&tri);
+            for (k, tri) in teapot.iter().enumerate().step_by(97) {
+                let normal = face_normal(tri);
                 let centre = (tri.a + tri.b + tri.c) / 3.0;
                 // The hull's lowest point (its own y) turned to face the triangle, then lifted.
                 let turn = glam::Quat::from_rotation_arc(Vec3::NEG_Y, -normal);
                 let gap = 0.0002 + 0.0098 * (k % 13) as f32 / 12.0;
                 let pose = Pose::from_parts(centre + normal * gap - turn * Vec3::new(0.0, lowest, 0.0), turn);
-                let exact = polyhedron_triangle(points, triangles, &pose, &tri);
-                let (queried, _, _) = cast.to_triangle(&pose, &tri);
+                let exact = polyhedron_triangle(points, triangles, &pose, tri);
+                let (queried, _, _) = cast.to_triangle(&pose, tri);
                 assert!(queried <= exact + 1e-6, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
                 assert!(exact - queried <= 2.0 * GJK_ERROR, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
                 checked += 1;
