@@ -127,9 +127,11 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     let flat: benchmark::FlatMesh = (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect());
     let (mut deepest, mut turned, mut held_frames, mut slid, mut off_surface, mut turned_normal) = (0.0f32, 0.0f32, 0, 0.0f32, 0.0f32, 0.0f32);
     let proxies = dqhand::collision::HandProxies::new(&dqhand::collision::fit_proxies(&model(), dqhand::collision::PROXY_MARGIN), &model().skeleton);
+    let query = dqhand::collision::ProxyMeshQuery::new(&proxies);
     let mut in_wrist: Option<glam::Quat> = None;
-    // Where each joint touching the held teapot was last frame, in the teapot's frame.
-    let mut touching: Vec<(usize, Vec3)> = Vec::new();
+    // Where each joint touching the held teapot was last frame and the teapot's normal there,
+    // in the teapot's frame.
+    let mut touching: Vec<(usize, Vec3, Vec3)> = Vec::new();
     run(&scene, &s, |m, t, _| {
         let skin = dqb(&mut skin_layer, m).positions().to_vec();
         let teapot = &m.objects().objects()[0];
@@ -144,22 +146,26 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
             let here = r.inverse() * m.poses()[0].0;
             let first = *in_wrist.get_or_insert(here);
             turned = turned.max(first.angle_between(here));
-            // Until the fingers open to let go, the joints touching stay where they are on it.
+            // Until the fingers open to let go, the joints that stopped on it (within the stop
+            // distance: one farther off, though within the contact distance, is still closing
+            // onto it) do not slide over it.
             let (q, p) = m.poses()[0];
             let on_teapot = |j: usize| q.inverse() * (Vec3::from(m.hands()[0].constraint().world()[j].translation) - p);
-            for &(j, was) in touching.iter().filter(|_| t < s.times.release) {
-                slid = slid.max(on_teapot(j).distance(was));
+            for &(j, was, normal) in touching.iter().filter(|_| t < s.times.release) {
+                let moved = on_teapot(j) - was;
+                slid = slid.max((moved - normal * moved.dot(normal)).length());
             }
-            touching = m.hands()[0].contacts().iter().filter(|c| c.object == 0).map(|c| (c.joint, on_teapot(c.joint))).collect();
+            touching = m.hands()[0].contacts().iter().filter(|c| c.object == 0 && c.distance <= dqhand::collision::STOP_DISTANCE).map(|c| (c.joint, on_teapot(c.joint), q.inverse() * c.normal)).collect();
             // Its contacts (kept from frame to frame while the grip holds still) are what a
             // fresh query of the joint's proxies finds: the same point and normal.
             let teapot = &m.objects().objects()[0];
+            let mesh = teapot.surface.as_trimesh().unwrap();
             for c in m.hands()[0].contacts() {
-                let fresh = proxies.colliders().iter().filter(|p| p.joint == c.joint).filter_map(|p| {
+                let fresh = proxies.colliders().iter().enumerate().filter(|(_, p)| p.joint == c.joint).filter_map(|(k, p)| {
                     let pose = dqhand::collision::pose_of(&m.hands()[0].constraint().world()[p.joint]);
-                    parry3d::query::contact(&pose, &*p.shape, &teapot.pose, &*teapot.surface, dqhand::collision::CONTACT_DISTANCE).ok().flatten()
+                    query.nearest(k, &*p.shape, &pose, mesh, &teapot.pose, dqhand::collision::CONTACT_DISTANCE)
                 });
-                let miss = fresh.map(|f| (f.point2.distance(c.point), f.normal1.angle_between(-c.normal))).fold((f32::INFINITY, f32::INFINITY), |a, b| if b.0 < a.0 { b } else { a });
+                let miss = fresh.map(|f| (f.point.distance(c.point), f.normal.angle_between(c.normal))).fold((f32::INFINITY, f32::INFINITY), |a, b| if b.0 < a.0 { b } else { a });
                 off_surface = off_surface.max(miss.0);
                 turned_normal = turned_normal.max(miss.1);
             }

@@ -5,7 +5,7 @@
 //! the end of it only, so nothing fast or thin is passed through):
 //! 1. **Wrist.** The hand's proxies, its fingers as last rendered, move rigidly from the last
 //!    rendered wrist to the tracked one (a screw: rotation about the wrist, translation of
-//!    it); parry's nonlinear shape cast (against a mesh, [`ProxyMeshCast`]'s advancement)
+//!    it); parry's nonlinear shape cast (against a mesh, [`ProxyMeshQuery`]'s advancement)
 //!    gives the first time of impact with any object or the table, and the wrist stops just
 //!    before it (a gap of [`STOP_DISTANCE`], so that the
 //!    next frame's cast starts clear of the surface: a cast that starts touching may let the
@@ -17,12 +17,17 @@
 //! 2. **Fingers.** Each finger closes along its flexion, from open to the tracked angles, by
 //!    conservative advancement: the distance of its proxies to the objects over an upper bound
 //!    of how fast any of their points moves per unit of the closure gives a step that cannot
-//!    pass through anything. At the first contact the joints proximal to the touching phalanx
+//!    pass through anything. A proxy is measured again only once that bound may have fallen to
+//!    the stop distance; against a mesh its distance is [`ProxyMeshQuery`]'s (exact for a
+//!    capsule; parry's in metres is centimetres long there). At the first contact the joints proximal to the touching phalanx
 //!    stop and the distal ones close on, so the finger wraps the object. Where the open
 //!    finger would itself be in an object (a thumb lying on the ball under the palm) the
 //!    closure starts from the finger as last rendered, which the wrist stage kept clear; a
 //!    finger touching the held object starts there too, and keeps its grip. The ring and
 //!    little fingers' chains begin at their CMC joints, which arch the palm as they close.
+//!
+//! The contacts of the rendered pose are every proxy within [`CONTACT_DISTANCE`] of an object:
+//! against a mesh, the nearest point [`ProxyMeshQuery`] finds.
 //!
 //! The tracked pose is left as it is: the grasp logic reads it.
 
@@ -30,7 +35,7 @@ use glam::{Affine3A, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{self, NonlinearRigidMotion};
 
-use super::proxy_mesh_cast::ProxyMeshCast;
+use super::proxy_mesh_query::ProxyMeshQuery;
 use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectColliders, FINGERS};
 use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
@@ -54,8 +59,13 @@ const MAX_ADVANCES: usize = 40;
 
 /// How much farther than it can move a proxy must be from a mesh object's hull for its cast to
 /// be skipped (m): parry's GJK distance in metres to small faces can be centimetres long (see
-/// `proxy_mesh_cast`'s `UNIT`); no cast is skipped on such an answer.
+/// `proxy_mesh_query`'s `UNIT`); no cast is skipped on such an answer.
 const MESH_DISTANCE_SLACK: f32 = 0.01;
+
+/// How far a finger's proxy looks for a mesh object's nearest triangle (m): a proxy farther
+/// than this advances as if it were this far (one more step, where a search of the whole
+/// mesh would cost more than it saves).
+const MESH_LOOKOUT: f32 = 0.03;
 
 /// Seconds the rendered wrist may be held back before it jumps to a free tracked pose.
 pub const SNAP_AFTER_S: f64 = 0.5;
@@ -101,7 +111,13 @@ struct FingerChain {
     proxies: Vec<(usize, usize, Vec<f32>)>,
     /// The largest distance of any of its proxies' points from its first DOF's joint.
     reach: f32,
+    /// Per proxy, during the closure: a lower bound of its distance to the objects and the
+    /// closure parameter it was measured at (it falls no faster than the proxy moves).
+    bounds: Vec<(f32, f32)>,
 }
+
+/// A bound that must be measured.
+const UNMEASURED: (f32, f32) = (f32::NEG_INFINITY, 0.0);
 
 /// Solves the rendered pose from the tracked one each frame; every buffer is allocated once.
 #[derive(Clone)]
@@ -140,7 +156,7 @@ pub struct ContactConstraint {
     last_contacts: Vec<Contact>,
     closure: [Closure; 5],
     near: Vec<usize>,
-    mesh_cast: ProxyMeshCast,
+    mesh_query: ProxyMeshQuery,
 }
 
 impl ContactConstraint {
@@ -209,13 +225,14 @@ impl ContactConstraint {
                     reach = reach.max(levers[0]);
                     Some((i, last, levers))
                 })
-                .collect();
-            FingerChain { dofs, others, proxies, reach }
+                .collect::<Vec<_>>();
+            let bounds = vec![UNMEASURED; proxies.len()];
+            FingerChain { dofs, others, proxies, reach, bounds }
         });
         let n = skeleton.len();
         let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
         Self {
-            mesh_cast: ProxyMeshCast::new(&proxies),
+            mesh_query: ProxyMeshQuery::new(&proxies),
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
@@ -385,7 +402,7 @@ impl ContactConstraint {
                     continue;
                 }
                 let hit = match mesh {
-                    Some(mesh) => self.mesh_cast.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
+                    Some(mesh) => self.mesh_query.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };
                 if let Some(hit) = hit {
@@ -432,7 +449,7 @@ impl ContactConstraint {
     /// they are kept without a query, and only the joints past them close (none, when every
     /// joint had stopped on it).
     fn close_finger(&mut self, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
-        let chain = std::mem::take(&mut self.fingers[f]);
+        let mut chain = std::mem::take(&mut self.fingers[f]);
         if chain.dofs.is_empty() {
             self.fingers[f] = chain;
             return;
@@ -490,30 +507,45 @@ impl ContactConstraint {
                 }
                 checking = None;
             }
+            chain.bounds.fill(UNMEASURED);
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
                 self.forward_trial();
-                // The nearest moving proxy (its distance, last DOF and the object), and the
-                // largest step no point of any can overrun.
+                // The nearest proxy measured (its distance, last DOF and the object), and the
+                // largest step no point of any can overrun. A proxy is measured only where its
+                // bound may have come down to the stop distance: the others cannot stop the
+                // finger here, and their bounds still limit the step.
                 let mut nearest = (f32::INFINITY, 0, usize::MAX);
                 let mut step = f32::INFINITY;
-                for (p, last, levers) in &chain.proxies {
+                for ((p, last, levers), (bound, at)) in chain.proxies.iter().zip(chain.bounds.iter_mut()) {
                     if *last < active {
+                        continue;
+                    }
+                    let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
+                    let remaining = *bound - speed * (s - *at);
+                    if remaining > STOP_DISTANCE {
+                        if speed > 0.0 {
+                            step = step.min(remaining / speed);
+                        }
                         continue;
                     }
                     let proxy = &self.proxies.colliders()[*p];
                     let pose = pose_of(&self.trial_world[proxy.joint]);
                     let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                     for &o in &self.near {
-                        let here = objects.collider(o).distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE);
+                        let c = objects.collider(o);
+                        let here = match c.surface.as_trimesh() {
+                            Some(mesh) => self.mesh_query.distance_at_least(*p, &*proxy.shape, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
+                            None => c.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE),
+                        };
                         if here < d {
                             (d, to) = (here, o);
                         }
                     }
+                    (*bound, *at) = (d, s);
                     if d < nearest.0 {
                         nearest = (d, *last, to);
                     }
-                    let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
                     if speed > 0.0 {
                         step = step.min(d / speed);
                     }
@@ -528,6 +560,7 @@ impl ContactConstraint {
                             break;
                         }
                         checking = Some(tried + 1);
+                        chain.bounds.fill(UNMEASURED);
                         continue;
                     }
                 }
@@ -541,6 +574,7 @@ impl ContactConstraint {
                     }
                     active = nearest.1 + 1;
                     s = 0.0;
+                    chain.bounds.fill(UNMEASURED);
                     if active >= chain.dofs.len() {
                         break;
                     }
@@ -580,11 +614,17 @@ impl ContactConstraint {
                 self.contacts.push(Contact { point, normal: turn * c.normal, ..*c });
             }
         }
-        for p in self.proxies.colliders() {
+        for (k, p) in self.proxies.colliders().iter().enumerate() {
             let pose = pose_of(&self.kinematics.world()[p.joint]);
             let aabb = p.shape.compute_aabb(&pose);
             let skip = still_on.map(|(o, _)| o).filter(|_| unmoved(p.joint));
             for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, skip).filter(|(i, _)| *i < objects.objects().len()) {
+                if let Some(mesh) = o.surface.as_trimesh() {
+                    if let Some(n) = self.mesh_query.nearest(k, &*p.shape, &pose, mesh, &o.pose, CONTACT_DISTANCE) {
+                        self.contacts.push(Contact { joint: p.joint, part: p.part, object: i, point: n.point, normal: n.normal, distance: n.distance });
+                    }
+                    continue;
+                }
                 if o.distance_at_least(&pose, &*p.shape, CONTACT_DISTANCE) > CONTACT_DISTANCE {
                     continue;
                 }

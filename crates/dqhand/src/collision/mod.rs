@@ -4,16 +4,18 @@
 //! * [`proxy`](fit_proxies) — one convex proxy per bone, fitted to a skinned mesh;
 //! * [`HandProxies`] and [`ObjectColliders`] — the hand's and the scene's shapes, built once;
 //! * [`ContactConstraint`] — continuous collision detection of the hand's motion against the
-//!   objects, which gives the rendered hand (it never sinks in) and its contacts; against a
-//!   mesh, its wrist stage advances each proxy over the triangles itself (`proxy_mesh_cast`).
+//!   objects, which gives the rendered hand (it never sinks in) and its contacts;
+//! * [`ProxyMeshQuery`] — a proxy against a triangle mesh (the nearest triangle, the time of
+//!   impact), its own rather than parry's, whose GJK in metres is centimetres off there.
 
 mod contact_constraint;
 mod hand_proxies;
 mod object_colliders;
 mod proxy;
-mod proxy_mesh_cast;
+mod proxy_mesh_query;
 
-pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S};
+pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S, STOP_DISTANCE};
 pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
 pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};
+pub use proxy_mesh_query::{MeshNearest, ProxyMeshQuery};
