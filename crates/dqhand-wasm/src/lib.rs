@@ -24,7 +24,8 @@ use dqhand::input::json_record::parse_record;
 use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::GestureLoop;
 use dqhand::kinematics::{JointModel, Pose, Side};
-use dqhand::skin::{Method, MethodSet};
+use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinnedMesh};
+use glam::Affine3A;
 use wasm_bindgen::prelude::*;
 
 /// A hand: its engine, the pose it was last given and the method it skins with.
@@ -144,6 +145,138 @@ impl Hand {
     /// The mesh as the current method last skinned it.
     fn skinned(&self) -> Result<&dqhand::skin::Deformed, JsError> {
         self.engine.deformed(self.method).ok_or_else(|| JsError::new(&format!("method {}: not skinned yet", self.method)))
+    }
+}
+
+/// The built-in hand's skin alone, deformed by skinning transforms the caller gives (not the
+/// hand's kinematics): for testing the deformers against a reference of one's own, with every
+/// rotation, and for comparing the kernels this build has.
+#[wasm_bindgen]
+pub struct Skinner {
+    mesh: Arc<SkinnedMesh>,
+    method: Method,
+    deformer: Deformer,
+    out: Deformed,
+    transforms: Vec<Affine3A>,
+}
+
+#[wasm_bindgen]
+impl Skinner {
+    /// The built-in hand's skin (as [`Hand::builtin`]), DQB with the fastest kernel this
+    /// build has, every transform the identity.
+    ///
+    /// # Errors
+    /// As [`Hand::builtin`].
+    pub fn builtin(length: f32, breadth: f32, side: &str) -> Result<Skinner, JsError> {
+        let model = build(&HandParams { length, breadth, side: side_of(side)?, ..HandParams::default() }).map_err(js)?;
+        let mesh = model.mesh;
+        let transforms = vec![Affine3A::IDENTITY; mesh.inverse_bind().len()];
+        let (deformer, out) = (Deformer::new(Method::Dqb, &mesh), Deformed::new(&mesh));
+        Ok(Skinner { mesh, method: Method::Dqb, deformer, out, transforms })
+    }
+
+    /// The kernels this build runs, slowest first (`"portable"`, and `"simd128"` in the SIMD
+    /// build).
+    pub fn kernels() -> Vec<String> {
+        Kernel::ALL.into_iter().filter(|k| k.available()).map(|k| k.name().to_owned()).collect()
+    }
+
+    /// How many joints (transforms) the skin has.
+    #[wasm_bindgen(getter, js_name = jointCount)]
+    pub fn joint_count(&self) -> usize {
+        self.transforms.len()
+    }
+
+    /// The mesh's vertex count.
+    #[wasm_bindgen(getter, js_name = vertexCount)]
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+
+    /// The rest positions, x y z per vertex (bind space, m): what the transforms move.
+    #[wasm_bindgen(js_name = restPositions)]
+    pub fn rest_positions(&self) -> Vec<f32> {
+        self.mesh.positions().into_iter().flatten().collect()
+    }
+
+    /// The rest unit normals, laid out as the positions.
+    #[wasm_bindgen(js_name = restNormals)]
+    pub fn rest_normals(&self) -> Vec<f32> {
+        self.mesh.normals().into_iter().flatten().collect()
+    }
+
+    /// Every vertex's influences as the deformers blend them, heaviest first (the one the
+    /// quaternion methods align the others' signs to): `influenceCount` pairs of joint index
+    /// and weight per vertex, unused pairs (−1, 0).
+    pub fn influences(&self) -> Vec<f32> {
+        let k = self.mesh.influences_per_vertex();
+        let mut all = Vec::with_capacity(self.mesh.vertex_count() * k * 2);
+        for v in 0..self.mesh.vertex_count() {
+            let before = all.len();
+            all.extend(self.mesh.influences(v).flat_map(|(j, w)| [j as f32, w]));
+            all.resize(before + 2 * k, 0.0);
+            for unused in all[before..].chunks_exact_mut(2).filter(|p| p[1] == 0.0) {
+                unused[0] = -1.0;
+            }
+        }
+        all
+    }
+
+    /// How many influences [`Self::influences`] gives each vertex.
+    #[wasm_bindgen(getter, js_name = influenceCount)]
+    pub fn influence_count(&self) -> usize {
+        self.mesh.influences_per_vertex()
+    }
+
+    /// Deforms with `"lb"`, `"qb"` or `"dqb"` and kernel `kernel` (one of [`Self::kernels`])
+    /// from the next [`Self::deform`] on.
+    ///
+    /// # Errors
+    /// Another method, or a kernel this build does not run; nothing changes then.
+    #[wasm_bindgen(js_name = setMethod)]
+    pub fn set_method(&mut self, method: &str, kernel: &str) -> Result<(), JsError> {
+        let method = method.parse::<Method>().map_err(js)?;
+        let kernel = Kernel::named(kernel).filter(|k| k.available()).ok_or_else(|| JsError::new(&format!("kernel {kernel:?}: this build runs {}", Self::kernels().join(", "))))?;
+        self.method = method;
+        self.deformer = Deformer::new(method, &self.mesh).with_kernel(kernel);
+        Ok(())
+    }
+
+    /// Deforms the skin by `transforms`: per joint the skinning transform (world × inverse
+    /// bind) as the 3 × 4 matrix `[R | t]`, row by row (12 floats). Allocates nothing.
+    ///
+    /// # Errors
+    /// Another length than 12 × `jointCount`, or a number that is not finite; the skin keeps
+    /// its last deformation then.
+    pub fn deform(&mut self, transforms: &[f32]) -> Result<(), JsError> {
+        if transforms.len() != 12 * self.transforms.len() {
+            return Err(JsError::new(&format!("transforms: {} floats given, {} joints need {}", transforms.len(), self.transforms.len(), 12 * self.transforms.len())));
+        }
+        if let Some(i) = transforms.iter().position(|a| !a.is_finite()) {
+            return Err(JsError::new(&format!("transforms[{i}] ({}): not a finite number", transforms[i])));
+        }
+        for (t, m) in self.transforms.iter_mut().zip(transforms.chunks_exact(12)) {
+            *t = Affine3A::from_cols_array(&[m[0], m[4], m[8], m[1], m[5], m[9], m[2], m[6], m[10], m[3], m[7], m[11]]);
+        }
+        self.deformer.deform(&self.mesh, &self.transforms[..], &mut self.out);
+        Ok(())
+    }
+
+    /// Where the deformed positions start in [`wasm_memory`] (as [`Hand::positions_ptr`]).
+    #[wasm_bindgen(js_name = positionsPtr)]
+    pub fn positions_ptr(&self) -> *const f32 {
+        self.out.positions().as_ptr().cast()
+    }
+
+    /// Where the deformed unit normals start in [`wasm_memory`].
+    #[wasm_bindgen(js_name = normalsPtr)]
+    pub fn normals_ptr(&self) -> *const f32 {
+        self.out.normals().as_ptr().cast()
+    }
+
+    /// The method and kernel it deforms with, as `"dqb simd128"`.
+    pub fn describe(&self) -> String {
+        format!("{} {}", self.method, self.deformer.kernel().name())
     }
 }
 

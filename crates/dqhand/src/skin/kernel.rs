@@ -9,7 +9,10 @@
 //! The same code is compiled for three instruction sets and one is chosen at run time
 //! ([`Kernel`]): portable; AVX2 + FMA, chunks of 8 vertices; AVX-512, blocks of 16 vertices
 //! (two of the mesh's 8-vertex chunks) blended one vertex per lane from the start, with no
-//! transpose (module `avx512`), and finished 16 lanes per register.
+//! transpose (module `avx512`), and finished 16 lanes per register. In WebAssembly the
+//! fourth, simd128, is compiled in or not (a module cannot detect features at run time: the
+//! page loads the build its engine validates), and blends in 128-bit blocks (module
+//! `simd128`).
 
 #[cfg(target_arch = "x86_64")]
 use super::skinned_mesh::BLOCK;
@@ -24,11 +27,13 @@ pub enum Kernel {
     Avx2,
     /// x86-64 with AVX-512 (F, VL, DQ) besides AVX2 and FMA.
     Avx512,
+    /// WebAssembly with 128-bit SIMD, in a build compiled for it (`make wasm`'s SIMD build).
+    Simd128,
 }
 
 impl Kernel {
-    /// Every kernel, slowest first.
-    pub const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
+    /// Every kernel, slowest first (of those one CPU can run).
+    pub const ALL: [Kernel; 4] = [Kernel::Portable, Kernel::Simd128, Kernel::Avx2, Kernel::Avx512];
 
     /// The fastest kernel this CPU runs.
     #[must_use]
@@ -39,19 +44,18 @@ impl Kernel {
     /// Whether this CPU runs the kernel.
     #[must_use]
     pub fn available(self) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::is_x86_feature_detected as has;
-            let avx2 = has!("avx2") && has!("fma");
-            match self {
-                Kernel::Portable => true,
-                Kernel::Avx2 => avx2,
-                Kernel::Avx512 => avx2 && has!("avx512f") && has!("avx512vl") && has!("avx512dq"),
+        match self {
+            Kernel::Portable => true,
+            Kernel::Simd128 => cfg!(all(target_arch = "wasm32", target_feature = "simd128")),
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx2 => std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
+            #[cfg(target_arch = "x86_64")]
+            Kernel::Avx512 => {
+                use std::arch::is_x86_feature_detected as has;
+                Kernel::Avx2.available() && has!("avx512f") && has!("avx512vl") && has!("avx512dq")
             }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            self == Kernel::Portable
+            #[cfg(not(target_arch = "x86_64"))]
+            Kernel::Avx2 | Kernel::Avx512 => false,
         }
     }
 
@@ -61,14 +65,21 @@ impl Kernel {
         if self.available() { self } else { Self::best() }
     }
 
-    /// `portable`, `avx2` or `avx512`.
+    /// `portable`, `avx2`, `avx512` or `simd128`.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Kernel::Portable => "portable",
             Kernel::Avx2 => "avx2",
             Kernel::Avx512 => "avx512",
+            Kernel::Simd128 => "simd128",
         }
+    }
+
+    /// The kernel of [`Self::name`] `name`, if there is one.
+    #[must_use]
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
     }
 }
 
@@ -78,6 +89,8 @@ const PORTABLE: u8 = 0;
 const AVX2: u8 = 1;
 #[cfg(target_arch = "x86_64")]
 const AVX512: u8 = 2;
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+const SIMD128: u8 = 3;
 
 /// Stack data the vector loops load and store whole registers of, aligned to a cache line:
 /// an unaligned 64-byte access straddles two lines, and where the stack happened to fall
@@ -183,6 +196,8 @@ pub(crate) fn deform<const W: usize, B: Blend<W>>(
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         Kernel::Avx2 => unsafe { deform_avx2::<W, B>(mesh, frame, first, positions, normals) },
+        #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+        Kernel::Simd128 => deform_any::<W, B, SIMD128>(mesh, frame, first, positions, normals),
         _ => deform_any::<W, B, PORTABLE>(mesh, frame, first, positions, normals),
     }
 }
@@ -351,6 +366,11 @@ fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Fra
         unsafe { avx2::blend::<W, K, B>(frame, kc, slots, b) };
         return;
     }
+    #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+    if ISA == SIMD128 {
+        simd128::blend::<W, K, B>(frame, kc, slots, b);
+        return;
+    }
     let Slots { js, ws, ps } = slots;
     let signed = B::SIGNED;
     let mut acc = [[0.0f32; W]; LANES];
@@ -372,12 +392,13 @@ fn blend<const W: usize, const K: usize, B: Blend<W>, const ISA: u8>(frame: &Fra
     }
 }
 
-/// `a·b + c` in one fused instruction on the SIMD kernels (both have FMA: one rounding, half
-/// the instructions of the finish's sums of products); plain on the portable one, where a
-/// fused multiply-add without the instruction would be a library call per lane.
+/// `a·b + c` in one fused instruction on the x86 SIMD kernels (both have FMA: one rounding,
+/// half the instructions of the finish's sums of products); plain on the portable one and on
+/// simd128 (which has no fused multiply-add), where a fused multiply-add without the
+/// instruction would be a library call per lane.
 #[inline(always)]
 pub(crate) fn mad<const ISA: u8>(a: f32, b: f32, c: f32) -> f32 {
-    if ISA == PORTABLE { a * b + c } else { a.mul_add(b, c) }
+    if ISA == PORTABLE || cfg!(not(target_arch = "x86_64")) { a * b + c } else { a.mul_add(b, c) }
 }
 
 /// `a · b`, by [`mad`].
@@ -501,6 +522,56 @@ mod avx2 {
             _mm256_permute2f128_ps::<0x31>(s2, s6),
             _mm256_permute2f128_ps::<0x31>(s3, s7),
         ]
+    }
+}
+
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+mod simd128 {
+    //! The blend step with WebAssembly's 128-bit SIMD: per vertex and influence, the parameter
+    //! row in blocks of four, one multiply and one add each (simd128 has no fused
+    //! multiply-add), then 4×4 transposes to one array per component.
+
+    use core::arch::wasm32::*;
+
+    use super::{Blend, Frame, Slots, LANES};
+
+    /// As the portable `blend`, for `W` a multiple of four up to 16 and methods whose signed
+    /// parameters are whole blocks (LB 0, QB 4, DQB 8).
+    #[inline(always)]
+    pub(super) fn blend<const W: usize, const K: usize, B: Blend<W>>(frame: &Frame<'_, W>, kc: usize, slots: Slots<'_, K>, b: &mut [[f32; LANES]; W]) {
+        const { assert!(W % 4 == 0 && W <= 16 && B::SIGNED % 4 == 0) };
+        let Slots { js, ws, ps } = slots;
+        let signed = B::SIGNED;
+        let mut acc = [[f32x4_splat(0.0); 4]; LANES];
+        for k in 0..kc.min(K) {
+            for (l, acc) in acc.iter_mut().enumerate() {
+                let w = ws[l][k];
+                // Slot 0 is the heaviest joint itself, whose sign is always +1.
+                let sw = if signed > 0 && k > 0 { w * frame.signs[ps[l][k] as usize] } else { w };
+                let row = &frame.params[usize::from(js[l][k])];
+                for (blk, a) in acc.iter_mut().enumerate().take(W / 4) {
+                    let wv = f32x4_splat(if 4 * blk < signed { sw } else { w });
+                    // SAFETY: `row` holds `W` floats and `4 * blk + 4 <= W`; wasm loads need no
+                    // alignment.
+                    let p = unsafe { v128_load(row.as_ptr().add(4 * blk).cast()) };
+                    *a = f32x4_add(*a, f32x4_mul(wv, p));
+                }
+            }
+        }
+        for blk in 0..W / 4 {
+            for g in 0..LANES / 4 {
+                let r = [0, 1, 2, 3].map(|i| acc[4 * g + i][blk]);
+                let t0 = i32x4_shuffle::<0, 4, 1, 5>(r[0], r[1]);
+                let t1 = i32x4_shuffle::<0, 4, 1, 5>(r[2], r[3]);
+                let t2 = i32x4_shuffle::<2, 6, 3, 7>(r[0], r[1]);
+                let t3 = i32x4_shuffle::<2, 6, 3, 7>(r[2], r[3]);
+                let columns = [i32x4_shuffle::<0, 1, 4, 5>(t0, t1), i32x4_shuffle::<2, 3, 6, 7>(t0, t1), i32x4_shuffle::<0, 1, 4, 5>(t2, t3), i32x4_shuffle::<2, 3, 6, 7>(t2, t3)];
+                for (c, v) in columns.into_iter().enumerate() {
+                    // SAFETY: lanes `4g..4g + 4` of a row of `LANES` floats.
+                    unsafe { v128_store(b[4 * blk + c][4 * g..].as_mut_ptr().cast(), v) };
+                }
+            }
+        }
     }
 }
 

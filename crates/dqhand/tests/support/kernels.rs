@@ -54,7 +54,7 @@ fn required() -> Vec<Kernel> {
         .map(str::trim)
         .filter(|name| !name.is_empty())
         .map(|name| {
-            Kernel::ALL.into_iter().find(|k| k.name() == name).unwrap_or_else(|| {
+            Kernel::named(name).unwrap_or_else(|| {
                 let names: Vec<&str> = Kernel::ALL.iter().map(|k| k.name()).collect();
                 panic!("{REQUIRE}={list}: {name:?} is not a kernel ({})", names.join(", "))
             })
@@ -65,7 +65,7 @@ fn required() -> Vec<Kernel> {
 impl fmt::Display for Kernels {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let names = |ks: &[Kernel]| if ks.is_empty() { "none".to_owned() } else { ks.iter().map(|k| k.name()).collect::<Vec<_>>().join(", ") };
-        write!(f, "kernel paths run: {}; skipped (this CPU lacks them): {}", names(&self.run), names(&self.skipped))?;
+        write!(f, "kernel paths run: {}; skipped (this CPU or build lacks them): {}", names(&self.run), names(&self.skipped))?;
         match std::env::var(REQUIRE) {
             Ok(list) => write!(f, "; {REQUIRE}={list}"),
             Err(_) => write!(f, "; {REQUIRE} unset (a skipped kernel is not a failure)"),
