@@ -2,12 +2,8 @@
 //! line per frame (a fixed rate on the records' clock), and with `--meshes` the rendered
 //! hand (DQB, contact-constrained, world coordinates) every Nth frame as PLY.
 //!
-//! A trace line:
-//! `{"t": s, "tracking": "ok"|"lost", "held": name|null, "contacts": [{"bone", "object",
-//! "p": [x,y,z], "n": [x,y,z]}], "objects": {"<name>": {"p": [x,y,z], "q": [x,y,z,w]}}}`.
-//! With `--left-model` the loop has two hands (records drive the hand of their side) and
-//! `tracking`, `held` and `contacts` are per hand: `{"left": …, "right": …}`; the meshes are
-//! `<frame>-left.ply` and `<frame>-right.ply`.
+//! A trace line is [`frame_trace`]'s. With `--left-model` the loop has two hands (records drive
+//! the hand of their side); the meshes are then `<frame>-left.ply` and `<frame>-right.ply`.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -17,13 +13,12 @@ use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::grasp::GraspParams;
 use dqhand::gesture::GestureSet;
-use dqhand::input::{GloveMapper, InputConfig, Record, Tracking};
-use dqhand::interaction::{ManipulatingHand, ManipulationLoop};
+use dqhand::input::{GloveMapper, InputConfig, Record};
+use dqhand::interaction::{frame_trace, ManipulationLoop};
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::{Method, MethodSet, SkinLayer};
-use serde_json::{json, Map, Value};
 
 use crate::recording::RecordingArgs;
 
@@ -86,8 +81,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     }
     let mut trace = std::io::BufWriter::new(std::fs::File::create(&args.trace).with_context(|| args.trace.display().to_string())?);
-    // Each hand's joint names (two models need not share a skeleton).
-    let names: Vec<Vec<String>> = manip.hands().iter().map(|h| h.rendered().skeleton().names().map(str::to_owned).collect()).collect();
     let mut record = Record { time: 0.0, side: args.recording.common.hand, hand: None, tracker: None, arrival: None };
     let mut pending: Option<Record> = None;
     let (mut frame, mut refused) = (0u64, 0u64);
@@ -119,7 +112,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             None => {}
         }
         manip.step(now);
-        write_frame(&mut trace, now, &manip, &names)?;
+        write_frame(&mut trace, now, &manip)?;
         if let Some(dir) = &args.meshes {
             if frame % args.every == 0 {
                 for (hand, skin) in manip.hands().iter().zip(&mut skins) {
@@ -141,19 +134,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop, joints: &[Vec<String>]) -> anyhow::Result<()> {
-    let names = manip.names();
-    let per_hand = |f: &dyn Fn(&ManipulatingHand, &[String]) -> Value| match manip.hands() {
-        [one] => f(one, &joints[0]),
-        hands => Value::Object(hands.iter().zip(joints).map(|(h, j)| (h.side().name().to_owned(), f(h, j))).collect()),
-    };
-    let contacts = per_hand(&|h, joints| {
-        h.contacts().iter().map(|c| json!({"bone": joints[c.joint], "object": names[c.object], "p": c.point.to_array(), "n": c.normal.to_array()})).collect()
-    });
-    let objects: Map<String, Value> = names.iter().zip(manip.poses()).map(|(n, (q, p))| (n.clone(), json!({"p": p.to_array(), "q": q.to_array()}))).collect();
-    let tracking = per_hand(&|h, _| json!(if h.tracking() == Tracking::Tracking { "ok" } else { "lost" }));
-    let held = per_hand(&|h, _| json!(h.held().map(|i| &names[i])));
-    serde_json::to_writer(&mut *out, &json!({"t": t, "tracking": tracking, "held": held, "contacts": contacts, "objects": objects}))?;
+fn write_frame(out: &mut impl Write, t: f64, manip: &ManipulationLoop) -> anyhow::Result<()> {
+    serde_json::to_writer(&mut *out, &frame_trace(t, manip))?;
     out.write_all(b"\n")?;
     Ok(())
 }

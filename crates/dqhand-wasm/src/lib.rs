@@ -22,8 +22,10 @@ use dqhand::gesture::GestureSet;
 use dqhand::hand::{build, HandParams};
 use dqhand::input::json_record::parse_record;
 use dqhand::input::{InputConfig, Record};
-use dqhand::interaction::GestureLoop;
+use dqhand::grasp::GraspParams;
+use dqhand::interaction::{frame_trace, GestureLoop, ManipulationLoop};
 use dqhand::kinematics::{JointModel, Pose, Side};
+use dqhand::scene::Scene;
 use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinnedMesh};
 use glam::Affine3A;
 use wasm_bindgen::prelude::*;
@@ -339,5 +341,64 @@ impl Gestures {
             }
             Err(rejection) => Err(JsError::new(&rejection.to_string())),
         }
+    }
+}
+
+/// The manipulation loop (the paper's 3D manipulation): records of a user's hands drive the
+/// built-in hand, or a left and a right one, in a scene; each frame solves the rendered hand
+/// against the objects (continuous collision detection), its grasps and the physics. The same
+/// loop as `dqhand grasp`.
+#[wasm_bindgen(js_name = GraspLoop)]
+pub struct Grasps {
+    inner: ManipulationLoop,
+    side: Side,
+    record: Record,
+}
+
+#[wasm_bindgen(js_class = GraspLoop)]
+impl Grasps {
+    /// A loop in the built-in scene `scene` (`"grasp"`, `"objects"`) of the built-in right hand,
+    /// or with `two_hands` of a left and a right one (records drive the hand of their side; a
+    /// record that does not say drives the right one).
+    ///
+    /// # Errors
+    /// A scene that is not built in.
+    #[wasm_bindgen(constructor)]
+    pub fn new(scene: &str, two_hands: bool) -> Result<Grasps, JsError> {
+        let scene = Scene::named(scene).map_err(js)?;
+        let hand = |side| build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js);
+        let (config, params) = (InputConfig::default(), GraspParams::default());
+        let inner = if two_hands {
+            ManipulationLoop::two_handed([(hand(Side::Left)?, None), (hand(Side::Right)?, None)], JointModel::Full, config, None, &scene, params)
+        } else {
+            ManipulationLoop::new(hand(Side::Right)?, JointModel::Full, None, config, None, &scene, params)
+        }
+        .map_err(js)?;
+        Ok(Grasps { inner, side: Side::Right, record: Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None } })
+    }
+
+    /// One record (a line of a recording), taken in before the next [`Self::step`].
+    ///
+    /// # Errors
+    /// A record that cannot be read or is refused (its problem on one line); the loop goes on
+    /// as the native one does.
+    pub fn push(&mut self, line: &str) -> Result<(), JsError> {
+        if line.trim().is_empty() {
+            return Ok(());
+        }
+        if let Err(rejection) = parse_record::<&str>(line.trim(), self.side, &[], &mut self.record) {
+            let message = rejection.to_string();
+            self.inner.reject(rejection);
+            return Err(JsError::new(&message));
+        }
+        self.inner.push(&self.record).map(|_| ()).map_err(|rejection| JsError::new(&rejection.to_string()))
+    }
+
+    /// Advances the loop to `now` (s, on the records' clock) and returns the frame as a JSON
+    /// line: `dqhand grasp --trace`'s (the rendered hands' contacts, what each holds, every
+    /// object's pose).
+    pub fn step(&mut self, now: f64) -> String {
+        self.inner.step(now);
+        frame_trace(now, &self.inner).to_string()
     }
 }

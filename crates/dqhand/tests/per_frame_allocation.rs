@@ -161,8 +161,9 @@ fn a_scene_frame_allocates_only_inside_rapier_and_parry_a_bounded_few_times() {
 
 /// Allocations in rapier per frame of the grasp scene (release build), at most: on average
 /// over any phase of the grasp, and in any one frame (where the hand first meets an object,
-/// rapier makes its contact pairs).
-const RAPIER_PER_FRAME: (f64, usize) = (10.0, 70);
+/// rapier makes its contact pairs: 79 measured with `enhanced-determinism`, whose ordered maps
+/// allocate more than the hash maps did, 66 before).
+const RAPIER_PER_FRAME: (f64, usize) = (10.0, 90);
 /// The same for parry's penetration queries from the contact constraint.
 const PARRY_PER_FRAME: (f64, usize) = (0.5, 8);
 

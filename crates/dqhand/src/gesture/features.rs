@@ -247,7 +247,7 @@ impl HandFeatures {
             } else {
                 // Rotating the metacarpal about n × m turns it toward the palm (−n).
                 let lateral = palm_normal.cross(metacarpal).normalize();
-                metacarpal.cross(proximal).dot(lateral).atan2(metacarpal.dot(proximal)).to_degrees()
+                libm::atan2f(metacarpal.cross(proximal).dot(lateral), metacarpal.dot(proximal)).to_degrees()
             };
             proximal_on_palm[f] = proximal.reject_from_normalized(palm_normal);
         }
@@ -280,7 +280,7 @@ impl HandFeatures {
 /// The unsigned angle between two vectors, radians; atan2 keeps it exact near 0 and 180°
 /// (acos of a rounded cosine does not), and gives 0 for a zero vector.
 fn angle(a: Vec3, b: Vec3) -> f32 {
-    a.cross(b).length().atan2(a.dot(b))
+    libm::atan2f(a.cross(b).length(), a.dot(b))
 }
 
 #[cfg(test)]
@@ -302,7 +302,7 @@ mod tests {
             let base = 5 + 5 * f;
             p[base] = Vec3::new(x, 0.0, -0.01);
             p[base + 1] = Vec3::new(x, 0.0, -0.08);
-            let along = if f == 0 { Vec3::new(0.0, -index_knuckle.sin(), -index_knuckle.cos()) } else { -Vec3::Z };
+            let along = if f == 0 { Vec3::new(0.0, -libm::sinf(index_knuckle), -libm::cosf(index_knuckle)) } else { -Vec3::Z };
             for (j, length) in [0.04, 0.025, 0.02].into_iter().enumerate() {
                 p[base + 2 + j] = p[base + 1 + j] + along * length;
             }

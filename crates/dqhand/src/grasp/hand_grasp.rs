@@ -198,7 +198,7 @@ impl Grasp {
         if a.0.held.is_some() || b.0.held.is_some() {
             return None;
         }
-        let opposed = a.0.params.opposition_deg.to_radians().cos();
+        let opposed = libm::cosf(a.0.params.opposition_deg.to_radians());
         let ready = |g: &Grasp, o: usize| now >= g.cooldown_until[o];
         let presses = |(g, _, closure, push): TwoHanded<'_>, c: &Contact| g.pressing(c, closure) || push.dot(-c.normal) >= g.params.push_m;
         a.1.iter().filter(|c| presses(a, c) && ready(a.0, c.object) && ready(b.0, c.object)).find_map(|ca| {
@@ -319,7 +319,7 @@ impl Grasp {
     /// The object the contacts grasp, if any: a pressing thumb or palm contact and a pressing
     /// finger contact on it, with opposing normals.
     fn find_grasp(&self, now: f64, contacts: &[Contact], closure: &[Closure; 5]) -> Option<usize> {
-        let opposed = self.params.opposition_deg.to_radians().cos();
+        let opposed = libm::cosf(self.params.opposition_deg.to_radians());
         let thumb_side = |c: &&Contact| matches!(c.part, HandPart::Palm | HandPart::Finger(0)) && self.pressing(c, closure);
         let finger = |c: &&Contact| matches!(c.part, HandPart::Finger(1..)) && self.pressing(c, closure);
         contacts.iter().filter(thumb_side).find_map(|a| {

@@ -327,11 +327,11 @@ fn solve_joint(step: &Step, u: Vec3, plane: Option<Vec3>, angles: &mut [f32]) {
             // A·R_F(φ)d0 = p cos φ + q sin φ = A·u, with p = A·d0, q = A·(F × d0).
             let (axis_a, axis_f) = (a.axis, f.axis);
             let (p, q) = (axis_a.dot(d0), axis_a.dot(axis_f.cross(d0)));
-            let rho = p.hypot(q);
+            let rho = libm::hypotf(p, q);
             let candidates = if rho < 1e-6 {
                 [0.0, 0.0]
             } else {
-                let (phase, spread) = (q.atan2(p), (axis_a.dot(u) / rho).clamp(-1.0, 1.0).acos());
+                let (phase, spread) = (libm::atan2f(q, p), libm::acosf((axis_a.dot(u) / rho).clamp(-1.0, 1.0)));
                 [wrap(phase + spread), wrap(phase - spread)]
             };
             // Of the two flexions, the one that needs the least abduction.
@@ -340,7 +340,7 @@ fn solve_joint(step: &Step, u: Vec3, plane: Option<Vec3>, angles: &mut [f32]) {
                 .into_iter()
                 .min_by(|x, y| (x.1.abs() + x.0.abs() * 1e-3).total_cmp(&(y.1.abs() + y.0.abs() * 1e-3)))
                 .expect("two candidates");
-            let w_bone = 1.0 - axis_a.dot(u).powi(2);
+            let w_bone = 1.0 - axis_a.dot(u) * axis_a.dot(u);
             let abd = match (plane, step.bend_axis) {
                 (Some(n), Some(bend)) if n.length_squared() > 1e-6 => {
                     let from_plane = signed_angle(axis_a, Quat::from_axis_angle(axis_f, flex) * bend, n);
@@ -365,7 +365,7 @@ fn solve_joint(step: &Step, u: Vec3, plane: Option<Vec3>, angles: &mut [f32]) {
 /// `axis`.
 fn signed_angle(axis: Vec3, from: Vec3, to: Vec3) -> f32 {
     let (a, b) = (from - axis * axis.dot(from), to - axis * axis.dot(to));
-    axis.dot(a.cross(b)).atan2(a.dot(b))
+    libm::atan2f(axis.dot(a.cross(b)), a.dot(b))
 }
 
 fn wrap(angle: f32) -> f32 {

@@ -19,6 +19,7 @@ mod gesture_loop;
 pub mod grasp_script;
 mod manipulating_hand;
 mod manipulation_loop;
+mod manipulation_trace;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
 #[cfg(feature = "synthetic")]
@@ -28,3 +29,4 @@ pub use command_table::{CommandRow, CommandTable};
 pub use gesture_loop::GestureLoop;
 pub use manipulating_hand::ManipulatingHand;
 pub use manipulation_loop::{HandEvents, ManipulationLoop};
+pub use manipulation_trace::frame_trace;

@@ -237,7 +237,7 @@ impl DualQuat {
             let direction = if pitch > 1e-9 { t / pitch } else { Vec3::X };
             return Screw { angle: 0.0, pitch, direction, moment: Vec3::ZERO };
         }
-        let angle = 2.0 * s.atan2(q.real.w);
+        let angle = 2.0 * libm::atan2f(s, q.real.w);
         let direction = v / s;
         let pitch = t.dot(direction);
         // The axis passes through the point r = ½ (t⊥ + cot(θ/2) l × t), so m = r × l.
@@ -251,7 +251,7 @@ impl DualQuat {
     #[must_use]
     pub fn from_screw(screw: Screw) -> Self {
         let Screw { angle, pitch, direction: l, moment: m } = screw;
-        let (s, c) = (0.5 * angle).sin_cos();
+        let (s, c) = libm::sincosf(0.5 * angle);
         let real = Quat::from_xyzw(l.x * s, l.y * s, l.z * s, c);
         let dv = l * (0.5 * pitch * c) + m * s;
         let dual = Quat::from_xyzw(dv.x, dv.y, dv.z, -0.5 * pitch * s);
