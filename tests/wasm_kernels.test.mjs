@@ -139,7 +139,7 @@ function reference(method, m, q, p, n, inf) {
 }
 
 test('the SIMD build holds SIMD instructions and the other none; the probe picks the SIMD build here', () => {
-  const count = (dir) => countInstructions(readFileSync(path.join(root, 'target', 'wasm', dir.replace('node', 'web'), 'dqhand_wasm_bg.wasm')));
+  const count = (dir) => countInstructions(readFileSync(path.join(root, 'target', 'wasm', dir, 'dqhand_wasm_bg.wasm')));
   const [plain, simd] = builds.map((b) => count(b.dir));
   assert.ok(plain.total > 10000 && simd.total > 10000, `instructions read: ${plain.total}, ${simd.total}`);
   assert.equal(plain.simd, 0, 'the build without SIMD holds none');
@@ -188,10 +188,10 @@ test('every kernel of both builds skins as LB, QB and DQB are defined, for rotat
           const what = `${dir} ${skinner.describe()}, seed ${seed}`;
           assert.ok(dp < 1e-6, `${what}: positions ${dp} m from the reference`);
           assert.ok(dn < 2e-5, `${what}: normals ${dn} from the reference`);
-          // The kernels of a build agree with each other more closely than with the reference.
+          // The kernels of a build agree with each other (they sum in the same order).
           if (first) {
             const apart = got.p.reduce((s, x, i) => Math.max(s, Math.abs(x - first.p[i])), 0);
-            assert.ok(apart < 1e-5, `${what}: ${apart} m from the portable kernel`);
+            assert.ok(apart < 1e-6, `${what}: ${apart} m from the portable kernel`);
           }
           first ??= got;
         }

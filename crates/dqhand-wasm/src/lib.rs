@@ -359,7 +359,9 @@ pub struct Grasps {
 impl Grasps {
     /// A loop in the built-in scene `scene` (`"grasp"`, `"objects"`) of the built-in right hand,
     /// or with `two_hands` of a left and a right one (records drive the hand of their side; a
-    /// record that does not say drives the right one).
+    /// record that does not say drives the right one), with the default input configuration
+    /// and grasp parameters: `dqhand grasp`'s with no `--config` (no glove: records of joints or
+    /// landmarks).
     ///
     /// # Errors
     /// A scene that is not built in.

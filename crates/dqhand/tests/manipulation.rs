@@ -113,6 +113,11 @@ fn rendered_skin_stays_out_of_the_ball_the_tracked_hand_does_not() {
     assert!(rendered <= 0.001, "the rendered skin goes {rendered} m into the ball");
 }
 
+/// Joints stopped on the teapot, followed from one frame to the next, that the grip test must
+/// see at least (about half of the 545 measured): a grip that never stops on the teapot would
+/// pass its slide check with nothing to check.
+const STOPPED_ON_AT_LEAST: usize = 250;
+
 #[test]
 fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     let mut skin_layer = SkinLayer::new(Arc::clone(&model().mesh), MethodSet::DQB);
@@ -126,6 +131,8 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     let m = objects.objects()[0].mesh.as_ref().unwrap();
     let flat: benchmark::FlatMesh = (m.vertices.iter().map(|v| v.to_array()).collect(), m.triangles.iter().flatten().copied().collect());
     let (mut deepest, mut turned, mut held_frames, mut slid, mut off_surface, mut turned_normal) = (0.0f32, 0.0f32, 0, 0.0f32, 0.0f32, 0.0f32);
+    // Joints (per frame) that stopped on the teapot and were followed to the next frame.
+    let mut stopped_on = 0;
     let proxies = dqhand::collision::HandProxies::new(&dqhand::collision::fit_proxies(&model(), dqhand::collision::PROXY_MARGIN), &model().skeleton);
     let query = dqhand::collision::ProxyMeshQuery::new(&proxies);
     let mut in_wrist: Option<glam::Quat> = None;
@@ -154,6 +161,7 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
             for &(j, was, normal) in touching.iter().filter(|_| t < s.times.release) {
                 let moved = on_teapot(j) - was;
                 slid = slid.max((moved - normal * moved.dot(normal)).length());
+                stopped_on += 1;
             }
             touching = m.hands()[0].contacts().iter().filter(|c| c.object == 0 && c.distance <= dqhand::collision::STOP_DISTANCE).map(|c| (c.joint, on_teapot(c.joint), q.inverse() * c.normal)).collect();
             // Its contacts (kept from frame to frame while the grip holds still) are what a
@@ -177,6 +185,7 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     assert!(held_frames > 60, "held for {held_frames} frames");
     assert!(deepest <= 0.001, "the rendered skin went {deepest} m into the teapot");
     assert!(turned.to_degrees() < 2.0, "the teapot turned {}° in the hand", turned.to_degrees());
+    assert!(stopped_on > STOPPED_ON_AT_LEAST, "only {stopped_on} joints stopped on the teapot were followed");
     assert!(slid < 0.0005, "a joint touching the teapot slid {slid} m over it");
     assert!(off_surface < 1e-4, "a contact point kept while held is {off_surface} m from a fresh query's");
     assert!(turned_normal < 1e-3, "a contact normal kept while held is {turned_normal} rad from a fresh query's");

@@ -179,7 +179,7 @@ pub(crate) fn softmax(v: &mut [f32]) {
     let top = v.iter().copied().fold(f32::NEG_INFINITY, f32::max);
     let mut sum = 0.0;
     for x in v.iter_mut() {
-        *x = (*x - top).exp();
+        *x = libm::expf(*x - top);
         sum += *x;
     }
     for x in v.iter_mut() {
