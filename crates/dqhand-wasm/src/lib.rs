@@ -282,6 +282,22 @@ impl Skinner {
     }
 }
 
+/// Reads one line of a recording into `record` (`side`: the hand of records that do not say):
+/// `false` for a blank line; a line that cannot be read goes to `reject` (the loop counts it,
+/// as the native one does) and is an error of one line.
+fn read(line: &str, side: Side, record: &mut Record, reject: impl FnOnce(dqhand::input::Rejection)) -> Result<bool, JsError> {
+    let line = line.trim();
+    if line.is_empty() {
+        return Ok(false);
+    }
+    parse_record::<&str>(line, side, &[], record).map_err(|rejection| {
+        let message = JsError::new(&rejection.to_string());
+        reject(rejection);
+        message
+    })?;
+    Ok(true)
+}
+
 /// The module's memory, which [`Hand::positions_ptr`] and [`Hand::normals_ptr`] point into
 /// (`wasmMemory`: the module's own export is already called `memory`).
 #[wasm_bindgen(js_name = wasmMemory)]
@@ -322,13 +338,8 @@ impl Gestures {
     /// A record that cannot be read or is refused (its problem on one line); the loop goes on
     /// as the native one does.
     pub fn push(&mut self, line: &str) -> Result<String, JsError> {
-        if line.trim().is_empty() {
+        if !read(line, self.side, &mut self.record, |r| self.inner.reject(r))? {
             return Ok(String::new());
-        }
-        if let Err(rejection) = parse_record::<&str>(line.trim(), self.side, &[], &mut self.record) {
-            let message = rejection.to_string();
-            self.inner.reject(rejection);
-            return Err(JsError::new(&message));
         }
         match self.inner.push(&self.record) {
             Ok(events) => {
@@ -385,13 +396,8 @@ impl Grasps {
     /// A record that cannot be read or is refused (its problem on one line); the loop goes on
     /// as the native one does.
     pub fn push(&mut self, line: &str) -> Result<(), JsError> {
-        if line.trim().is_empty() {
+        if !read(line, self.side, &mut self.record, |r| self.inner.reject(r))? {
             return Ok(());
-        }
-        if let Err(rejection) = parse_record::<&str>(line.trim(), self.side, &[], &mut self.record) {
-            let message = rejection.to_string();
-            self.inner.reject(rejection);
-            return Err(JsError::new(&message));
         }
         self.inner.push(&self.record).map(|_| ()).map_err(|rejection| JsError::new(&rejection.to_string()))
     }
