@@ -522,32 +522,28 @@ impl ContactConstraint {
                         continue;
                     }
                     let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
-                    let remaining = *bound - speed * (s - *at);
-                    if remaining > STOP_DISTANCE {
-                        if speed > 0.0 {
-                            step = step.min(remaining / speed);
+                    let mut remaining = *bound - speed * (s - *at);
+                    if remaining <= STOP_DISTANCE {
+                        let proxy = &self.proxies.colliders()[*p];
+                        let pose = pose_of(&self.trial_world[proxy.joint]);
+                        let (mut d, mut to) = (f32::INFINITY, usize::MAX);
+                        for &o in &self.near {
+                            let c = objects.collider(o);
+                            let here = match c.surface.as_trimesh() {
+                                Some(mesh) => self.mesh_query.distance_at_least(*p, &*proxy.shape, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
+                                None => c.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE),
+                            };
+                            if here < d {
+                                (d, to) = (here, o);
+                            }
                         }
-                        continue;
-                    }
-                    let proxy = &self.proxies.colliders()[*p];
-                    let pose = pose_of(&self.trial_world[proxy.joint]);
-                    let (mut d, mut to) = (f32::INFINITY, usize::MAX);
-                    for &o in &self.near {
-                        let c = objects.collider(o);
-                        let here = match c.surface.as_trimesh() {
-                            Some(mesh) => self.mesh_query.distance_at_least(*p, &*proxy.shape, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
-                            None => c.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE),
-                        };
-                        if here < d {
-                            (d, to) = (here, o);
+                        (*bound, *at, remaining) = (d, s, d);
+                        if d < nearest.0 {
+                            nearest = (d, *last, to);
                         }
-                    }
-                    (*bound, *at) = (d, s);
-                    if d < nearest.0 {
-                        nearest = (d, *last, to);
                     }
                     if speed > 0.0 {
-                        step = step.min(d / speed);
+                        step = step.min(remaining / speed);
                     }
                 }
                 if let Some(tried) = checking.take() {

@@ -154,7 +154,8 @@ impl QueryShape {
     /// the distance: for a capsule, the larger of its axis's distance to the triangle's
     /// bounding sphere and to the triangle's plane; for a hull, the larger of the gap between its
     /// box and the triangle's box in the joint's frame and the gap along the triangle's normal.
-    fn bound(&self, pose: &Pose, tri: &Triangle) -> f32 {
+    /// `to_local` is `pose`'s inverse, which the caller makes once for all its triangles.
+    fn bound(&self, pose: &Pose, to_local: &Pose, tri: &Triangle) -> f32 {
         match self {
             Self::Capsule { a, b, radius } => {
                 let (p, q) = (*pose * *a, *pose * *b);
@@ -169,7 +170,6 @@ impl QueryShape {
                 (segment_distance(centroid, p, q) - spread).max(plane) - radius
             }
             Self::Scaled(_, aabb) => {
-                let to_local = pose.inverse();
                 let [a, b, c] = [to_local * tri.a, to_local * tri.b, to_local * tri.c];
                 let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
                 let boxes = (aabb.mins - hi).max(lo - aabb.maxs).max(Vec3::ZERO).length();
@@ -254,7 +254,7 @@ impl ProxyMeshQuery {
     /// mesh's frame) within `limit` (the deepest, where it overlaps several); a triangle whose cheap bound is above `exact_below` counts
     /// as that far (with no normal or point).
     fn search(query: &QueryShape, pose: &Pose, mesh: &TriMesh, limit: f32, exact_below: f32) -> Option<MeshNearest> {
-        let (aabb, deepest) = (query.aabb(pose), query.deepest());
+        let (aabb, deepest, to_local) = (query.aabb(pose), query.deepest(), pose.inverse());
         mesh.bvh()
             .find_best(
                 limit,
@@ -262,7 +262,7 @@ impl ProxyMeshQuery {
                 |triangle, best| {
                     let triangle = mesh.triangle(triangle);
                     // The cheap bound first: most triangles near the proxy are not the nearest.
-                    let bound = query.bound(pose, &triangle);
+                    let bound = query.bound(pose, &to_local, &triangle);
                     if bound >= best {
                         return None;
                     }
@@ -294,9 +294,10 @@ impl ProxyMeshQuery {
         }
         let local_pose = |t: f32| mesh_pose.inv_mul(&motion.position_at_time(t));
         let start = local_pose(0.0);
+        let to_start = start.inverse();
         self.candidates.clear();
         self.candidates.extend(mesh.bvh().intersect_aabb(&swept.transform_by(&mesh_pose.inverse())).map(|triangle| {
-            let bound = cast.bound(&start, &mesh.triangle(triangle));
+            let bound = cast.bound(&start, &to_start, &mesh.triangle(triangle));
             Candidate { triangle, bound, at: 0.0, rate: speed, left: None }
         }));
         // Nearest first: a contact at the start is then found after few exact distances.
