@@ -14,7 +14,7 @@ import { fileURLToPath } from 'node:url';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
-const { GestureLoop, GraspLoop, Hand, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
+const { Hand, Interaction, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
 const dqhand = process.env.DQHAND_BIN ?? path.join(root, 'target', 'debug', 'dqhand');
 const out = mkdtempSync(path.join(tmpdir(), 'dqhand-wasm-'));
 
@@ -98,30 +98,100 @@ test('bad input is a one-line Error naming it, and the hand keeps its last pose'
   assert.equal(largestGap(before, after), 0);
 });
 
+/** Every non-blank line of the built-in recording `name`. */
+const recordingLines = (name) => readFileSync(path.join(root, 'crates', 'dqhand', 'data', 'recordings', name), 'utf8').split('\n').filter((l) => l.trim() !== '');
+
 for (const name of ['gestures-joints.jsonl', 'gestures-landmarks.jsonl']) {
-  test(`the WASM gesture loop gives dqhand replay's events on ${name}, and goes on past a bad line`, () => {
+  test(`the WASM interaction gives dqhand replay's gesture events on ${name}, and goes on past a bad line`, () => {
     const recording = path.join(root, 'crates', 'dqhand', 'data', 'recordings', name);
     const expected = execFileSync(dqhand, ['replay', '--gestures', '--input', recording], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] });
-    const lines = readFileSync(recording, 'utf8').split('\n').filter((l) => l.trim() !== '');
-    const loop = new GestureLoop('right');
+    const interaction = new Interaction('right', '');
     let events = '';
     let refused = 0;
-    lines.forEach((line, i) => {
-      events += loop.push(line);
+    recordingLines(name).forEach((line, i) => {
+      interaction.pushLine(line);
+      if (interaction.step(JSON.parse(line).t) > 0) events += interaction.takeEvents();
       // A broken line after every 500th: refused with one line, and the loop goes on.
       if (i % 500 === 499) {
-        assert.throws(() => loop.push(line.slice(0, 40)), (e) => e instanceof Error && !e.message.includes('\n'));
+        assert.throws(() => interaction.pushLine(line.slice(0, 40)), (e) => e instanceof Error && !e.message.includes('\n'));
         refused += 1;
       }
     });
     assert.ok(refused >= 3);
+    assert.deepEqual(Array.from(interaction.counts()), [recordingLines(name).length, refused]);
     assert.ok(expected.split('\n').length > 10, `the recording names gestures (${expected.length} bytes of events)`);
-    assert.equal(events, expected);
+    // The same events, each naming its hand.
+    const named = expected.trim().split('\n').map((l) => ({ ...JSON.parse(l), hand: 'right' }));
+    assert.deepEqual(events.trim().split('\n').map((l) => JSON.parse(l)), named);
   });
 }
 
-test('a gesture loop for a side that is none is refused', () => {
-  assert.throws(() => new GestureLoop('up'), /side "up"/);
+/** WebXR's hand joints in `XRHand`'s order. */
+const FINGERS = ['index-finger', 'middle-finger', 'ring-finger', 'pinky-finger'].flatMap((f) => ['metacarpal', 'phalanx-proximal', 'phalanx-intermediate', 'phalanx-distal', 'tip'].map((b) => `${f}-${b}`));
+const XR_JOINTS = ['wrist', 'thumb-metacarpal', 'thumb-phalanx-proximal', 'thumb-phalanx-distal', 'thumb-tip', ...FINGERS];
+
+/** A WebXR joint (`{p, q}`) as the 4 × 4 column-major matrix `XRFrame.fillPoses` writes. */
+function jointMatrix({ p, q }, out, at) {
+  const [x, y, z, w] = q;
+  const m = [
+    1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
+    2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
+    2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
+    p[0], p[1], p[2], 1,
+  ];
+  out.set(m, at);
+}
+
+test('joints given as fillPoses matrices drive the hand as the same joints in JSON lines, and the skin is read in place with no memory growth', () => {
+  const lines = recordingLines('gestures-joints.jsonl').slice(0, 600);
+  const [json, arrays] = [new Interaction('right', ''), new Interaction('right', '')];
+  const [matrices, radii] = [new Float32Array(25 * 16), new Float32Array(25)];
+  const view = (it) => new Float32Array(wasmMemory().buffer, it.positionsPtr(0), 3 * it.vertexCount(0));
+  let [eventsJson, eventsArrays, worst, buffer] = ['', '', 0, null];
+  lines.forEach((line, i) => {
+    const record = JSON.parse(line);
+    const joints = XR_JOINTS.map((name) => record.joints[name]);
+    joints.forEach((j, k) => {
+      jointMatrix(j, matrices, 16 * k);
+      radii[k] = j.r ?? 0;
+    });
+    json.pushLine(line);
+    arrays.pushJoints(record.hand ?? 'right', record.t, matrices, radii);
+    if (json.step(record.t) > 0) eventsJson += json.takeEvents();
+    if (arrays.step(record.t) > 0) eventsArrays += arrays.takeEvents();
+    worst = Math.max(worst, largestGap(view(json), view(arrays)));
+    // After the first frames, stepping allocates nothing: the memory (and every view of it) stays.
+    if (i === 10) buffer = wasmMemory().buffer;
+    if (i > 10) assert.equal(wasmMemory().buffer, buffer, `frame ${i}: the module's memory grew`);
+  });
+  assert.ok(eventsJson.length > 0, 'the first 600 records name gestures');
+  // The same events; their times may differ in the last bit (serde_json reads a decimal to the
+  // nearest double or one next to it, the array path takes the page's double as it is).
+  const parse = (events) => events.trim().split('\n').map((l) => JSON.parse(l));
+  const [a, j] = [parse(eventsArrays), parse(eventsJson)];
+  assert.deepEqual(a.map(({ t, ...e }) => e), j.map(({ t, ...e }) => e));
+  a.forEach((e, i) => assert.ok(Math.abs(e.t - j[i].t) < 1e-12, `event ${i}: t ${e.t} and ${j[i].t}`));
+  // Quaternion to matrix and back rounds in the last bits of float32.
+  assert.ok(worst < 1e-5, `skins ${worst} m apart`);
+  // The skin is in the world where the tracked hand is: a vertex within 3 cm of its middle fingertip.
+  const skin = view(arrays);
+  const tip = JSON.parse(lines.at(-1)).joints['middle-finger-tip'].p;
+  let nearest = Infinity;
+  for (let i = 0; i < skin.length; i += 3) nearest = Math.min(nearest, Math.hypot(skin[i] - tip[0], skin[i + 1] - tip[1], skin[i + 2] - tip[2]));
+  assert.ok(nearest < 0.03, `the skin's nearest vertex is ${nearest} m from the tracked middle fingertip`);
+});
+
+test('bad typed arrays are refused with one line naming the problem, and the hand goes on', () => {
+  const it = new Interaction('left', '');
+  assert.equal(it.side(0), 'left');
+  assert.throws(() => it.pushJoints('left', 0, new Float32Array(24 * 16), new Float32Array(0)), /joint matrices: 384 floats, 25 joints need 400/);
+  assert.throws(() => it.pushLandmarks('left', 0, new Float32Array(63).fill(NaN)), /landmark 0: position/);
+  assert.throws(() => it.pushLandmarks('middle', 0, new Float32Array(63)), /side "middle"/);
+  assert.deepEqual(Array.from(it.counts()), [0, 2]);
+  assert.equal(it.step(0.1), 0);
+  assert.equal(it.tracking(0), 'waiting');
+  assert.throws(() => new Interaction('three', ''), /hands "three"/);
+  assert.throws(() => new Interaction('both', '{"objects": [{"name": "x", "shape": "cone"}]}'), (e) => e instanceof Error && !e.message.includes('\n'));
 });
 
 /** Frames of `recording` through `loop` as `dqhand grasp` makes them: every record up to a
@@ -133,8 +203,9 @@ function graspFrames(loop, recording, rate = 60) {
   let now = JSON.parse(records[0]).t;
   let next = 0;
   for (;;) {
-    while (next < records.length && JSON.parse(records[next]).t <= now) loop.push(records[next++]);
-    frames.push(JSON.parse(loop.step(now)));
+    while (next < records.length && JSON.parse(records[next]).t <= now) loop.pushLine(records[next++]);
+    loop.step(now);
+    frames.push(JSON.parse(loop.trace(now)));
     if (next >= records.length) return frames;
     now += 1 / rate;
   }
@@ -150,12 +221,13 @@ const apart = (a, b) => a.reduce((m, x, i) => Math.max(m, Math.abs(x - b[i])), 0
 // no difference at all over the 650 frames).
 for (const dir of ['node', 'node-simd']) {
   test(`the WASM grasp loop (${dir}) gives dqhand grasp's frames on the grasp recording: holds, contacts and object poses`, () => {
-    const { GraspLoop: Loop } = require(path.join(root, 'target', 'wasm', dir, 'dqhand_wasm.js'));
+    const { Interaction: Loop } = require(path.join(root, 'target', 'wasm', dir, 'dqhand_wasm.js'));
     const recording = path.join(root, 'crates', 'dqhand', 'data', 'recordings', 'grasp-joints.jsonl');
     const trace = path.join(out, 'grasp.jsonl');
-    execFileSync(dqhand, ['grasp', '--scene', 'grasp', '--input', recording, '--trace', trace], { stdio: 'ignore' });
+    // Gestures on, as in the page: the scene's gesture commands (an open palm held resets it) act.
+    execFileSync(dqhand, ['grasp', '--gestures', '--scene', 'grasp', '--input', recording, '--trace', trace], { stdio: 'ignore' });
     const expected = readFileSync(trace, 'utf8').trim().split('\n').map((l) => JSON.parse(l));
-    const frames = graspFrames(new Loop('grasp', false), recording);
+    const frames = graspFrames(new Loop('right', 'grasp'), recording);
     assert.equal(frames.length, expected.length);
     const held = new Set(expected.map((f) => f.held).filter((h) => h !== null));
     assert.deepEqual([...held].sort(), ['ball', 'teapot'], 'the recording grasps the ball and the teapot');
@@ -180,9 +252,17 @@ for (const dir of ['node', 'node-simd']) {
   });
 }
 
-test('a grasp loop in a scene that is not built in is refused, and a broken record is one line', () => {
-  assert.throws(() => new GraspLoop('kitchen', false), (e) => e instanceof Error && e.message.includes('kitchen') && !e.message.includes('\n'));
-  const loop = new GraspLoop('objects', true);
-  assert.throws(() => loop.push('{"t": 0, "joints": '), (e) => e instanceof Error && !e.message.includes('\n'));
-  assert.equal(JSON.parse(loop.step(0)).held.left, null);
+test('an interaction in a scene that is not built in is refused, and a broken record is one line', () => {
+  assert.throws(() => new Interaction('both', 'kitchen'), (e) => e instanceof Error && e.message.includes('kitchen') && !e.message.includes('\n'));
+  const loop = new Interaction('both', 'objects');
+  assert.deepEqual([loop.handCount, loop.side(0), loop.side(1)], [2, 'left', 'right']);
+  assert.throws(() => loop.pushLine('{"t": 0, "joints": '), (e) => e instanceof Error && !e.message.includes('\n'));
+  loop.step(0);
+  assert.equal(JSON.parse(loop.trace(0)).held.left, null);
+  assert.deepEqual([loop.held(0), loop.held(1)], [-1, -1]);
+  const scene = JSON.parse(loop.scene());
+  assert.equal(scene.objects.length, loop.objectCount);
+  const poses = new Float32Array(wasmMemory().buffer, loop.posesPtr(), 7 * loop.objectCount);
+  const trace = JSON.parse(loop.trace(0));
+  scene.objects.forEach((o, i) => assert.deepEqual(Array.from(poses.slice(7 * i, 7 * i + 3)), trace.objects[o.name].p.map(Math.fround)));
 });

@@ -1,8 +1,11 @@
-//! dqhand's engine for JavaScript, in WebAssembly: the built-in anatomical hand, its forward
-//! kinematics and LB, QB or DQB skinning (paper Figure 1, the kinematics and skin layers), and
-//! the gesture loop, with no server. The same library as the native `dqhand`, compiled for `wasm32-unknown-unknown`
-//! and bound with wasm-bindgen; `make wasm` builds it into `target/wasm/` and a Node test checks
-//! its frames and gesture events against the native commands'.
+//! dqhand's engine for JavaScript, in WebAssembly, with no server: the built-in anatomical
+//! hand posed by joint angles and skinned with LB, QB or DQB ([`Hand`]: paper Figure 1, the
+//! kinematics and skin layers), its skin alone under transforms of one's own ([`Skinner`]), and
+//! both interaction loops, one or two hands driven by tracked hands in a scene or none
+//! ([`Interaction`]). The same library as the native `dqhand`, compiled for
+//! `wasm32-unknown-unknown` and bound with wasm-bindgen; `make wasm` builds it into
+//! `target/wasm/`, and Node tests check its skins, gesture events and grasps against the native
+//! commands'. The npm package `dqhand` (packages/dqhand) wraps it for three.js.
 //!
 //! ```js
 //! import { Hand, wasmMemory } from "./dqhand_wasm.js";
@@ -18,15 +21,17 @@
 use std::sync::Arc;
 
 use dqhand::engine::Engine;
-use dqhand::gesture::GestureSet;
+use dqhand::gesture::{EventKind, GestureSet, TwoHandEvent};
+use dqhand::grasp::GraspEvent;
 use dqhand::hand::{build, HandParams};
+use dqhand::input::array_record::{joints_record, landmarks_record};
 use dqhand::input::json_record::parse_record;
 use dqhand::input::{InputConfig, Record};
 use dqhand::grasp::GraspParams;
-use dqhand::interaction::{frame_trace, GestureLoop, ManipulationLoop};
+use dqhand::interaction::{frame_trace, scene_shapes, ManipulationLoop};
 use dqhand::kinematics::{JointModel, Pose, Side};
 use dqhand::scene::Scene;
-use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinnedMesh};
+use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinLayer, SkinnedMesh};
 use glam::Affine3A;
 use wasm_bindgen::prelude::*;
 
@@ -305,108 +310,306 @@ pub fn wasm_memory() -> JsValue {
     wasm_bindgen::memory()
 }
 
-/// The gesture loop (the paper's gesture interaction): records of a user's hand (WebXR or
-/// OpenXR joints, MediaPipe landmarks, as JSON lines, docs/formats.md) through the input
-/// pipeline (checks, filters, retargeting onto the built-in hand), forward kinematics, the finger
-/// features and the recogniser of the built-in gestures: the same loop as `dqhand replay`.
-#[wasm_bindgen(js_name = GestureLoop)]
-pub struct Gestures {
-    inner: GestureLoop,
-    side: Side,
+/// A user's hands in the page: one built-in hand (or a left and a right one) driven by tracked
+/// hands (WebXR joints, MediaPipe landmarks, recorded lines), their gestures recognised, in a
+/// scene or none, each rendered hand skinned where the page reads it with no copy. The paper's
+/// two loops in one: gesture interaction, and 3D manipulation when the scene has objects (the
+/// rendered hands stop on the objects and on each other, grasp and carry; `dqhand grasp`'s loop).
+///
+/// Per frame: push each tracked hand's record, then [`Self::step`]; read the skins through
+/// [`Self::positions_ptr`] and [`Self::normals_ptr`], the objects through [`Self::poses_ptr`],
+/// the events through [`Self::take_events`] when `step` says there are some. Nothing of that
+/// allocates in the module (its memory does not grow, so views of it stay valid).
+#[wasm_bindgen]
+pub struct Interaction {
+    manip: ManipulationLoop,
+    skins: Vec<SkinLayer>,
+    method: Method,
     record: Record,
+    /// Events since the last [`Self::take_events`], JSON lines.
+    events: String,
+    event_count: usize,
+    /// x y z, qx qy qz qw per object after the last step.
+    poses: Vec<f32>,
 }
 
-#[wasm_bindgen(js_class = GestureLoop)]
-impl Gestures {
-    /// A loop driving the built-in `side` hand (`"left"` or `"right"`: also the side of records
-    /// that do not say), recognising the built-in gestures.
+#[wasm_bindgen]
+impl Interaction {
+    /// Hands `"right"`, `"left"` or `"both"` (each built as itself, of `length` and `breadth`
+    /// m, as [`Hand::builtin`], default 0.19 and 0.085), in `scene`: `""` for none, a built-in
+    /// scene's name (`"grasp"`, `"objects"`, `"two-hands"`), or a scene file's JSON text
+    /// (docs/formats.md; shapes only: a page has no files for mesh objects). The rendered
+    /// hands are skinned with DQB.
     ///
     /// # Errors
-    /// Another side.
+    /// Other hands, a scene that is not built in or cannot be read (its problem on one line),
+    /// measurements that are not a hand's.
     #[wasm_bindgen(constructor)]
-    pub fn new(side: &str) -> Result<Gestures, JsError> {
-        let side = side_of(side)?;
-        let model = build(&HandParams { side, ..HandParams::default() }).map_err(js)?;
-        let inner = GestureLoop::new(Arc::new(model), JointModel::Full, None, InputConfig::default(), Some(GestureSet::builtin())).map_err(js)?;
-        Ok(Gestures { inner, side, record: Record { time: 0.0, side, hand: None, tracker: None, arrival: None } })
-    }
-
-    /// One record (a line of a recording): the gesture events it starts or ends, as JSON
-    /// lines, `dqhand replay`'s output (empty when none).
-    ///
-    /// # Errors
-    /// A record that cannot be read or is refused (its problem on one line); the loop goes on
-    /// as the native one does.
-    pub fn push(&mut self, line: &str) -> Result<String, JsError> {
-        if !read(line, self.side, &mut self.record, |r| self.inner.reject(r))? {
-            return Ok(String::new());
-        }
-        match self.inner.push(&self.record) {
-            Ok(events) => {
-                let mut out = String::new();
-                for event in events {
-                    out.push_str(&serde_json::to_string(&event).map_err(|e| JsError::new(&e.to_string()))?);
-                    out.push('\n');
-                }
-                Ok(out)
-            }
-            Err(rejection) => Err(JsError::new(&rejection.to_string())),
-        }
-    }
-}
-
-/// The manipulation loop (the paper's 3D manipulation): records of a user's hands drive the
-/// built-in hand, or a left and a right one, in a scene; each frame solves the rendered hand
-/// against the objects (continuous collision detection), its grasps and the physics. The same
-/// loop as `dqhand grasp`.
-#[wasm_bindgen(js_name = GraspLoop)]
-pub struct Grasps {
-    inner: ManipulationLoop,
-    side: Side,
-    record: Record,
-}
-
-#[wasm_bindgen(js_class = GraspLoop)]
-impl Grasps {
-    /// A loop in the built-in scene `scene` (`"grasp"`, `"objects"`) of the built-in right hand,
-    /// or with `two_hands` of a left and a right one (records drive the hand of their side; a
-    /// record that does not say drives the right one), with the default input configuration
-    /// and grasp parameters: `dqhand grasp`'s with no `--config` (no glove: records of joints or
-    /// landmarks).
-    ///
-    /// # Errors
-    /// A scene that is not built in.
-    #[wasm_bindgen(constructor)]
-    pub fn new(scene: &str, two_hands: bool) -> Result<Grasps, JsError> {
-        let scene = Scene::named(scene).map_err(js)?;
-        let hand = |side| build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js);
-        let (config, params) = (InputConfig::default(), GraspParams::default());
-        let inner = if two_hands {
-            ManipulationLoop::two_handed([(hand(Side::Left)?, None), (hand(Side::Right)?, None)], JointModel::Full, config, None, &scene, params)
-        } else {
-            ManipulationLoop::new(hand(Side::Right)?, JointModel::Full, None, config, None, &scene, params)
+    pub fn new(hands: &str, scene: &str, length: Option<f32>, breadth: Option<f32>) -> Result<Interaction, JsError> {
+        let scene = match scene.trim_start() {
+            "" => Scene { table: None, objects: Vec::new(), actions: Vec::new() },
+            text if text.starts_with('{') => Scene::from_json(text, "scene", std::path::Path::new("")).map_err(js)?,
+            name => Scene::named(name).map_err(js)?,
+        };
+        let defaults = HandParams::default();
+        let (length, breadth) = (length.unwrap_or(defaults.length), breadth.unwrap_or(defaults.breadth));
+        let hand = |side| build(&HandParams { length, breadth, side, ..HandParams::default() }).map(Arc::new).map_err(js);
+        let (config, params, gestures) = (InputConfig::default(), GraspParams::default(), Some(GestureSet::builtin()));
+        let manip = match hands {
+            "both" => ManipulationLoop::two_handed([(hand(Side::Left)?, None), (hand(Side::Right)?, None)], JointModel::Full, config, gestures, &scene, params),
+            one => ManipulationLoop::new(hand(side_of(one).map_err(|_| JsError::new(&format!("hands {one:?}: expected \"left\", \"right\" or \"both\"")))?)?, JointModel::Full, None, config, gestures, &scene, params),
         }
         .map_err(js)?;
-        Ok(Grasps { inner, side: Side::Right, record: Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None } })
+        let skins = manip
+            .hands()
+            .iter()
+            .map(|h| {
+                let mut skin = SkinLayer::new(Arc::clone(&h.input().model().mesh), MethodSet::DQB);
+                skin.deform(h.rendered().layer());
+                skin
+            })
+            .collect();
+        let side = manip.hands()[0].side();
+        let poses = vec![0.0; 7 * manip.names().len()];
+        let mut interaction = Interaction { manip, skins, method: Method::Dqb, record: Record { time: 0.0, side, hand: None, tracker: None, arrival: None }, events: String::new(), event_count: 0, poses };
+        interaction.read_poses();
+        Ok(interaction)
     }
 
-    /// One record (a line of a recording), taken in before the next [`Self::step`].
+    /// How many hands (1 or 2; of two, the left one is hand 0).
+    #[wasm_bindgen(getter, js_name = handCount)]
+    pub fn hand_count(&self) -> usize {
+        self.skins.len()
+    }
+
+    /// Hand `k`'s side, `"left"` or `"right"`.
+    pub fn side(&self, k: usize) -> String {
+        self.manip.hands()[k.min(self.skins.len() - 1)].side().name().to_owned()
+    }
+
+    /// Hand `k`'s vertex count.
+    #[wasm_bindgen(js_name = vertexCount)]
+    pub fn vertex_count(&self, k: usize) -> usize {
+        self.skin(k).mesh().vertex_count()
+    }
+
+    /// Hand `k`'s triangles, three vertex indices each (a copy: they never change).
+    pub fn indices(&self, k: usize) -> Vec<u32> {
+        self.skin(k).mesh().indices().to_vec()
+    }
+
+    /// Skins with `"lb"`, `"qb"` or `"dqb"` from now on. Allocates the method's buffers the
+    /// first time: take views of the memory again after it.
     ///
     /// # Errors
-    /// A record that cannot be read or is refused (its problem on one line); the loop goes on
-    /// as the native one does.
-    pub fn push(&mut self, line: &str) -> Result<(), JsError> {
-        if !read(line, self.side, &mut self.record, |r| self.inner.reject(r))? {
-            return Ok(());
+    /// Another name.
+    #[wasm_bindgen(js_name = setMethod)]
+    pub fn set_method(&mut self, method: &str) -> Result<(), JsError> {
+        let method = method.parse::<Method>().map_err(js)?;
+        for (skin, hand) in self.skins.iter_mut().zip(self.manip.hands()) {
+            skin.set_methods(MethodSet::new(&[method]).map_err(js)?);
+            skin.deform(hand.rendered().layer());
         }
-        self.inner.push(&self.record).map(|_| ()).map_err(|rejection| JsError::new(&rejection.to_string()))
+        self.method = method;
+        Ok(())
     }
 
-    /// Advances the loop to `now` (s, on the records' clock) and returns the frame as a JSON
-    /// line: `dqhand grasp --trace`'s (the rendered hands' contacts, what each holds, every
-    /// object's pose).
-    pub fn step(&mut self, now: f64) -> String {
-        self.inner.step(now);
-        frame_trace(now, &self.inner).to_string()
+    /// Where hand `k`'s skinned positions start in [`wasm_memory`]: `3 * vertexCount(k)` floats,
+    /// x y z per vertex, world metres, rewritten in place by each [`Self::step`].
+    #[wasm_bindgen(js_name = positionsPtr)]
+    pub fn positions_ptr(&self, k: usize) -> *const f32 {
+        self.deformed(k).positions().as_ptr().cast()
     }
+
+    /// Where hand `k`'s skinned unit normals start, laid out as the positions.
+    #[wasm_bindgen(js_name = normalsPtr)]
+    pub fn normals_ptr(&self, k: usize) -> *const f32 {
+        self.deformed(k).normals().as_ptr().cast()
+    }
+
+    /// One record of WebXR hand tracking: the 25 joints of `side`'s hand at `t` (s), as
+    /// `XRFrame.fillPoses` writes them (16 floats per joint, column-major, in the reference
+    /// space the scene is in: metres, +Y up) and `fillJointRadii` (25 floats, or empty).
+    ///
+    /// # Errors
+    /// A record that is refused (the problem on one line; the loop counts it and goes on).
+    #[wasm_bindgen(js_name = pushJoints)]
+    pub fn push_joints(&mut self, side: &str, t: f64, matrices: &[f32], radii: &[f32]) -> Result<(), JsError> {
+        let side = side_of(side)?;
+        let read = joints_record(t, side, matrices, radii, &mut self.record);
+        self.take(read)
+    }
+
+    /// One record of MediaPipe Hands: `side`'s 21 world landmarks at `t` (s), x y z each,
+    /// metres, in the engine's axes (`+Y` up; docs/formats.md says how the camera's map).
+    ///
+    /// # Errors
+    /// As [`Self::push_joints`].
+    #[wasm_bindgen(js_name = pushLandmarks)]
+    pub fn push_landmarks(&mut self, side: &str, t: f64, landmarks: &[f32]) -> Result<(), JsError> {
+        let side = side_of(side)?;
+        let read = landmarks_record(t, side, landmarks, &mut self.record);
+        self.take(read)
+    }
+
+    /// One line of a recording (docs/formats.md: joints, landmarks; a line that does not say
+    /// drives the first hand's side). Blank lines are skipped.
+    ///
+    /// # Errors
+    /// As [`Self::push_joints`].
+    #[wasm_bindgen(js_name = pushLine)]
+    pub fn push_line(&mut self, line: &str) -> Result<(), JsError> {
+        let side = self.manip.hands()[0].side();
+        if read(line, side, &mut self.record, |r| self.manip.reject(r))? {
+            self.take(Ok(()))?;
+        }
+        Ok(())
+    }
+
+    /// Advances to `now` (s, on the records' clock): each rendered hand follows its tracked
+    /// one, stopped by the objects and the other hand, grasps, carries and lets go, the
+    /// physics steps, and the skins are deformed. Returns how many events are waiting
+    /// ([`Self::take_events`]).
+    pub fn step(&mut self, now: f64) -> usize {
+        let events = self.manip.step(now);
+        for (k, event) in events.iter() {
+            let side = self.manip.hands()[k].side().name();
+            let line = match event {
+                GraspEvent::Grasp { object } => format!(r#"{{"t":{now},"hand":"{side}","event":"grasp","object":{}}}"#, json_str(&self.manip.names()[object])),
+                GraspEvent::Release { object, linvel, angvel } => format!(
+                    r#"{{"t":{now},"hand":"{side}","event":"release","object":{},"linvel":{:?},"angvel":{:?}}}"#,
+                    json_str(&self.manip.names()[object]),
+                    linvel.to_array(),
+                    angvel.to_array()
+                ),
+            };
+            self.add_event(&line);
+        }
+        for event in events.two_hand() {
+            let (kind, g) = match event {
+                TwoHandEvent::Start(g) => ("start", g),
+                TwoHandEvent::End(g) => ("end", g),
+            };
+            let name = self.manip.two_hand_gestures().map_or("", |r| r.gestures()[g].name.as_str());
+            let line = format!(r#"{{"t":{now},"hand":"both","event":"{kind}","gesture":{}}}"#, json_str(name));
+            self.add_event(&line);
+        }
+        for (skin, hand) in self.skins.iter_mut().zip(self.manip.hands()) {
+            skin.deform(hand.rendered().layer());
+        }
+        self.read_poses();
+        self.event_count
+    }
+
+    /// The events since the last call, JSON lines: `{"t", "hand", "event": "start" | "end",
+    /// "gesture"}` (`hand` `"both"` for a gesture of both hands), `{"t", "hand", "event":
+    /// "grasp", "object"}`, `{"t", "hand", "event": "release", "object", "linvel", "angvel"}`.
+    #[wasm_bindgen(js_name = takeEvents)]
+    pub fn take_events(&mut self) -> String {
+        self.event_count = 0;
+        std::mem::take(&mut self.events)
+    }
+
+    /// Hand `k`'s tracking: `"waiting"` (no record yet), `"tracking"` or `"lost"`.
+    pub fn tracking(&self, k: usize) -> String {
+        self.manip.hands()[k.min(self.skins.len() - 1)].tracking().as_str().to_owned()
+    }
+
+    /// Hand `k`'s current gesture, if any.
+    pub fn gesture(&self, k: usize) -> Option<String> {
+        self.manip.hands()[k.min(self.skins.len() - 1)].input().gesture().map(str::to_owned)
+    }
+
+    /// The object hand `k` holds (its index), or −1.
+    pub fn held(&self, k: usize) -> i32 {
+        self.manip.hands()[k.min(self.skins.len() - 1)].held().map_or(-1, |i| i as i32)
+    }
+
+    /// The scene's table and objects' shapes as JSON (`dqhand::interaction::scene_shapes`,
+    /// the objects in the order of [`Self::poses_ptr`]).
+    pub fn scene(&self) -> String {
+        scene_shapes(&self.manip, usize::MAX).to_string()
+    }
+
+    /// How many objects the scene has.
+    #[wasm_bindgen(getter, js_name = objectCount)]
+    pub fn object_count(&self) -> usize {
+        self.manip.names().len()
+    }
+
+    /// Where the objects' poses start in [`wasm_memory`]: 7 floats per object, position x y z
+    /// (m) and rotation x y z w, rewritten by each [`Self::step`].
+    #[wasm_bindgen(js_name = posesPtr)]
+    pub fn poses_ptr(&self) -> *const f32 {
+        self.poses.as_ptr()
+    }
+
+    /// Every object back where the scene puts it, at rest (on the next [`Self::step`]).
+    pub fn reset(&mut self) {
+        self.manip.reset();
+    }
+
+    /// The last frame as `dqhand grasp --trace` writes it at `now` (the time given to the last
+    /// [`Self::step`]): the rendered hands' contacts, what each holds, every object's pose.
+    pub fn trace(&self, now: f64) -> String {
+        frame_trace(now, &self.manip).to_string()
+    }
+
+    /// Records taken and refused so far, over every hand.
+    pub fn counts(&self) -> Vec<f64> {
+        let (accepted, refused) = self.manip.hands().iter().fold((0, 0), |(a, r), h| (a + h.input().pipeline().accepted(), r + h.input().pipeline().rejections().total()));
+        vec![accepted as f64, refused as f64]
+    }
+}
+
+impl Interaction {
+    fn skin(&self, k: usize) -> &SkinLayer {
+        &self.skins[k.min(self.skins.len() - 1)]
+    }
+
+    fn deformed(&self, k: usize) -> &Deformed {
+        self.skin(k).deformed(self.method).expect("every skin is deformed with its method from its construction on")
+    }
+
+    /// A record read into `self.record` (or refused) into the loop; its gesture events logged.
+    fn take(&mut self, read: Result<(), dqhand::input::Rejection>) -> Result<(), JsError> {
+        if let Err(rejection) = read {
+            let message = JsError::new(&rejection.to_string());
+            self.manip.reject(rejection);
+            return Err(message);
+        }
+        let side = self.manip.hands()[self.manip.hand_of(self.record.side)].side().name();
+        let mut lines = [None, None];
+        match self.manip.push(&self.record) {
+            Ok(events) => {
+                for (line, e) in lines.iter_mut().zip(events) {
+                    let kind = if e.event == EventKind::Start { "start" } else { "end" };
+                    *line = Some(format!(r#"{{"t":{},"hand":"{side}","event":"{kind}","gesture":{}}}"#, e.t, json_str(e.gesture)));
+                }
+            }
+            Err(rejection) => return Err(JsError::new(&rejection.to_string())),
+        }
+        for line in lines.into_iter().flatten() {
+            self.add_event(&line);
+        }
+        Ok(())
+    }
+
+    fn add_event(&mut self, line: &str) {
+        self.events.push_str(line);
+        self.events.push('\n');
+        self.event_count += 1;
+    }
+
+    fn read_poses(&mut self) {
+        for (out, (q, p)) in self.poses.chunks_exact_mut(7).zip(self.manip.poses()) {
+            out[..3].copy_from_slice(&p.to_array());
+            out[3..].copy_from_slice(&q.to_array());
+        }
+    }
+}
+
+/// `s` as a JSON string (quoted and escaped).
+fn json_str(s: &str) -> String {
+    serde_json::Value::from(s).to_string()
 }

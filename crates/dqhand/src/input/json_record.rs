@@ -301,7 +301,7 @@ fn glove_sample<S: AsRef<str>>(glove: &Entries<f32, MAX_GLOVE_SENSORS>, sensors:
 }
 
 /// A time field: finite and not negative.
-fn seconds(field: &str, t: f64) -> Result<f64, Rejection> {
+pub(super) fn seconds(field: &str, t: f64) -> Result<f64, Rejection> {
     if !t.is_finite() {
         return Err(Rejection::new(RejectKind::NonFinite, format!("{field}: {t} is not a finite time")));
     }
@@ -311,7 +311,8 @@ fn seconds(field: &str, t: f64) -> Result<f64, Rejection> {
     Ok(t)
 }
 
-fn position(p: [f32; 3], label: impl Fn() -> String) -> Result<Vec3, Rejection> {
+/// A position: finite and within [`MAX_DISTANCE`] of the origin.
+pub(super) fn position(p: [f32; 3], label: impl Fn() -> String) -> Result<Vec3, Rejection> {
     let v = Vec3::from(p);
     if !v.is_finite() {
         return Err(Rejection::new(RejectKind::NonFinite, format!("{}: position {p:?} is not finite", label())));
@@ -322,7 +323,8 @@ fn position(p: [f32; 3], label: impl Fn() -> String) -> Result<Vec3, Rejection> 
     Ok(v)
 }
 
-fn orientation(q: [f32; 4], label: impl Fn() -> String) -> Result<Quat, Rejection> {
+/// An orientation: finite and of about unit length (made unit).
+pub(super) fn orientation(q: [f32; 4], label: impl Fn() -> String) -> Result<Quat, Rejection> {
     let v = Quat::from_array(q);
     if !v.is_finite() {
         return Err(Rejection::new(RejectKind::NonFinite, format!("{}: orientation {q:?} is not finite", label())));

@@ -9,6 +9,7 @@ mod glove_layout;
 mod glove_mapper;
 mod glove_mapping;
 mod config;
+pub mod array_record;
 pub mod json_record;
 pub mod mediapipe;
 mod one_euro;

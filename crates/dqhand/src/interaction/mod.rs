@@ -20,6 +20,7 @@ pub mod grasp_script;
 mod manipulating_hand;
 mod manipulation_loop;
 mod manipulation_trace;
+mod scene_shapes;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
 #[cfg(feature = "synthetic")]
@@ -30,3 +31,4 @@ pub use gesture_loop::GestureLoop;
 pub use manipulating_hand::ManipulatingHand;
 pub use manipulation_loop::{HandEvents, ManipulationLoop};
 pub use manipulation_trace::frame_trace;
+pub use scene_shapes::scene_shapes;
