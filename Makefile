@@ -12,7 +12,7 @@ OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_p
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm
+.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -44,7 +44,7 @@ $(VIEWER_DEPS): viewer/package.json viewer/package-lock.json
 	cd viewer && $(NPM) ci --no-audit --no-fund
 	touch $@
 
-$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*)
+$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*) $(wildcard packages/dqhand/src/*)
 	cd viewer && $(NPM) run build
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
@@ -115,11 +115,21 @@ examples: recordings
 	$(CARGO) run --locked -q -p dqhand --example gestures_from_a_recording -- $(RECORDINGS)/gestures-joints.jsonl
 	$(CARGO) run --locked -q -p dqhand --features synthetic --example grasp_the_ball
 
+# The npm package `dqhand` (packages/dqhand): the web build of the engine, with and without
+# SIMD (one glue module serves both: wasm-bindgen writes the same for each), its TypeScript
+# compiled, packed into target/npm/dqhand-<version>.tgz as `npm publish` would ship it.
+package: wasm
+	cmp target/wasm/web/dqhand_wasm.js target/wasm/web-simd/dqhand_wasm.js
+	mkdir -p packages/dqhand/wasm target/npm
+	cp target/wasm/web/dqhand_wasm.js target/wasm/web/dqhand_wasm.d.ts target/wasm/web/dqhand_wasm_bg.wasm packages/dqhand/wasm/
+	cp target/wasm/web-simd/dqhand_wasm_bg.wasm packages/dqhand/wasm/dqhand_wasm_simd_bg.wasm
+	cd packages/dqhand && $(NPM) ci --no-audit --no-fund && rm -rf dist && npx tsc -p tsconfig.json && npm pack --pack-destination ../../target/npm
+
 # Rust tests (unit, property, golden, CLI, server, doctests; their temporary files, the
 # doctests' binaries among them, under target/ rather than a small /tmp), the features alone and the
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
 # browser tests against a real `dqhand demo`.
-test: assets viewer chromium recordings wasm
+test: assets viewer chromium recordings package
 	mkdir -p target/tmp
 	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) TMPDIR=$(CURDIR)/target/tmp $(CARGO) test --locked --workspace
 	$(MAKE) features examples

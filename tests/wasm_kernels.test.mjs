@@ -14,7 +14,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 import { countInstructions } from './support_wasm_code.mjs';
-import { buildDirectory, simdSupported, SIMD_PROBE } from '../crates/dqhand-wasm/js/simd.mjs';
+import { simdSupported, SIMD_PROBE } from '../packages/dqhand/dist/simd.js';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
@@ -138,7 +138,7 @@ function reference(method, m, q, p, n, inf) {
   return { position: rotate(c0, p).map((x, i) => x + tr[i]), normal: rotate(c0, n), ambiguous };
 }
 
-test('the SIMD build holds SIMD instructions and the other none; the probe picks the SIMD build here', () => {
+test('the SIMD build holds SIMD instructions and the other none; the probe picks the SIMD build here, and the package ships both', () => {
   const count = (dir) => countInstructions(readFileSync(path.join(root, 'target', 'wasm', dir, 'dqhand_wasm_bg.wasm')));
   const [plain, simd] = builds.map((b) => count(b.dir));
   assert.ok(plain.total > 10000 && simd.total > 10000, `instructions read: ${plain.total}, ${simd.total}`);
@@ -148,7 +148,10 @@ test('the SIMD build holds SIMD instructions and the other none; the probe picks
   // Node has had SIMD since 16.4; the probe is a module that validates only with it, and a
   // truncated one does not validate at all.
   assert.equal(simdSupported(), true);
-  assert.equal(buildDirectory(), 'web-simd');
+  // What the npm package ships (`make package`): its SIMD file holds them, its other none.
+  const shipped = (file) => countInstructions(readFileSync(path.join(root, 'packages', 'dqhand', 'wasm', file)));
+  assert.equal(shipped('dqhand_wasm_simd_bg.wasm').simd, simd.simd);
+  assert.equal(shipped('dqhand_wasm_bg.wasm').simd, 0);
   assert.equal(WebAssembly.validate(SIMD_PROBE.slice(0, -1)), false);
 });
 

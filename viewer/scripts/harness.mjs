@@ -3,7 +3,9 @@
 // rendered canvas back.
 
 import { spawn } from 'node:child_process';
-import { existsSync } from 'node:fs';
+import { createReadStream, existsSync, statSync } from 'node:fs';
+import { createServer } from 'node:http';
+import { createRequire } from 'node:module';
 import path from 'node:path';
 import { createInterface } from 'node:readline';
 import { fileURLToPath } from 'node:url';
@@ -48,6 +50,34 @@ export function startServer({ port = 0, args = [] } = {}) {
   });
 }
 
+/** Content types of what a built page holds (a .wasm must be application/wasm to stream-compile). */
+const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.css': 'text/css', '.wasm': 'application/wasm', '.json': 'application/json', '.png': 'image/png', '.svg': 'image/svg+xml', '.data': 'application/octet-stream', '.tflite': 'application/octet-stream', '.binarypb': 'application/octet-stream' };
+
+/**
+ * A plain static file server of `dir` on a free loopback port, as any web host is: files, their
+ * content types, nothing else (no dqhand process). Resolves to its URL and a `stop`.
+ * @param {string} dir
+ */
+export function serveStatic(dir) {
+  const top = path.resolve(dir);
+  const server = createServer((req, res) => {
+    const name = decodeURIComponent(new URL(req.url ?? '/', 'http://x').pathname);
+    const file = path.resolve(top, `.${name.endsWith('/') ? `${name}index.html` : name}`);
+    if (!file.startsWith(top + path.sep) || !existsSync(file) || !statSync(file).isFile()) {
+      res.writeHead(404).end();
+      return;
+    }
+    res.writeHead(200, { 'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream' });
+    createReadStream(file).pipe(res);
+  });
+  return new Promise((resolve) => {
+    server.listen(0, '127.0.0.1', () => {
+      const { port } = /** @type {import('node:net').AddressInfo} */ (server.address());
+      resolve({ url: `http://127.0.0.1:${port}/`, port, stop: () => new Promise((done) => server.close(() => done())) });
+    });
+  });
+}
+
 /**
  * Headless Chromium with software WebGL (SwiftShader), as on a machine without a GPU.
  * @param {string[]} [args] - more command-line switches (e.g. a fake camera's)
@@ -69,6 +99,27 @@ export function launchBrowser(args = []) {
 export async function newPage(browser, viewport = { width: 900, height: 520 }) {
   const p = await browser.newPage({ viewport });
   p.on('pageerror', (e) => console.error('page error:', e.message));
+  return p;
+}
+
+/** IWER's UMD build: defines `window.IWER`. */
+const IWER_BUNDLE = createRequire(import.meta.url).resolve('iwer/build/iwer.min.js');
+
+/**
+ * A page of `browser` with a headset emulated by IWER (a Meta Quest 3 tracking hands) injected
+ * before the page's own script, so the shipped page holds no emulator; the device is
+ * `window.iwer`. Over headless Chromium's own navigator.xr, which offers no immersive session.
+ * @param {import('playwright-core').Browser} browser
+ */
+export async function emulatedPage(browser) {
+  const p = await newPage(browser);
+  await p.addInitScript({ path: IWER_BUNDLE });
+  await p.addInitScript(() => {
+    const device = new window.IWER.XRDevice(window.IWER.metaQuest3);
+    device.primaryInputMode = 'hand';
+    device.installRuntime({ forceInstall: true });
+    window.iwer = device;
+  });
   return p;
 }
 

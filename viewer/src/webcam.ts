@@ -5,7 +5,7 @@
 // vite.config.ts), loaded on the first press: nothing comes from the network, and no frame
 // or landmark leaves the page except to the local engine.
 
-import { chosenHand, handsToSend, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from './landmarks';
+import { chosenHand, handsToSend, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from '../../packages/dqhand/src/landmarks';
 import type { Side } from './protocol';
 import type { InputSender } from './sender';
 

@@ -625,7 +625,7 @@ describe('the Camera button on a video of a hand not ours: the WebXR generic han
 
   test('MediaPipe\'s tracking error: its landmarks against the true joints, in the camera\'s frame', () => {
     // The records are in the engine's world: the camera's axes turned a half turn about z
-    // (src/landmarks.ts, cameraToWorld), undone here; the translation goes in the alignment.
+    // (packages/dqhand/src/landmarks.ts, placeLandmarks), undone here; the translation goes in the alignment.
     const frames = recorded.filter(({ frame }) => generic.gestures.some((h) => frame >= (h.from_s + SETTLED_S) * generic.fps && frame < h.to_s * generic.fps));
     const joints = truth.frames[0].joints;
     const chain = [0, 10, 11, 12, 13, 14]; // the wrist, the middle finger's joints to its tip

@@ -2,7 +2,7 @@
 // the axes written out here from their definitions.
 
 import { describe, expect, test } from 'vitest';
-import { CAMERA_FOV_DEG, HAND_DISTANCE_M, SIDE_CHANGE_FRAMES, SideFilter, chosenHand, handTranslation, handsToSend, landmarkRecord, userSide, type Point, type Vec3 } from '../src/landmarks';
+import { CAMERA_FOV_DEG, HAND_DISTANCE_M, SIDE_CHANGE_FRAMES, SideFilter, chosenHand, handTranslation, handsToSend, landmarkRecord, userSide, type Point, type Vec3 } from '../../packages/dqhand/src/landmarks';
 
 /** A right hand's 21 landmarks about their mean, as MediaPipe's world landmarks of a palm facing the camera, fingers up (m, camera axes: y down). */
 function rightHandFacingCamera(): Point[] {

@@ -4,14 +4,11 @@
 // records reaching the engine, its hand following the emulated one and drawn where that is,
 // and the desktop view back after the session.
 
-import { createRequire } from 'node:module';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import type { Browser, Page } from 'playwright-core';
 import type { XRDevice } from 'iwer';
-import { canvasStats, countColour, launchBrowser, newPage, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
+import { canvasStats, countColour, emulatedPage as emulatedPageOf, launchBrowser, newPage, settle, startServer, thumbDifference, waitState } from '../scripts/harness.mjs';
 
-/** IWER's UMD build: defines `window.IWER`. */
-const IWER_BUNDLE = createRequire(import.meta.url).resolve('iwer/build/iwer.min.js');
 /** The skin's colours, lit and shaded (the viewer's SKIN, 0xe0a98f). */
 const SKIN = { r: [120, 255], g: [70, 210], b: [70, 190] };
 /** The page's globals with the emulator: its module and the device, as the init script makes it. */
@@ -49,20 +46,8 @@ const canvasPlace = () => page.evaluate(() => {
 });
 
 
-/** A page of `browser` with the emulated headset injected before its own script. */
-async function emulatedPage(): Promise<Page> {
-  const p = await newPage(browser);
-  await p.addInitScript({ path: IWER_BUNDLE });
-  await p.addInitScript(() => {
-    const w = window as unknown as Emulated;
-    const device = new w.IWER.XRDevice(w.IWER.metaQuest3);
-    device.primaryInputMode = 'hand';
-    // Over headless Chromium's own navigator.xr, which offers no immersive session.
-    device.installRuntime({ forceInstall: true });
-    w.iwer = device;
-  });
-  return p;
-}
+/** A page of the tests' browser with the emulated headset. */
+const emulatedPage = () => emulatedPageOf(browser);
 
 beforeAll(async () => {
   server = await startServer();

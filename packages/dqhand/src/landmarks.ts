@@ -15,7 +15,8 @@ export interface Point {
   z: number;
 }
 
-import type { Side } from './protocol';
+/** A user's hand. */
+export type Side = 'left' | 'right';
 
 export type Vec3 = [number, number, number];
 
@@ -79,22 +80,33 @@ function solve3(m: number[], r: number[]): Vec3 | null {
   return [column(0) / d, column(1) / d, column(2) / d];
 }
 
-/** A point of the camera's space (m) in the engine's world, a hand at `HAND_DISTANCE_M` ahead landing on `anchor`. */
-export function cameraToWorld(p: Vec3, anchor: Vec3): Vec3 {
-  return [anchor[0] - p[0], anchor[1] - p[1], anchor[2] + p[2] - HAND_DISTANCE_M];
+/**
+ * One hand of MediaPipe's results in the engine's world, into `out` (63 floats: 21 landmarks,
+ * x y z, m): its world landmarks placed by [`handTranslation`] and turned about `anchor`.
+ * False (and `out` untouched) when the hand cannot be placed. Allocates nothing but the fit.
+ */
+export function placeLandmarks(world: readonly Point[], image: readonly Point[], aspect: number, anchor: Vec3, out: Float32Array | Float64Array): boolean {
+  if (world.length !== 21 || image.length !== 21 || out.length !== 63) return false;
+  const centre = handTranslation(world, image, aspect);
+  if (!centre) return false;
+  world.forEach((w, i) => {
+    // The camera's axes turned half about z (the file's header), a hand HAND_DISTANCE_M ahead on the anchor.
+    out[3 * i] = anchor[0] - (w.x + centre[0]);
+    out[3 * i + 1] = anchor[1] - (w.y + centre[1]);
+    out[3 * i + 2] = anchor[2] + (w.z + centre[2]) - HAND_DISTANCE_M;
+  });
+  return true;
 }
 
 /**
- * One hand of MediaPipe's results, the user's `side` one, as a landmarks record at time `t` (s): its world landmarks
- * placed by [`handTranslation`] and turned into the engine's world about `anchor`. Null when
- * the hand cannot be placed.
+ * One hand of MediaPipe's results, the user's `side` one, as a landmarks record at time `t` (s),
+ * placed as [`placeLandmarks`] does. Null when the hand cannot be placed.
  */
 export function landmarkRecord(t: number, side: Side, world: readonly Point[], image: readonly Point[], aspect: number, anchor: Vec3): LandmarkRecord | null {
-  if (world.length !== 21 || image.length !== 21) return null;
-  const centre = handTranslation(world, image, aspect);
-  if (!centre) return null;
+  const placed = new Float64Array(63);
+  if (!placeLandmarks(world, image, aspect, anchor, placed)) return null;
   const round = (x: number) => Math.round(x * 1e5) / 1e5; // 10 µm: the record stays small
-  const landmarks = world.map((w) => cameraToWorld([w.x + centre[0], w.y + centre[1], w.z + centre[2]], anchor).map(round) as Vec3);
+  const landmarks = Array.from({ length: 21 }, (_, i) => [round(placed[3 * i]), round(placed[3 * i + 1]), round(placed[3 * i + 2])] as Vec3);
   return { t, hand: side, landmarks };
 }
 

@@ -1,0 +1,385 @@
+// The engine in the page: loading the WebAssembly build this browser runs, and the two things
+// it makes, hands driven by tracking (`Hands`: both of the paper's loops, gestures and
+// manipulation) and a hand posed by joint angles (`PosedHand`). Skins and object poses are
+// read from the module's memory through views that are made again only when that memory grows
+// (which detaches every view of it), so a frame allocates nothing.
+
+import init, { Hand, Interaction, wasmMemory } from '../wasm/dqhand_wasm.js';
+import { simdSupported } from './simd.js';
+import { type Point, type Side, type Vec3, placeLandmarks } from './landmarks.js';
+import { XRJoints } from './xr.js';
+
+/** A skinning method: linear (LB), quaternion (QB) or dual quaternion blending (DQB, the default). */
+export type Method = 'lb' | 'qb' | 'dqb';
+
+/** Which build to load: `'auto'` picks the SIMD one where the browser validates SIMD. */
+export type Build = 'auto' | 'simd' | 'plain';
+
+export interface LoadOptions {
+  build?: Build;
+  /** Where the `.wasm` files are (a folder URL ending in `/`); default: beside this package's files. */
+  wasmBase?: string | URL;
+  /** The chosen build's `.wasm` itself, bytes or compiled (where there is no fetch of files: Node, workers). */
+  module?: BufferSource | WebAssembly.Module;
+}
+
+/** Anything with a skinned mesh in the engine's memory: what a `HandMesh` draws. */
+export interface SkinSource {
+  /** The hand's vertex count. */
+  vertexCount(hand: number): number;
+  /** Its triangles, three vertex indices each. */
+  indices(hand: number): Uint32Array;
+  /** Views of the skinned positions and normals (x y z per vertex, world metres), valid until the next call into the engine. */
+  skin(hand: number): { positions: Float32Array; normals: Float32Array };
+}
+
+/** What `step` reports: a gesture begun or ended (`hand` `'both'` for a gesture of both hands), an object grasped or let go. */
+export type HandEvent =
+  | { t: number; hand: Side | 'both'; event: 'start' | 'end'; gesture: string }
+  | { t: number; hand: Side; event: 'grasp'; object: string }
+  | { t: number; hand: Side; event: 'release'; object: string; linvel: Vec3; angvel: Vec3 };
+
+/** A scene object's shape in its own frame (metres; a cylinder's axis is +Y). */
+export type ObjectShape =
+  | { shape: 'sphere'; radius: number }
+  | { shape: 'box'; size: Vec3 }
+  | { shape: 'cylinder'; radius: number; height: number }
+  | { shape: 'mesh'; positions: number[]; indices: number[]; simplified: boolean };
+
+/** An object to put in a scene: docs/formats.md's scene object (shapes, not mesh files). */
+export type SceneObject = { name: string; position: Vec3; rotation?: [number, number, number, number]; mass: number; friction?: number; restitution?: number } & (
+  | { shape: 'sphere'; radius: number }
+  | { shape: 'box'; size: Vec3 }
+  | { shape: 'cylinder'; radius: number; height: number }
+);
+
+/** A scene: a table's top at `height` (m, +Y up) and objects; or a built-in scene's name (`'grasp'`, `'objects'`, `'two-hands'`). */
+export type SceneSpec = string | { table?: { height: number }; objects: SceneObject[]; actions?: { gesture: string; hold_s?: number; action: 'reset' }[] };
+
+export interface HandsOptions {
+  /** Which of the user's hands the engine drives (each built as itself); default `'right'`. */
+  hands?: Side | 'both';
+  /** The scene the hands manipulate; default none (gestures only). */
+  scene?: SceneSpec | null;
+  /** Wrist crease to middle fingertip (m), default 0.19; breadth across the knuckles (m), default 0.085. */
+  length?: number;
+  breadth?: number;
+}
+
+export interface PosedHandOptions {
+  side?: Side;
+  length?: number;
+  breadth?: number;
+  /** `'full'` (23 angles) or `'paper'` (18, the paper's Table 1). */
+  jointModel?: 'full' | 'paper';
+}
+
+/** The loaded engine: makes hands. One per page (the module is loaded once). */
+export class Engine {
+  private constructor(
+    /** Whether the SIMD build (the simd128 kernel) was loaded. */
+    readonly simd: boolean,
+  ) {}
+
+  /** @internal */
+  static async load(options: LoadOptions = {}): Promise<Engine> {
+    const simd = options.build === 'simd' || (options.build !== 'plain' && simdSupported());
+    const file = simd ? 'dqhand_wasm_simd_bg.wasm' : 'dqhand_wasm_bg.wasm';
+    const url = options.wasmBase ? new URL(file, options.wasmBase) : simd ? new URL('../wasm/dqhand_wasm_simd_bg.wasm', import.meta.url) : new URL('../wasm/dqhand_wasm_bg.wasm', import.meta.url);
+    await init({ module_or_path: options.module ?? url });
+    return new Engine(simd);
+  }
+
+  /** Hands driven by tracked hands, in a scene or none. Throws an `Error` of one line for bad options. */
+  hands(options: HandsOptions = {}): Hands {
+    return new Hands(options);
+  }
+
+  /** The built-in hand posed by joint angles. Throws an `Error` of one line for bad options. */
+  posedHand(options: PosedHandOptions = {}): PosedHand {
+    return new PosedHand(options);
+  }
+}
+
+let loading: Promise<Engine> | null = null;
+
+/** Loads the engine (once per page; later calls get the same one, whatever their options). */
+export function loadEngine(options: LoadOptions = {}): Promise<Engine> {
+  loading ??= Engine.load(options);
+  return loading;
+}
+
+/** A view of `count` floats at `ptr` in the module's memory, made again only when the memory has grown. */
+class MemoryView {
+  private buffer: ArrayBuffer | null = null;
+  private view = new Float32Array(0);
+  private at = -1;
+
+  get(ptr: number, count: number): Float32Array {
+    const buffer = wasmMemory().buffer as ArrayBuffer;
+    if (buffer !== this.buffer || ptr !== this.at || count !== this.view.length) {
+      [this.buffer, this.at, this.view] = [buffer, ptr, new Float32Array(buffer, ptr, count)];
+    }
+    return this.view;
+  }
+}
+
+const NO_EVENTS: readonly HandEvent[] = Object.freeze([]);
+
+/**
+ * One or two hands driven by the user's tracked hands: per frame, push what the trackers give
+ * (`pushXRFrame`, `pushLandmarks`, `pushMediaPipe`, `pushLine`), then `step(t)`. With a
+ * scene, the rendered hands stop on the objects and on each other, grasp, carry and let go,
+ * and the objects fall and roll. Hand 0 is the left one of two.
+ */
+export class Hands implements SkinSource {
+  private inner: Interaction;
+  private readonly spec: HandsOptions;
+  private views: { positions: MemoryView; normals: MemoryView }[] = [];
+  private readonly poseView = new MemoryView();
+  private readonly xr = new XRJoints();
+  private readonly landmarks = new Float32Array(63);
+  private shapes: ({ name: string } & ObjectShape)[] | null = null;
+  /** The scene's table top, null without one. */
+  private tableTop: { height: number; centre: [number, number]; half: [number, number] } | null = null;
+
+  /** @internal Use `Engine.hands`. */
+  constructor(options: HandsOptions) {
+    this.spec = { ...options };
+    this.inner = Hands.make(this.spec);
+    this.views = Array.from({ length: this.inner.handCount }, () => ({ positions: new MemoryView(), normals: new MemoryView() }));
+  }
+
+  private static make(o: HandsOptions): Interaction {
+    const scene = o.scene == null ? '' : typeof o.scene === 'string' ? o.scene : JSON.stringify(o.scene);
+    return new Interaction(o.hands ?? 'right', scene, o.length, o.breadth);
+  }
+
+  /** How many hands (1 or 2). */
+  get count(): number {
+    return this.inner.handCount;
+  }
+
+  /** Hand `k`'s side. */
+  side(k: number): Side {
+    return this.inner.side(k) as Side;
+  }
+
+  /** The hand of `side` (its index), or −1 when the engine drives none of that side. */
+  handOf(side: Side): number {
+    for (let k = 0; k < this.count; k++) if (this.side(k) === side) return k;
+    return -1;
+  }
+
+  vertexCount(k: number): number {
+    return this.inner.vertexCount(k);
+  }
+
+  indices(k: number): Uint32Array {
+    return this.inner.indices(k);
+  }
+
+  skin(k: number): { positions: Float32Array; normals: Float32Array } {
+    const n = 3 * this.inner.vertexCount(k);
+    const v = this.views[k];
+    return { positions: v.positions.get(this.inner.positionsPtr(k), n), normals: v.normals.get(this.inner.normalsPtr(k), n) };
+  }
+
+  /** Skins with `method` from now on. */
+  setMethod(method: Method): void {
+    this.inner.setMethod(method);
+  }
+
+  /**
+   * Pushes every hand of `frame`'s session the engine drives and the headset tracks in full
+   * (all 25 joints), posed in `space` (the scene's reference space, e.g. `'local-floor'`), at
+   * `t` seconds (default: the frame's time). Returns how many were pushed. A hand the tracker
+   * refuses is counted by the engine (`counts`), not thrown.
+   */
+  pushXRFrame(frame: XRFrame, space: XRReferenceSpace, t?: number): number {
+    let pushed = 0;
+    const sources = frame.session.inputSources;
+    for (let i = 0; i < sources.length; i++) {
+      const source = sources[i];
+      const side = source.handedness;
+      if (!source.hand || (side !== 'left' && side !== 'right') || (this.count === 1 && this.side(0) !== side)) continue;
+      if (!this.xr.read(frame, source.hand, space)) continue;
+      try {
+        this.inner.pushJoints(side, t ?? frame.predictedDisplayTime / 1000, this.xr.matrices, this.xr.radii);
+        pushed++;
+      } catch {
+        // Refused (counted by the engine); the hand keeps its last pose.
+      }
+    }
+    return pushed;
+  }
+
+  /** Pushes `side`'s 21 world landmarks (x y z each, m, the engine's axes: +Y up) at `t` s. Throws an `Error` of one line when refused. */
+  pushLandmarks(side: Side, t: number, landmarks: Float32Array): void {
+    this.inner.pushLandmarks(side, t, landmarks);
+  }
+
+  /**
+   * Pushes the hands of one MediaPipe Hands result (`multiHandWorldLandmarks`,
+   * `multiHandLandmarks`, `multiHandedness`) at `t` s, placed before the camera with the hand's
+   * middle `anchor` m in the world at half a metre from it (the camera facing the user; the
+   * image not mirrored). Returns how many hands were pushed.
+   */
+  pushMediaPipe(
+    results: { multiHandWorldLandmarks?: Point[][]; multiHandLandmarks?: Point[][]; multiHandedness?: { label: string }[] },
+    t: number,
+    aspect: number,
+    anchor: Vec3 = [0, 1.2, -0.3],
+  ): number {
+    const world = results.multiHandWorldLandmarks ?? [];
+    const image = results.multiHandLandmarks ?? [];
+    let pushed = 0;
+    world.forEach((w, i) => {
+      // MediaPipe labels hands as if the image were mirrored: the label is the other hand.
+      const side: Side = results.multiHandedness?.[i]?.label === 'Left' ? 'right' : 'left';
+      if (this.count === 1 && this.side(0) !== side) return;
+      if (!image[i] || !placeLandmarks(w, image[i], aspect, anchor, this.landmarks)) return;
+      try {
+        this.inner.pushLandmarks(side, t, this.landmarks);
+        pushed++;
+      } catch {
+        // Refused (counted); the hand keeps its last pose.
+      }
+    });
+    return pushed;
+  }
+
+  /** Pushes one line of a recording (docs/formats.md). Throws an `Error` of one line when refused. */
+  pushLine(line: string): void {
+    this.inner.pushLine(line);
+  }
+
+  /**
+   * Advances to `t` s (the records' clock): the hands follow, grasp and carry; the physics
+   * steps; the skins are deformed. Returns the events of the frame (a shared empty array when
+   * there are none).
+   */
+  step(t: number): readonly HandEvent[] {
+    if (this.inner.step(t) === 0) return NO_EVENTS;
+    return this.inner
+      .takeEvents()
+      .trim()
+      .split('\n')
+      .map((l) => JSON.parse(l) as HandEvent);
+  }
+
+  /** Hand `k`'s tracking: `'waiting'` (nothing yet), `'tracking'` or `'lost'`. */
+  tracking(k: number): 'waiting' | 'tracking' | 'lost' {
+    return this.inner.tracking(k) as 'waiting' | 'tracking' | 'lost';
+  }
+
+  /** Hand `k`'s gesture now, or null. */
+  gesture(k: number): string | null {
+    return this.inner.gesture(k) ?? null;
+  }
+
+  /** The name of the object hand `k` holds, or null. */
+  held(k: number): string | null {
+    const i = this.inner.held(k);
+    return i < 0 ? null : this.objects()[i].name;
+  }
+
+  /** The scene's objects' shapes, in the order of `poses`. */
+  objects(): readonly ({ name: string } & ObjectShape)[] {
+    this.readScene();
+    return this.shapes!;
+  }
+
+  /** The scene's table top (centre and half sizes along x and z), or null. */
+  table(): { height: number; centre: [number, number]; half: [number, number] } | null {
+    this.readScene();
+    return this.tableTop;
+  }
+
+  private readScene(): void {
+    if (this.shapes) return;
+    const scene = JSON.parse(this.inner.scene());
+    [this.shapes, this.tableTop] = [scene.objects, scene.table];
+  }
+
+  /** The objects' poses: 7 floats each, position x y z (m), rotation x y z w; a view, valid until the next call into the engine. */
+  poses(): Float32Array {
+    return this.poseView.get(this.inner.posesPtr(), 7 * this.inner.objectCount);
+  }
+
+  /**
+   * Adds `object` to the scene. The engine is made again around the scene with the other
+   * objects where they are now (and at rest): a hand's tracking starts over (at its next
+   * record), and an object held is let go.
+   */
+  addObject(object: SceneObject): void {
+    const base = typeof this.spec.scene === 'string' ? null : this.spec.scene;
+    if (typeof this.spec.scene === 'string' && this.spec.scene !== '') {
+      throw new Error(`addObject: the scene is the built-in ${JSON.stringify(this.spec.scene)}; give the scene as objects to add to it`);
+    }
+    const poses = this.poses();
+    const objects = (base?.objects ?? []).map((o, i) => ({ ...o, position: [poses[7 * i], poses[7 * i + 1], poses[7 * i + 2]] as Vec3, rotation: [poses[7 * i + 3], poses[7 * i + 4], poses[7 * i + 5], poses[7 * i + 6]] as [number, number, number, number] }));
+    const scene = { ...(base ?? {}), objects: [...objects, object] };
+    const next = Hands.make({ ...this.spec, scene });
+    this.inner.free();
+    [this.inner, this.spec.scene, this.shapes] = [next, scene, null];
+  }
+
+  /** Every object back where the scene puts it, at rest (at the next `step`). */
+  reset(): void {
+    this.inner.reset();
+  }
+
+  /** Records taken and refused so far, over every hand. */
+  counts(): { accepted: number; refused: number } {
+    const [accepted, refused] = this.inner.counts();
+    return { accepted, refused };
+  }
+
+  /** Frees the engine's memory of these hands; they cannot be used after. */
+  dispose(): void {
+    this.inner.free();
+  }
+}
+
+/** The built-in hand posed by joint angles (radians, in `dofNames` order), skinned with DQB unless told. */
+export class PosedHand implements SkinSource {
+  private readonly inner: Hand;
+  private readonly views = { positions: new MemoryView(), normals: new MemoryView() };
+
+  /** @internal Use `Engine.posedHand`. */
+  constructor(o: PosedHandOptions) {
+    this.inner = Hand.builtin(o.length ?? 0.19, o.breadth ?? 0.085, o.side ?? 'right', o.jointModel ?? 'full');
+  }
+
+  /** The angles' names, `'<bone>.<flex|abd>'`. */
+  dofNames(): string[] {
+    return this.inner.dofNames();
+  }
+
+  /** Poses `angles` (clamped to the hand's limits) and skins. Throws an `Error` of one line for a wrong count or a non-finite angle. */
+  setAngles(angles: Float32Array): void {
+    this.inner.step(angles);
+  }
+
+  setMethod(method: Method): void {
+    this.inner.setMethod(method);
+  }
+
+  vertexCount(): number {
+    return this.inner.vertexCount;
+  }
+
+  indices(): Uint32Array {
+    return this.inner.indices();
+  }
+
+  skin(): { positions: Float32Array; normals: Float32Array } {
+    const n = 3 * this.inner.vertexCount;
+    return { positions: this.views.positions.get(this.inner.positionsPtr(), n), normals: this.views.normals.get(this.inner.normalsPtr(), n) };
+  }
+
+  dispose(): void {
+    this.inner.free();
+  }
+}

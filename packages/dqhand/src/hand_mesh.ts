@@ -1,0 +1,48 @@
+// A skinned hand as a three.js mesh: its position and normal attributes are the engine's skin,
+// copied in place from the module's memory each frame (one copy each, nothing allocated; the
+// attributes own their arrays, so the module's memory growing never leaves them dangling).
+
+import { BufferAttribute, BufferGeometry, DynamicDrawUsage, Mesh, MeshStandardMaterial, type Material } from 'three';
+import type { SkinSource } from './engine.js';
+
+/** The skin's colour (a light skin tone, lit). */
+export const SKIN_COLOUR = 0xe0a98f;
+
+/**
+ * Hand `hand` of `source`, drawn. Its vertices are in world metres already (the engine places
+ * the hand where the tracked one is): leave the mesh's own transform at the identity, or put it
+ * under a parent to move the whole world. Call `update()` after each `step` (or `setAngles`).
+ */
+export class HandMesh extends Mesh<BufferGeometry, Material> {
+  constructor(
+    readonly source: SkinSource,
+    readonly hand = 0,
+    material: Material = new MeshStandardMaterial({ color: SKIN_COLOUR, roughness: 0.55, metalness: 0 }),
+  ) {
+    const n = source.vertexCount(hand);
+    const geometry = new BufferGeometry();
+    for (const name of ['position', 'normal']) {
+      geometry.setAttribute(name, new BufferAttribute(new Float32Array(3 * n), 3).setUsage(DynamicDrawUsage));
+    }
+    geometry.setIndex(new BufferAttribute(source.indices(hand), 1));
+    super(geometry, material);
+    this.name = 'dqhand';
+    this.update();
+  }
+
+  /** Copies the engine's latest skin into the attributes (and the bounds three.js culls and picks by). */
+  update(): void {
+    const { positions, normals } = this.source.skin(this.hand);
+    const { position, normal } = this.geometry.attributes as Record<string, BufferAttribute>;
+    (position.array as Float32Array).set(positions);
+    (normal.array as Float32Array).set(normals);
+    position.needsUpdate = normal.needsUpdate = true;
+    this.geometry.computeBoundingSphere();
+    this.geometry.computeBoundingBox();
+  }
+
+  /** Frees the geometry (the material is the caller's when given). */
+  dispose(): void {
+    this.geometry.dispose();
+  }
+}
