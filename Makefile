@@ -11,8 +11,10 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_party/node_modules/iwer/lib/device/configs/hand/pinch.js
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
+# The engine's web builds as the npm package and the page load them (make package-wasm).
+PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
-.PHONY: demo test build viewer assets chromium figures bench bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package
+.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -37,14 +39,15 @@ $(RECORDINGS)/gestures-joints.jsonl: $(wildcard crates/*/src/*.rs crates/*/src/*
 	$(DQHAND_DEBUG) synthesize --format glove --seed 2 --length 0.2 --breadth 0.09 --side right --out $(RECORDINGS)/gestures-glove.csv
 	$(DQHAND_DEBUG) synthesize --scene grasp --side right --out $(RECORDINGS)/grasp-joints.jsonl
 
-# The page (TypeScript + three.js, built by Vite into viewer/dist, which `dqhand demo` serves).
-viewer: $(VIEWER_DIST)
+# The page (TypeScript + three.js, built by Vite into viewer/dist, which `dqhand demo` or any
+# static host serves): it runs the engine itself, the package's WebAssembly (package-wasm).
+viewer: package-wasm $(VIEWER_DIST)
 
 $(VIEWER_DEPS): viewer/package.json viewer/package-lock.json
 	cd viewer && $(NPM) ci --no-audit --no-fund
 	touch $@
 
-$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*) $(wildcard packages/dqhand/src/*)
+$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*) $(wildcard packages/dqhand/src/*) $(PACKAGE_WASM)
 	cd viewer && $(NPM) run build
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
@@ -118,11 +121,18 @@ examples: recordings
 # The npm package `dqhand` (packages/dqhand): the web build of the engine, with and without
 # SIMD (one glue module serves both: wasm-bindgen writes the same for each), its TypeScript
 # compiled, packed into target/npm/dqhand-<version>.tgz as `npm publish` would ship it.
-package: wasm
+# `install -C` copies only what changed, so an unchanged engine does not rebuild the page.
+package-wasm: wasm
 	cmp target/wasm/web/dqhand_wasm.js target/wasm/web-simd/dqhand_wasm.js
-	mkdir -p packages/dqhand/wasm target/npm
-	cp target/wasm/web/dqhand_wasm.js target/wasm/web/dqhand_wasm.d.ts target/wasm/web/dqhand_wasm_bg.wasm packages/dqhand/wasm/
-	cp target/wasm/web-simd/dqhand_wasm_bg.wasm packages/dqhand/wasm/dqhand_wasm_simd_bg.wasm
+	mkdir -p packages/dqhand/wasm
+	install -C -m 644 target/wasm/web/dqhand_wasm.js target/wasm/web/dqhand_wasm.d.ts target/wasm/web/dqhand_wasm_bg.wasm packages/dqhand/wasm/
+	install -C -m 644 target/wasm/web-simd/dqhand_wasm_bg.wasm packages/dqhand/wasm/dqhand_wasm_simd_bg.wasm
+
+$(PACKAGE_WASM):
+	$(MAKE) package-wasm
+
+package: package-wasm
+	mkdir -p target/npm
 	cd packages/dqhand && $(NPM) ci --no-audit --no-fund && rm -rf dist && npx tsc -p tsconfig.json && npm pack --pack-destination ../../target/npm
 
 # Rust tests (unit, property, golden, CLI, server, doctests; their temporary files, the
@@ -172,6 +182,12 @@ bench: build
 	./target/release/dqhand bench
 	./target/release/dqhand bench --stream 3
 
+# The engine in WebAssembly timed in headless Chromium beside the native kernels, in one run:
+# deformers of both builds, the page's interaction frame, load to the first drawn hand
+# (docs/performance.md, "The engine in the browser").
+bench-web: build viewer chromium recordings
+	cd viewer && CHROMIUM=$(CHROMIUM) node scripts/bench-web.mjs
+
 # The viewer server under load and abuse (1, 10, 64 viewers; malformed flood; slowloris; a
 # slow reader), measured; `make test` runs a short version that asserts behaviour only.
 loadtest: build
@@ -206,7 +222,7 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules viewer/node_modules viewer/dist $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist packages/dqhand/wasm packages/dqhand/dist packages/dqhand/node_modules $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
 
 # The built-in gesture classifier, trained on the tuning split of varied hands (deterministic;
 # `dqhand gesture-bench --outside third_party/node_modules` reports on the held-out split).

@@ -24,6 +24,17 @@ export interface ConnectionEvents {
 
 const RETRY_MS = 500;
 
+/** An engine's text message to the handler of its type (throws a `ProtocolError` for a bad one). */
+export function dispatchText(text: string, events: ConnectionEvents): void {
+  const message = decodeText(text);
+  if (message.type === 'hello') events.hello(message);
+  else if (message.type === 'input') events.input(message);
+  else if (message.type === 'scene') events.scene(message);
+  else if (message.type === 'recording') events.recording(message);
+  else if (message.type === 'learning') events.learning(message);
+  else events.error(message.message);
+}
+
 export class Connection {
   private socket: WebSocket | null = null;
   /** Commands that set up the view, replayed after a reconnect, by kind. */
@@ -57,13 +68,7 @@ export class Connection {
   private receive(data: string | ArrayBuffer): void {
     try {
       if (typeof data === 'string') {
-        const message = decodeText(data);
-        if (message.type === 'hello') this.events.hello(message);
-        else if (message.type === 'input') this.events.input(message);
-        else if (message.type === 'scene') this.events.scene(message);
-        else if (message.type === 'recording') this.events.recording(message);
-        else if (message.type === 'learning') this.events.learning(message);
-        else this.events.error(message.message);
+        dispatchText(data, this.events);
         return;
       }
       this.bytesReceived += data.byteLength;

@@ -1,11 +1,13 @@
-// The viewer page: connects to the engine, draws its frames and turns controls into commands.
+// The viewer page: runs the engine (in the page, WebAssembly; or in `dqhand demo`, over a
+// WebSocket), draws its frames and turns controls into commands.
 
 import './style.css';
 import { Vector3 } from 'three';
-import { Connection } from './connection';
+import { Connection, type ConnectionEvents } from './connection';
 import { heldText, InputPanel } from './input';
 import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
+import { LocalConnection } from './local';
 import { InputSender } from './sender';
 import { Webcam } from './webcam';
 import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
@@ -32,18 +34,26 @@ const status = (text: string, kind: '' | 'ok' | 'error') => {
   s.className = kind;
 };
 
-const wsOrigin = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}`;
-/** The page's own live input to the engine: the camera's hand or an XR session's. */
-const sender = new InputSender(`${wsOrigin}/input`);
-const xr = new XRInput(scene.renderer, sender, $, {
-  changed: () => {
-    if (xr.active && webcam.state.on) webcam.stop('stopped for the VR or AR session');
-    showLive();
-  },
-  error: (message) => status(message, 'error'),
-});
+/**
+ * Whether the engine runs in this page: asked (`?engine=page` or `?engine=server`), else
+ * wherever `dqhand demo` does not serve the page (it answers `engine.json`; a static host has
+ * no such file).
+ */
+async function engineInPage(): Promise<boolean> {
+  const asked = params.get('engine');
+  if (asked === 'page' || asked === 'server') return asked === 'page';
+  try {
+    const answer = await fetch('./engine.json', { cache: 'no-store', signal: AbortSignal.timeout(3000) });
+    if (!answer.ok) return true;
+    return (await answer.json()).engine !== 'dqhand demo';
+  } catch {
+    // No answer in 3 s, or one that is not JSON (a host that answers every path with a page).
+    return true;
+  }
+}
 
-const connection = new Connection(`${wsOrigin}/stream`, {
+const wsOrigin = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}`;
+const events: ConnectionEvents = {
   hello(h) {
     hello = h;
     const second = h.second_hand ? ` — and a ${h.second_hand.side} hand: ${h.second_hand.description}` : '';
@@ -108,8 +118,21 @@ const connection = new Connection(`${wsOrigin}/stream`, {
     $<HTMLButtonElement>('record').disabled = !connected;
     showRecording(false); // a recording going on is announced by the new session
     sceneSet = false;
-    status(connected ? 'connected' : 'disconnected — reconnecting…', connected ? 'ok' : '');
+    status(connected ? (local ? 'engine in this page' : 'connected') : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
+};
+
+/** In the page: `?scene=NAME` puts the hand in a built-in scene, `&hands=2` both hands in it. */
+const local = (await engineInPage()) ? new LocalConnection(events, params.get('scene') ?? '', params.get('hands') === '2') : null;
+const connection = local ?? new Connection(`${wsOrigin}/stream`, events);
+/** The page's own live input to the engine: the camera's hand or an XR session's. */
+const sender = local?.input ?? new InputSender(`${wsOrigin}/input`);
+const xr = new XRInput(scene.renderer, sender, $, {
+  changed: () => {
+    if (xr.active && webcam.state.on) webcam.stop('stopped for the VR or AR session');
+    showLive();
+  },
+  error: (message) => status(message, 'error'),
 });
 
 // --- the user's own hand: camera and recording ------------------------------------------------
@@ -316,6 +339,7 @@ let engineUs = 0;
 function loop(now: number, xrFrame?: XRFrame): void {
   xr.update(now, xrFrame);
   scene.render();
+  if (frame) firstFrameMs ??= performance.now();
   frames++;
   if (now - since >= 1000) {
     pageFps = (frames * 1000) / (now - since);
@@ -342,6 +366,8 @@ function loop(now: number, xrFrame?: XRFrame): void {
     });
   }
 }
+/** When the first hand was drawn, ms after the page's navigation began (`make bench-web` reads it). */
+let firstFrameMs: number | null = null;
 // three.js's loop: the window's animation frames, or the XR session's while one runs.
 scene.renderer.setAnimationLoop(loop);
 
@@ -353,6 +379,9 @@ declare global {
 }
 window.dqhand = {
   state: () => ({
+    /** Where the engine runs: `'page'` (WebAssembly, here) or `'server'` (dqhand demo). */
+    engine: local ? 'page' : 'server',
+    firstFrameMs,
     connected: connection.connected,
     framesReceived: connection.framesReceived,
     errors: [...errors],

@@ -7,7 +7,15 @@
 /** The first wait before opening the socket again, and the longest (ms). */
 const RETRY_MS = [250, 5000] as const;
 
-export class InputSender {
+/** Where the page's live input goes: the server's `/input`, or the page's own engine. */
+export interface RecordSink {
+  /** Takes one record now, or drops it (false). */
+  send(record: object): boolean;
+  /** The records stop: the engine marks the hand lost after its grace time. */
+  close(): void;
+}
+
+export class InputSender implements RecordSink {
   private socket: WebSocket | null = null;
   /** When the socket may be opened again (performance.now(), ms), and the wait after the next failure. */
   private retryAt = 0;

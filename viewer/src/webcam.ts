@@ -7,7 +7,7 @@
 
 import { chosenHand, handsToSend, landmarkRecord, SideFilter, userSide, type Point, type Vec3 } from '../../packages/dqhand/src/landmarks';
 import type { Side } from './protocol';
-import type { InputSender } from './sender';
+import type { RecordSink } from './sender';
 
 /** MediaPipe Hands' solution API, as its script defines it on `window` (@mediapipe/hands index.d.ts). */
 interface HandsResults {
@@ -70,7 +70,7 @@ export class Webcam {
   readonly state: WebcamState = { on: false, status: 'off', frames: 0, detected: 0, sent: 0, hands: [], detectMs: 0, fps: 0, width: 0, height: 0 };
 
   constructor(
-    private readonly sender: InputSender,
+    private readonly sender: RecordSink,
     private readonly preview: HTMLCanvasElement,
     private readonly changed: (state: WebcamState) => void,
   ) {}

@@ -5,7 +5,7 @@
 
 import type { WebGLRenderer } from 'three';
 import type { Side } from './protocol';
-import type { InputSender } from './sender';
+import type { RecordSink } from './sender';
 
 export type XRMode = 'immersive-vr' | 'immersive-ar';
 
@@ -49,7 +49,7 @@ export class XRInput {
    */
   constructor(
     private readonly renderer: WebGLRenderer,
-    private readonly sender: InputSender,
+    private readonly sender: RecordSink,
     $: (id: string) => HTMLElement,
     private readonly events: { changed(): void; error(message: string): void },
   ) {

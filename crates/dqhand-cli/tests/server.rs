@@ -148,6 +148,11 @@ fn serves_the_page_and_nothing_outside_it() {
     assert_eq!(get(a, "/"), (200, "<!doctype html><title>viewer</title>".into()));
     assert_eq!(get(a, "/assets/app.js").0, 200);
     assert_eq!(get(a, "/index.html?x=1").0, 200);
+    // The page runs its engine here rather than in itself (a static host has no such file).
+    let (status, body) = get(a, "/engine.json");
+    assert_eq!((status, serde_json::from_str::<Value>(&body).unwrap()["engine"].as_str()), (200, Some("dqhand demo")));
+    assert_eq!(http(a, &format!("POST /engine.json HTTP/1.1\r\nHost: {a}\r\nContent-Length: 0\r\n\r\n")).0, 405);
+    assert_eq!(http(a, &format!("GET /engine.json HTTP/1.1\r\nHost: evil.example:{}\r\n\r\n", a.rsplit(':').next().unwrap())).0, 403, "a rebound Host is refused here too");
     for path in ["/../secret.txt", "/assets/../../secret.txt", "/%2e%2e/secret.txt", "/..%2fsecret.txt", "/assets%5c..%5c..%5csecret.txt", "//etc/passwd", "/missing.js", "/%zz"] {
         let (status, body) = get(a, path);
         assert!(status == 404 || status == 400, "{path}: {status}");

@@ -126,6 +126,10 @@ impl LearnRequest {
     }
 }
 
+/// Largest command a page may send (a server's socket or the page's own engine); larger ones
+/// are answered with an error. The hello tells the page.
+pub const MAX_COMMAND_BYTES: usize = 4 * 1024;
+
 impl Command {
     /// Parses one message.
     ///
@@ -133,5 +137,16 @@ impl Command {
     /// A one-line description of what is wrong with the JSON.
     pub fn parse(text: &str) -> Result<Self, String> {
         serde_json::from_str(text).map_err(|e| format!("not a valid command: {e}"))
+    }
+
+    /// Parses one message of a page, refusing one longer than [`MAX_COMMAND_BYTES`].
+    ///
+    /// # Errors
+    /// As [`Self::parse`], or the message's length.
+    pub fn parse_bounded(text: &str) -> Result<Self, String> {
+        if text.len() > MAX_COMMAND_BYTES {
+            return Err(format!("message of {} bytes refused (at most {MAX_COMMAND_BYTES})", text.len()));
+        }
+        Self::parse(text)
     }
 }

@@ -14,7 +14,7 @@ mod live_input;
 mod session;
 
 pub use action::{Action, ViewerAction};
-pub use command::{Command, LearnRequest};
+pub use command::{Command, LearnRequest, MAX_COMMAND_BYTES};
 pub use error::{Error, Result};
 pub use frame::{FrameHeader, FrameView, FrameWriter, Topology};
 pub use live_input::{InputUpdate, InputView, LiveInput, SCENE_PERIOD, STEP_PERIOD};

@@ -5,7 +5,7 @@
 //! sends [`Command`]s back. All per-frame buffers are allocated when the session starts.
 
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::{EulerRot, Quat, Vec3};
 use serde_json::json;

@@ -18,6 +18,8 @@
 //! const positions = new Float32Array(wasmMemory().buffer, hand.positionsPtr(), 3 * hand.vertexCount);
 //! ```
 
+mod local_stream;
+
 use std::sync::Arc;
 
 use dqhand::engine::Engine;
@@ -34,6 +36,8 @@ use dqhand::scene::Scene;
 use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinLayer, SkinnedMesh};
 use glam::Affine3A;
 use wasm_bindgen::prelude::*;
+
+pub use local_stream::LocalStream;
 
 /// A hand: its engine, the pose it was last given and the method it skins with.
 #[wasm_bindgen]
@@ -247,6 +251,13 @@ impl Skinner {
         self.method = method;
         self.deformer = Deformer::new(method, &self.mesh).with_kernel(kernel);
         Ok(())
+    }
+
+    /// Deforms normals too (`true`, the default) or positions only, from the next
+    /// [`Self::deform`] on (take views again: the buffers are new).
+    #[wasm_bindgen(js_name = setNormals)]
+    pub fn set_normals(&mut self, on: bool) {
+        self.out = if on { Deformed::new(&self.mesh) } else { Deformed::positions_only(&self.mesh) };
     }
 
     /// Deforms the skin by `transforms`: per joint the skinning transform (world × inverse

@@ -6,7 +6,7 @@
 
 import init, { Hand, Interaction, wasmMemory } from '../wasm/dqhand_wasm.js';
 import { simdSupported } from './simd.js';
-import { type Point, type Side, type Vec3, placeLandmarks } from './landmarks.js';
+import { type Point, type Side, type Vec3, placeLandmarks, userSide } from './landmarks.js';
 import { XRJoints } from './xr.js';
 
 /** A skinning method: linear (LB), quaternion (QB) or dual quaternion blending (DQB, the default). */
@@ -85,7 +85,7 @@ export class Engine {
   static async load(options: LoadOptions = {}): Promise<Engine> {
     const simd = options.build === 'simd' || (options.build !== 'plain' && simdSupported());
     const file = simd ? 'dqhand_wasm_simd_bg.wasm' : 'dqhand_wasm_bg.wasm';
-    const url = options.wasmBase ? new URL(file, options.wasmBase) : simd ? new URL('../wasm/dqhand_wasm_simd_bg.wasm', import.meta.url) : new URL('../wasm/dqhand_wasm_bg.wasm', import.meta.url);
+    const url = options.wasmBase ? new URL(file, new URL(options.wasmBase, import.meta.url)) : simd ? new URL('../wasm/dqhand_wasm_simd_bg.wasm', import.meta.url) : new URL('../wasm/dqhand_wasm_bg.wasm', import.meta.url);
     await init({ module_or_path: options.module ?? url });
     return new Engine(simd);
   }
@@ -105,7 +105,10 @@ let loading: Promise<Engine> | null = null;
 
 /** Loads the engine (once per page; later calls get the same one, whatever their options). */
 export function loadEngine(options: LoadOptions = {}): Promise<Engine> {
-  loading ??= Engine.load(options);
+  loading ??= Engine.load(options).catch((e: unknown) => {
+    loading = null; // a later call tries again
+    throw e;
+  });
   return loading;
 }
 
@@ -142,12 +145,15 @@ export class Hands implements SkinSource {
   private shapes: ({ name: string } & ObjectShape)[] | null = null;
   /** The scene's table top, null without one. */
   private tableTop: { height: number; centre: [number, number]; half: [number, number] } | null = null;
+  /** Each hand's side (read once: the engine's answer is a new string each time). */
+  private readonly sides: Side[];
 
   /** @internal Use `Engine.hands`. */
   constructor(options: HandsOptions) {
     this.spec = { ...options };
     this.inner = Hands.make(this.spec);
     this.views = Array.from({ length: this.inner.handCount }, () => ({ positions: new MemoryView(), normals: new MemoryView() }));
+    this.sides = this.views.map((_, k) => this.inner.side(k) as Side);
   }
 
   private static make(o: HandsOptions): Interaction {
@@ -162,7 +168,7 @@ export class Hands implements SkinSource {
 
   /** Hand `k`'s side. */
   side(k: number): Side {
-    return this.inner.side(k) as Side;
+    return this.sides[Math.min(k, this.sides.length - 1)];
   }
 
   /** The hand of `side` (its index), or −1 when the engine drives none of that side. */
@@ -223,7 +229,9 @@ export class Hands implements SkinSource {
    * Pushes the hands of one MediaPipe Hands result (`multiHandWorldLandmarks`,
    * `multiHandLandmarks`, `multiHandedness`) at `t` s, placed before the camera with the hand's
    * middle `anchor` m in the world at half a metre from it (the camera facing the user; the
-   * image not mirrored). Returns how many hands were pushed.
+   * image not mirrored). A hand MediaPipe labels as the other side now and then is taken as it
+   * says (the viewer steadies labels over frames: `SideFilter` in landmarks.ts). Returns how
+   * many hands were pushed.
    */
   pushMediaPipe(
     results: { multiHandWorldLandmarks?: Point[][]; multiHandLandmarks?: Point[][]; multiHandedness?: { label: string }[] },
@@ -234,10 +242,11 @@ export class Hands implements SkinSource {
     const world = results.multiHandWorldLandmarks ?? [];
     const image = results.multiHandLandmarks ?? [];
     let pushed = 0;
+    const sides = world.map((_, i) => userSide(results.multiHandedness?.[i]?.label === 'Left' ? 'Left' : 'Right'));
     world.forEach((w, i) => {
-      // MediaPipe labels hands as if the image were mirrored: the label is the other hand.
-      const side: Side = results.multiHandedness?.[i]?.label === 'Left' ? 'right' : 'left';
-      if (this.count === 1 && this.side(0) !== side) return;
+      // Two hands labelled alike are one hand seen twice as far as anyone can tell: only the first drives.
+      if ((this.count === 1 && this.side(0) !== sides[i]) || sides.indexOf(sides[i]) !== i) return;
+      const side = sides[i];
       if (!image[i] || !placeLandmarks(w, image[i], aspect, anchor, this.landmarks)) return;
       try {
         this.inner.pushLandmarks(side, t, this.landmarks);
@@ -310,7 +319,7 @@ export class Hands implements SkinSource {
   /**
    * Adds `object` to the scene. The engine is made again around the scene with the other
    * objects where they are now (and at rest): a hand's tracking starts over (at its next
-   * record), and an object held is let go.
+   * record), and an object held is let go. Make a new `SceneObjects` to draw the new object.
    */
   addObject(object: SceneObject): void {
     const base = typeof this.spec.scene === 'string' ? null : this.spec.scene;

@@ -53,8 +53,8 @@ export class SceneObjects extends Group {
 
   /** Moves each object to its pose, and colours the ones a hand holds. */
   update(): void {
-    const poses = this.hands.poses();
     for (let k = 0; k < this.hands.count; k++) this.heldNow[k] = this.hands.held(k);
+    const poses = this.hands.poses(); // after the calls above, which may grow the memory
     this.meshes.forEach((m, i) => {
       m.position.fromArray(poses, 7 * i);
       m.quaternion.fromArray(poses, 7 * i + 3);

@@ -6,8 +6,7 @@ use dqhand_stream::Command;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
 
-/// Largest command accepted from a page; larger ones are answered with an error.
-pub const MAX_COMMAND_BYTES: usize = 4 * 1024;
+pub use dqhand_stream::MAX_COMMAND_BYTES;
 /// Largest WebSocket message read at all; beyond it the connection is closed (after an
 /// error message), since the rest of the message would have to be read to go on.
 pub const MAX_WIRE_BYTES: usize = 64 * 1024;
@@ -33,10 +32,7 @@ pub enum Incoming {
 impl Incoming {
     pub fn of(message: Message) -> Self {
         match message {
-            Message::Text(text) if text.len() > MAX_COMMAND_BYTES => {
-                Self::Refused(format!("message of {} bytes refused (at most {MAX_COMMAND_BYTES})", text.len()))
-            }
-            Message::Text(text) => Command::parse(&text).map_or_else(Self::Refused, Self::Command),
+            Message::Text(text) => Command::parse_bounded(&text).map_or_else(Self::Refused, Self::Command),
             Message::Binary(_) => Self::Refused("binary messages are not commands; send JSON text".into()),
             Message::Close(_) => Self::Close,
             Message::Ping(_) | Message::Pong(_) | Message::Frame(_) => Self::Nothing,

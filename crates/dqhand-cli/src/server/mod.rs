@@ -104,6 +104,10 @@ fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
     }
 }
 
+/// Where the page learns that `dqhand demo` runs its engine (and streams it on
+/// [`socket::PATH`]); a static host has no such file, and the page then runs the engine itself.
+pub const ENGINE_PATH: &str = "/engine.json";
+
 /// One connection: a request for a file, or the upgrade to the engine stream. `head` is this
 /// connection's place among the heads still arriving, kept until its request is accepted (a
 /// refusal lingers in it); a served place is taken only then.
@@ -132,6 +136,11 @@ fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place
     match (accept, feed) {
         (Some(accept), Some(feed)) => input_socket::run(stream, request, &accept, feed),
         (Some(accept), None) => socket::run(stream, request, &accept, shared),
+        // The page asks whether its engine runs here (else it runs its own: a static host).
+        (None, _) if request.path == ENGINE_PATH => match request.method.as_str() {
+            "GET" | "HEAD" => request::respond(&stream, 200, "application/json", br#"{"engine": "dqhand demo", "stream": "/stream"}"#, request.method == "HEAD"),
+            _ => request::respond(&stream, 405, "text/plain", b"only GET and HEAD\n", false),
+        },
         (None, _) => match &shared.assets {
             Some(root) => assets::serve(&stream, &request, root),
             None => request::respond(&stream, 404, "text/plain", b"not found\n", false),

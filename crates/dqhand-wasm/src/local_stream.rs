@@ -1,0 +1,169 @@
+//! The viewer's engine in the page itself: what `dqhand demo` runs for each viewer (a
+//! `Session` posing and skinning the hand with the methods in view, the gesture sequence and
+//! its timeline, the live input every viewer follows, a scene with one or two hands), run by
+//! the page with no server, speaking the same messages: the hello, the topologies, binary
+//! frames, `input` and `scene` messages. The page's live input (its camera, a WebXR session)
+//! goes in as records; its commands (sliders, methods, heat map, timeline) as JSON text.
+
+use std::sync::Arc;
+
+use dqhand::gesture::GestureSet;
+use dqhand::grasp::GraspParams;
+use dqhand::hand::{build, HandParams};
+use dqhand::input::{InputConfig, Record};
+use dqhand::interaction::{GestureLoop, ManipulationLoop};
+use dqhand::kinematics::{JointModel, Side};
+use dqhand::scene::Scene;
+use dqhand_stream::{Applied, Command, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
+use wasm_bindgen::prelude::*;
+
+use crate::{js, read};
+
+/// Longest step of the engine's clock, s: after a stall (a hidden tab) it resumes, not races.
+const MAX_STEP_S: f32 = 0.1;
+/// What the hello names as the live input.
+const SOURCE: &str = "this page (camera or WebXR)";
+
+/// One viewer's engine and the live input it follows, in the page.
+#[wasm_bindgen]
+pub struct LocalStream {
+    session: Session,
+    input: LiveInput,
+    view: InputView,
+    /// The latest frame of each hand shown, encoded, and how many the last step wrote.
+    frames: [Vec<u8>; 2],
+    frame_count: usize,
+    /// Text messages for the page since it last took them.
+    texts: Vec<String>,
+    record: Record,
+    /// Steps counted since `rate_since` (s), and the rate over the last second.
+    rate: (f64, u32, f32),
+    clock: f64,
+}
+
+#[wasm_bindgen]
+impl LocalStream {
+    /// The built-in right hand, with `two_hands` a left one too (both follow the live input's
+    /// hand of their side), in `scene` (`""` for none, or a built-in scene's name).
+    ///
+    /// # Errors
+    /// A scene that is not built in; two hands with no scene (only a scene's loop drives two).
+    #[wasm_bindgen(constructor)]
+    pub fn new(scene: &str, two_hands: bool) -> Result<LocalStream, JsError> {
+        let hand = |side| build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js);
+        let model = hand(Side::Right)?;
+        let left = if two_hands { Some(hand(Side::Left)?) } else { None };
+        let (joint_model, config, gestures) = (JointModel::Full, InputConfig::default(), Some(GestureSet::builtin()));
+        let input = match (scene, &left) {
+            ("", None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, None, config, gestures).map_err(js)?, SOURCE, false),
+            ("", Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),
+            (name, left) => {
+                let scene = Scene::named(name).map_err(js)?;
+                let manip = match left {
+                    Some(left) => ManipulationLoop::two_handed([(Arc::clone(left), None), (Arc::clone(&model), None)], joint_model, config, gestures, &scene, GraspParams::default()),
+                    None => ManipulationLoop::new(Arc::clone(&model), joint_model, None, config, gestures, &scene, GraspParams::default()),
+                }
+                .map_err(js)?;
+                LiveInput::with_scene(manip, SOURCE, false)
+            }
+        }
+        .map_err(|e| JsError::new(&e.to_string()))?;
+        let session = Session::new(model, left.map(|l| (l, Side::Left)), joint_model).map_err(|e| JsError::new(&e.to_string()))?;
+        let view = input.view();
+        let record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
+        Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], frame_count: 0, texts: Vec::new(), record, rate: (0.0, 0, 0.0), clock: 0.0 })
+    }
+
+    /// The hello message (JSON text), as the server's first message.
+    pub fn hello(&self) -> String {
+        self.session.hello(MAX_COMMAND_BYTES, Some(&self.input))
+    }
+
+    /// How many hands are shown (1 or 2): the topologies the page reads.
+    #[wasm_bindgen(getter, js_name = handCount)]
+    pub fn hand_count(&self) -> usize {
+        self.session.topologies().len()
+    }
+
+    /// Hand `k`'s encoded topology (a binary message, as the server's).
+    pub fn topology(&self, k: usize) -> Vec<u8> {
+        self.session.topologies().get(k).map(|t| t.encode()).unwrap_or_default()
+    }
+
+    /// A command of the page (JSON text, docs/protocol.md). Returns what the page must do
+    /// itself: `""` nothing, `"record"` or `"stop-recording"` (the page records its own input).
+    ///
+    /// # Errors
+    /// A command that cannot be read or applied, or one the page's engine does not do
+    /// (learning a gesture live); the one-line message names it. Nothing changes then.
+    pub fn command(&mut self, text: &str) -> Result<String, JsError> {
+        let command = Command::parse_bounded(text).map_err(|e| JsError::new(&e))?;
+        if matches!(command, Command::Ack { .. }) {
+            return Ok(String::new());
+        }
+        match self.session.apply(&command).map_err(|e| JsError::new(&e.to_string()))? {
+            Applied::Frame => Ok(String::new()),
+            Applied::Hello => {
+                self.texts.push(self.hello());
+                Ok(String::new())
+            }
+            Applied::Record(on) => Ok(if on { "record" } else { "stop-recording" }.to_owned()),
+            Applied::Learn(_) => Err(JsError::new("learn: learning a gesture needs dqhand demo (the page's engine does not learn yet)")),
+        }
+    }
+
+    /// One record of the page's live input (a JSON line, docs/formats.md).
+    ///
+    /// # Errors
+    /// A record that cannot be read or is refused; the input counts it and goes on.
+    pub fn push(&mut self, line: &str) -> Result<(), JsError> {
+        let input = &self.input;
+        if read(line, Side::Right, &mut self.record, |r| input.reject(r))? {
+            input.push(&self.record, |_| {}).map_err(|r| JsError::new(&r.to_string()))?;
+        }
+        Ok(())
+    }
+
+    /// Advances the engine by `dt` seconds (the page's frame time): the timeline plays, the
+    /// hands follow the live input (in a scene, the rendered hands), and each hand's frame is
+    /// written. Returns how many frames ([`Self::frame_ptr`]); the text messages it made wait
+    /// in [`Self::take_texts`].
+    pub fn step(&mut self, dt: f32) -> usize {
+        let dt = dt.clamp(0.0, MAX_STEP_S);
+        self.session.advance(dt);
+        let update = self.input.update(&mut self.session, &mut self.view);
+        if update.hello {
+            self.texts.push(self.hello());
+        }
+        self.texts.extend([update.message, update.scene].into_iter().flatten());
+        self.clock += f64::from(dt);
+        let (since, count, fps) = &mut self.rate;
+        *count += 1;
+        if self.clock - *since >= 1.0 {
+            *fps = *count as f32 / (self.clock - *since) as f32;
+            (*since, *count) = (self.clock, 0);
+        }
+        let fps = *fps;
+        self.session.render(fps, &mut self.frames[0]);
+        self.frame_count = 1 + usize::from(self.session.render_second(fps, &mut self.frames[1]));
+        self.frame_count
+    }
+
+    /// Where frame `k` of the last step starts in the module's memory (`wasmMemory`).
+    #[wasm_bindgen(js_name = framePtr)]
+    pub fn frame_ptr(&self, k: usize) -> *const u8 {
+        self.frames[k.min(1)].as_ptr()
+    }
+
+    /// Frame `k`'s length in bytes.
+    #[wasm_bindgen(js_name = frameLen)]
+    pub fn frame_len(&self, k: usize) -> usize {
+        self.frames[k.min(1)].len()
+    }
+
+    /// The text messages (JSON: hello, input, scene) made since the last call.
+    #[wasm_bindgen(js_name = takeTexts)]
+    pub fn take_texts(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.texts)
+    }
+}

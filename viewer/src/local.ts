@@ -1,0 +1,148 @@
+// The engine in the page, with no server: the same engine `dqhand demo` runs for each viewer
+// (crates/dqhand-wasm/src/local_stream.rs, in WebAssembly), speaking the same messages, so the
+// page draws and controls it exactly as it does a server's. What a server does beside the
+// engine, the page does itself: its live input (camera, WebXR) goes straight in, and a
+// recording of it is saved as a file the browser downloads (it replays with `dqhand replay`).
+
+import init, { LocalStream, wasmMemory } from '../../packages/dqhand/wasm/dqhand_wasm.js';
+import { simdSupported } from '../../packages/dqhand/src/simd';
+import { decodeFrame, decodeTopology, encodeCommand, type Command } from './protocol';
+import { dispatchText, type ConnectionEvents } from './connection';
+import type { RecordSink } from './sender';
+
+/** The engine's step rate (Hz): a timer's, which runs during an XR session too (the window's animation frames stop then). */
+const RATE_HZ = 60;
+
+/** Loads the build this browser runs: with WebAssembly SIMD where it validates, else without. */
+async function loadEngine(): Promise<void> {
+  const url = simdSupported() ? new URL('../../packages/dqhand/wasm/dqhand_wasm_simd_bg.wasm', import.meta.url) : new URL('../../packages/dqhand/wasm/dqhand_wasm_bg.wasm', import.meta.url);
+  await init({ module_or_path: url });
+}
+
+/** The page's engine, driven by a timer; `send`, `setting` and `remember` as a server connection's. */
+export class LocalConnection {
+  connected = false;
+  framesReceived = 0;
+  bytesReceived = 0;
+  /** Records taken into the engine, and refused by it. */
+  sent = 0;
+  refused = 0;
+  private stream: LocalStream | null = null;
+  private last = 0;
+  /** The records of a recording going on (JSON lines), or null. */
+  private recorded: string[] | null = null;
+  private saved: { path: string | null; records: number } = { path: null, records: 0 };
+  /** The page's live input (camera, WebXR) into this engine. */
+  readonly input: RecordSink = { send: (record) => this.push(record), close: () => {} };
+
+  /** `scene`: a built-in scene's name or `''`; `twoHands`: a left hand too (a scene's). */
+  constructor(private readonly events: ConnectionEvents, scene: string, twoHands: boolean) {
+    void this.start(scene, twoHands);
+  }
+
+  private async start(scene: string, twoHands: boolean): Promise<void> {
+    try {
+      await loadEngine();
+      this.stream = new LocalStream(scene, twoHands);
+    } catch (e) {
+      this.events.error(`the page's engine: ${(e as Error).message}`);
+      return;
+    }
+    // As a connection opens: the status first, then the engine's hello and topologies.
+    this.connected = true;
+    this.events.status(true);
+    this.text(this.stream.hello());
+    for (let k = 0; k < this.stream.handCount; k++) this.events.topology(decodeTopology(this.stream.topology(k).slice().buffer as ArrayBuffer));
+    this.last = performance.now();
+    const timer = setInterval(() => {
+      try {
+        this.tick();
+      } catch (e) {
+        // The engine stopped (a trap in the WebAssembly): said once, and no more steps.
+        clearInterval(timer);
+        this.connected = false;
+        this.events.error(`the page's engine stopped: ${(e as Error).message}`);
+        this.events.status(false);
+      }
+    }, 1000 / RATE_HZ);
+  }
+
+  private tick(): void {
+    const stream = this.stream!;
+    const now = performance.now();
+    const frames = stream.step((now - this.last) / 1000);
+    this.last = now;
+    for (const text of stream.takeTexts()) this.text(text);
+    for (let k = 0; k < frames; k++) {
+      // A copy: the engine writes its next frame over this one, and the page keeps frames.
+      const [start, length] = [stream.framePtr(k), stream.frameLen(k)];
+      const bytes = (wasmMemory().buffer as ArrayBuffer).slice(start, start + length);
+      this.bytesReceived += bytes.byteLength;
+      this.framesReceived++;
+      try {
+        this.events.frame(decodeFrame(bytes));
+      } catch (e) {
+        this.events.error((e as Error).message);
+      }
+    }
+  }
+
+  private text(text: string): void {
+    try {
+      dispatchText(text, this.events);
+    } catch (e) {
+      this.events.error((e as Error).message);
+    }
+  }
+
+  /** Applies a command now (dropped before the engine has loaded). */
+  send(command: Command): void {
+    if (!this.stream) return;
+    try {
+      const todo = this.stream.command(encodeCommand(command));
+      if (todo === 'record') this.record(true);
+      else if (todo === 'stop-recording') this.record(false);
+    } catch (e) {
+      this.events.error((e as Error).message);
+    }
+  }
+
+  /** A setting: the page's engine lives as long as the page, so nothing is replayed later. */
+  setting(command: Command): void {
+    this.send(command);
+  }
+
+  remember(): void {}
+
+  /** One record of the page's live input into the engine (and the recording going on). */
+  private push(record: object): boolean {
+    if (!this.stream) return false;
+    const line = JSON.stringify(record);
+    try {
+      this.stream.push(line);
+      this.sent++;
+      this.recorded?.push(line);
+      return true;
+    } catch {
+      this.refused++; // counted by the engine too, and shown in the Input panel
+      return false;
+    }
+  }
+
+  /** Starts a recording of the live input, or stops it and has the browser download it. */
+  private record(on: boolean): void {
+    if (on) {
+      this.recorded ??= [];
+    } else if (this.recorded) {
+      const name = `dqhand-${new Date().toISOString().replace(/[:.]/g, '-')}.jsonl`;
+      const url = URL.createObjectURL(new Blob(this.recorded.map((l) => `${l}\n`), { type: 'application/x-ndjson' }));
+      const a = Object.assign(document.createElement('a'), { href: url, download: name });
+      a.click();
+      setTimeout(() => URL.revokeObjectURL(url), 10_000);
+      this.saved = { path: name, records: this.recorded.length };
+      this.recorded = null;
+    }
+    const { path, records } = on ? { path: 'a file this page downloads when you stop', records: 0 } : this.saved;
+    this.events.recording({ type: 'recording', on, path, records, failed: false });
+  }
+}
