@@ -55,10 +55,14 @@ const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
 
 /**
  * A plain static file server of `dir` on a free loopback port, as any web host is: files, their
- * content types, nothing else (no dqhand process). Resolves to its URL and a `stop`.
+ * content types, nothing else (no dqhand process). Resolves to its URL and a `stop`. With
+ * `isolated`, the pages are cross-origin isolated (COOP and COEP headers), which gives them
+ * performance.now() to 5 µs instead of 100 µs.
  * @param {string} dir
+ * @param {{ isolated?: boolean }} [options]
  */
-export function serveStatic(dir) {
+export function serveStatic(dir, { isolated = false } = {}) {
+  const isolation = isolated ? { 'cross-origin-opener-policy': 'same-origin', 'cross-origin-embedder-policy': 'require-corp' } : {};
   const top = path.resolve(dir);
   const server = createServer((req, res) => {
     const name = decodeURIComponent(new URL(req.url ?? '/', 'http://x').pathname);
@@ -67,7 +71,7 @@ export function serveStatic(dir) {
       res.writeHead(404).end();
       return;
     }
-    res.writeHead(200, { 'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream' });
+    res.writeHead(200, { 'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream', ...isolation });
     createReadStream(file).pipe(res);
   });
   return new Promise((resolve) => {
