@@ -317,6 +317,11 @@ impl ContactConstraint {
         // Carried by the same object last frame and this one, the hand has not moved on it:
         // what the fingers keep of their pose need not be asked of it again.
         let still_on = self.carried.filter(|&(o, _)| Some(o) == carrier);
+        if self.wrist.is_none() {
+            // Restarted: there is no last rendered hand but the tracked one (the one before
+            // the restart, or the rest pose, may be anywhere, in the table).
+            self.rendered.clone_from(&self.tracked);
+        }
         self.wrist = Some(wrist);
         self.previous.clone_from(&self.rendered);
         self.rendered.clone_from(&self.tracked);

@@ -13,7 +13,7 @@ use glam::{Affine3A, Mat3, Quat, Vec3};
 use parry3d::query::Ray;
 
 use super::synthetic::joint_set;
-use crate::collision::{ObjectCollider, ObjectColliders, TableTop};
+use crate::collision::{fit_proxies, ObjectCollider, ObjectColliders, Proxy, ProxyShape, TableTop, FINGERS};
 use crate::gesture::gesture;
 use crate::kinematics::Side;
 use crate::input::{HandData, Record, TrackedJoint};
@@ -26,9 +26,15 @@ use crate::{Error, Result, SceneProblem};
 const PRESS_M: f32 = 0.01;
 /// Where the hand starts and ends, back from the grasp along the approach, m.
 const STANDOFF_M: f32 = 0.2;
-/// How far above the table's top a scripted grasp keeps the hand's joints (about a finger's
-/// half thickness, m).
-const TABLE_CLEARANCE_M: f32 = 0.01;
+/// How far above the table's top a scripted hand keeps its skin, m: its proxies (the skin and
+/// a 1 mm margin) then leave the contact constraint's stop gap, so the rendered hand can be
+/// where the tracked one is. (Its joints 1 cm up, as before, put the skin of a proximal
+/// phalanx, 12.5 mm round its joint, in the table, and a rendered finger blocked open there
+/// dragged a released ball along.)
+const SKIN_CLEARANCE_M: f32 = 0.002;
+/// Turns about the approach a hand taking a thing from a table may be given, degrees, fewest
+/// first ([`grasp`]).
+const TILTS_DEG: [f32; 7] = [0.0, 10.0, -10.0, 20.0, -20.0, 30.0, -30.0];
 /// Carrying speed, m/s.
 const CARRY_SPEED: f32 = 0.5;
 
@@ -165,7 +171,11 @@ enum Lead {
 /// the palm it meets a mug or a teapot first and holds the palm 4 cm off.
 struct Closing {
     pinch: bool,
-    dofs: Vec<(f32, f32, Lead)>,
+    /// Per DOF: open and shut angles, how it follows, its finger (in [`FINGERS`] order) and,
+    /// for a finger's abduction, its angle when held against the middle finger.
+    dofs: Vec<(f32, f32, Lead, usize, Option<f32>)>,
+    /// Per finger, held against the middle finger (not splayed) all through.
+    together: [bool; 5],
 }
 
 impl Closing {
@@ -193,16 +203,22 @@ impl Closing {
                 } else {
                     Lead::Distal
                 };
-                (open, shut, lead)
+                let finger = FINGERS.iter().position(|f| d.bone.starts_with(f)).expect("every DOF is a finger's");
+                let together = (d.motion == Motion::Abd && !thumb).then_some(if d.bone.starts_with("middle") { 0.0 } else { d.min_deg });
+                (open, shut, lead, finger, together)
             })
             .collect();
-        Self { pinch, dofs }
+        Self { pinch, dofs, together: [false; 5] }
     }
 
     /// The hand closed by `closed` (0 open, 1 shut).
     fn pose(&self, closed: f32) -> Pose {
         let mut pose = Pose::rest(self.dofs.len());
-        for (a, &(open, shut, lead)) in pose.angles.iter_mut().zip(&self.dofs) {
+        for (a, &(open, shut, lead, finger, together)) in pose.angles.iter_mut().zip(&self.dofs) {
+            if let Some(together) = together.filter(|_| self.together[finger]) {
+                *a = together.to_radians();
+                continue;
+            }
             let s = match lead {
                 Lead::Even => closed,
                 Lead::Knuckle => (closed / 0.6).min(1.0),
@@ -232,6 +248,8 @@ struct HandPath {
     rotation: Quat,
     side: Side,
     keys: Vec<Key>,
+    /// Shapes holding the skin of each bone: what keeps the hand off the table.
+    skin: Vec<Proxy>,
 }
 
 impl HandPath {
@@ -249,14 +267,17 @@ impl HandPath {
             let world = Mat3::from_cols(d, f, d.cross(f));
             Quat::from_mat3(&(world * hand.transpose())).normalize()
         };
-        Ok(Self { hand, joints, closing, frame, rotation, side, keys: Vec::new() })
+        Ok(Self { hand, joints, closing, frame, rotation, side, keys: Vec::new(), skin: fit_proxies(model, 0.0) })
     }
 
     /// Where the palm goes to take `object`, aiming `aim` off its middle. A grasp (`grip`):
     /// the palm presses into the surface point seen along the approach `d` through the middle
     /// of the object's bounding box, shifted across the approach so that the hand's grip
-    /// point is over the middle; a flat hand, the palm's centre is. A pinch: the tips meet in
-    /// the middle.
+    /// point is over the middle; a flat hand, the palm's centre is. Where that line misses the
+    /// object (the grip point of a power grasp is 4–5 cm out along the fingers, past a 4 cm
+    /// ball's edge), the palm presses into the surface seen through the middle: the fingers lie
+    /// on it there, and the palm is not pushed to the object's middle plane. A pinch: the tips
+    /// meet in the middle.
     fn reach(&self, object: &ObjectCollider, d: Vec3, aim: Vec3, grip: bool) -> Vec3 {
         let offset = if grip { self.rotation * (self.frame.grip - self.frame.palm) } else { Vec3::ZERO };
         let offset = offset - (aim - d * aim.dot(d));
@@ -264,24 +285,68 @@ impl HandPath {
             return object.aabb().center() - offset;
         }
         let centre = object.aabb().center() - (offset - d * offset.dot(d));
-        let ray = Ray::new(centre - d, d);
-        let toi = object.surface.cast_ray(&object.pose, &ray, 2.0, true).unwrap_or(1.0);
+        let cast = |from: Vec3| object.surface.cast_ray(&object.pose, &Ray::new(from - d, d), 2.0, true);
+        let toi = cast(centre).or_else(|| cast(object.aabb().center())).unwrap_or(1.0);
         centre - d + d * (toi + PRESS_M)
     }
 
-    /// `palm` raised until the open hand there, and closed, is clear of the table's top by
-    /// [`TABLE_CLEARANCE_M`] (a hand taking a ball from the side, thumb up, cannot have its
-    /// little finger in the table).
+    /// `palm` raised until the open hand there, and closed, has its skin [`SKIN_CLEARANCE_M`]
+    /// above the table's top; a finger whose skin would be in the table open is held against
+    /// the middle finger first, not splayed ([`Closing::together`]: the splayed little finger
+    /// of an open hand taking a ball from the side, thumb up, reaches 3 cm below its knuckle,
+    /// which raises the whole hand until the ball is out of the thumb's reach). Returns the
+    /// palm.
     fn above_table(&mut self, palm: Vec3, table: Option<TableTop>) -> Vec3 {
         let Some(table) = table else { return palm };
-        let lowest = [0.0, 1.0].map(|c| {
-            let mut pose = self.closing.pose(c);
-            pose.wrist = Some(self.wrist_at(palm));
-            self.hand.pose(&pose);
-            self.hand.world().iter().map(|w| w.translation.y).fold(f32::INFINITY, f32::min)
-        });
-        let deficit = table.height + TABLE_CLEARANCE_M - lowest[0].min(lowest[1]);
-        palm + Vec3::Y * deficit.max(0.0)
+        let floor = table.height + SKIN_CLEARANCE_M;
+        self.closing.together = [false; 5];
+        for finger in 1..FINGERS.len() {
+            self.closing.together[finger] = self.lowest(palm, 0.0, Some(finger)) < floor;
+        }
+        let lowest = self.lowest(palm, 0.0, None).min(self.lowest(palm, 1.0, None));
+        palm + Vec3::Y * (floor - lowest).max(0.0)
+    }
+
+    /// The lowest point of the skin of the hand with its palm at `palm` closed by `closed`:
+    /// of `finger`'s bones (in [`FINGERS`] order), or of all.
+    fn lowest(&mut self, palm: Vec3, closed: f32, finger: Option<usize>) -> f32 {
+        let mut pose = self.closing.pose(closed);
+        pose.wrist = Some(self.wrist_at(palm));
+        self.hand.pose(&pose);
+        let joints = self.hand.skeleton().joints();
+        let world = self.hand.world();
+        let lowest = |p: &Proxy| {
+            let w = world[p.joint];
+            match &p.shape {
+                ProxyShape::Capsule { start, end, radius } => w.transform_point3(*start).y.min(w.transform_point3(*end).y) - radius,
+                ProxyShape::ConvexHull { points, .. } => points.iter().map(|q| w.transform_point3(*q).y).fold(f32::INFINITY, f32::min),
+            }
+        };
+        self.skin.iter().filter(|p| finger.is_none_or(|f| joints[p.joint].name.starts_with(FINGERS[f]))).map(lowest).fold(f32::INFINITY, f32::min)
+    }
+
+    /// Where the palm goes to take `object` (aiming `aim` off its middle) with the hand clear
+    /// of `table` ([`Self::reach`], [`Self::above_table`]), turned about the approach `d` by
+    /// the first of [`TILTS_DEG`] that needs the least raise: a user taking a ball off a
+    /// table from the side tips the fingers up rather than lift the hand over it and take it
+    /// by its upper half (the table would hold the palm 3 cm above the ball's middle, out of
+    /// the thumb's reach). From above, a turn about the approach changes no height, and the
+    /// hand is not turned.
+    fn place(&mut self, object: &ObjectCollider, d: Vec3, aim: Vec3, table: Option<TableTop>) -> Vec3 {
+        let base = self.rotation;
+        let mut best = (f32::INFINITY, 0.0);
+        for tilt in TILTS_DEG {
+            self.rotation = Quat::from_axis_angle(d, tilt.to_radians()) * base;
+            let at = self.reach(object, d, aim, true);
+            let raise = self.above_table(at, table).y - at.y;
+            // Less by a millimetre: not for rounding.
+            if raise < best.0 - 0.001 {
+                best = (raise, tilt);
+            }
+        }
+        self.rotation = Quat::from_axis_angle(d, best.1.to_radians()) * base;
+        let at = self.reach(object, d, aim, true);
+        self.above_table(at, table)
     }
 
     /// The wrist that puts the palm at `palm`.
@@ -346,8 +411,7 @@ pub fn grasp(model: Arc<Model>, file: &str, objects: &ObjectColliders, task: &Gr
     let object = find(objects, file, &task.object)?;
     let d = task.approach.normalize();
     let mut path = HandPath::new(&model, side, d, task.fingers, task.pinch)?;
-    let grasp_at = path.reach(object, d, task.aim, true);
-    let grasp_at = path.above_table(grasp_at, objects.table());
+    let grasp_at = path.place(object, d, task.aim, objects.table());
     let start = grasp_at - d * STANDOFF_M;
     let lifted = grasp_at + Vec3::Y * task.lift;
     let carried = lifted + task.carry;
