@@ -4,20 +4,14 @@
 // engine, the page does itself: its live input (camera, WebXR) goes straight in, and a
 // recording of it is saved as a file the browser downloads (it replays with `dqhand replay`).
 
-import init, { LocalStream, wasmMemory } from '../../packages/dqhand/wasm/dqhand_wasm.js';
-import { simdSupported } from '../../packages/dqhand/src/simd';
+import { LocalStream, wasmMemory } from '../../packages/dqhand/wasm/dqhand_wasm.js';
+import { loadEngine } from '../../packages/dqhand/src/engine';
 import { decodeFrame, decodeTopology, encodeCommand, type Command } from './protocol';
 import { dispatchText, type ConnectionEvents } from './connection';
 import type { RecordSink } from './sender';
 
 /** The engine's step rate (Hz): a timer's, which runs during an XR session too (the window's animation frames stop then). */
 const RATE_HZ = 60;
-
-/** Loads the build this browser runs: with WebAssembly SIMD where it validates, else without. */
-async function loadEngine(): Promise<void> {
-  const url = simdSupported() ? new URL('../../packages/dqhand/wasm/dqhand_wasm_simd_bg.wasm', import.meta.url) : new URL('../../packages/dqhand/wasm/dqhand_wasm_bg.wasm', import.meta.url);
-  await init({ module_or_path: url });
-}
 
 /** The page's engine, driven by a timer; `send`, `setting` and `remember` as a server connection's. */
 export class LocalConnection {
