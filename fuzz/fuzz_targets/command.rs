@@ -14,7 +14,7 @@ static HAND: LazyLock<Arc<Model>> = LazyLock::new(|| Arc::new(build(&HandParams 
 
 fuzz_target!(|bytes: &[u8]| {
     let Ok(text) = std::str::from_utf8(bytes) else { return };
-    let mut session = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let mut session = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     for line in text.lines() {
         if let Ok(command) = Command::parse(line) {
             let before = session.pose().clone();

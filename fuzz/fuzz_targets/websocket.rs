@@ -44,7 +44,7 @@ impl Write for Client<'_> {
 
 fuzz_target!(|bytes: &[u8]| {
     let mut ws = messages::server_socket(Client(bytes), Vec::new());
-    let mut session = Session::new(HAND.clone(), JointModel::Full).unwrap();
+    let mut session = Session::new(HAND.clone(), None, JointModel::Full).unwrap();
     // The server reads on after a timeout only; a client's bytes running out is an error.
     while let Ok(message) = ws.read() {
         assert!(message.len() <= MAX_WIRE_BYTES, "a message of {} bytes read", message.len());
