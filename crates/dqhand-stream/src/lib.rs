@@ -10,6 +10,7 @@ mod action;
 mod command;
 mod error;
 pub mod frame;
+mod frame_rate;
 mod live_input;
 mod session;
 
@@ -17,5 +18,6 @@ pub use action::{Action, ViewerAction};
 pub use command::{Command, LearnRequest, MAX_COMMAND_BYTES};
 pub use error::{Error, Result};
 pub use frame::{FrameHeader, FrameView, FrameWriter, Topology};
+pub use frame_rate::FrameRate;
 pub use live_input::{InputUpdate, InputView, LiveInput, SCENE_PERIOD, STEP_PERIOD};
 pub use session::{Applied, Session, GESTURE_SECONDS};

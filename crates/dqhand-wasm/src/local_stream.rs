@@ -14,7 +14,7 @@ use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::{GestureLoop, ManipulationLoop};
 use dqhand::kinematics::{JointModel, Side};
 use dqhand::scene::Scene;
-use dqhand_stream::{Applied, Command, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
+use dqhand_stream::{Applied, Command, FrameRate, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
 use wasm_bindgen::prelude::*;
 
 use crate::{js, read};
@@ -30,14 +30,13 @@ pub struct LocalStream {
     session: Session,
     input: LiveInput,
     view: InputView,
-    /// The latest frame of each hand shown, encoded, and how many the last step wrote.
+    /// The latest frame of each hand shown, encoded.
     frames: [Vec<u8>; 2],
-    frame_count: usize,
     /// Text messages for the page since it last took them.
     texts: Vec<String>,
     record: Record,
-    /// Steps counted since `rate_since` (s), and the rate over the last second.
-    rate: (f64, u32, f32),
+    rate: FrameRate,
+    /// The engine's clock: the steps' times added up (s).
     clock: f64,
 }
 
@@ -71,7 +70,7 @@ impl LocalStream {
         let session = Session::new(model, left.map(|l| (l, Side::Left)), joint_model).map_err(|e| JsError::new(&e.to_string()))?;
         let view = input.view();
         let record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
-        Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], frame_count: 0, texts: Vec::new(), record, rate: (0.0, 0, 0.0), clock: 0.0 })
+        Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], texts: Vec::new(), record, rate: FrameRate::default(), clock: 0.0 })
     }
 
     /// The hello message (JSON text), as the server's first message.
@@ -137,16 +136,9 @@ impl LocalStream {
         }
         self.texts.extend([update.message, update.scene].into_iter().flatten());
         self.clock += f64::from(dt);
-        let (since, count, fps) = &mut self.rate;
-        *count += 1;
-        if self.clock - *since >= 1.0 {
-            *fps = *count as f32 / (self.clock - *since) as f32;
-            (*since, *count) = (self.clock, 0);
-        }
-        let fps = *fps;
+        let fps = self.rate.tick(self.clock);
         self.session.render(fps, &mut self.frames[0]);
-        self.frame_count = 1 + usize::from(self.session.render_second(fps, &mut self.frames[1]));
-        self.frame_count
+        1 + usize::from(self.session.render_second(fps, &mut self.frames[1]))
     }
 
     /// Where frame `k` of the last step starts in the module's memory (`wasmMemory`).

@@ -6,7 +6,7 @@ use std::io::{ErrorKind, Write};
 use std::net::TcpStream;
 use std::time::{Duration, Instant};
 
-use dqhand_stream::{Applied, Command, LiveInput, Session};
+use dqhand_stream::{Applied, Command, FrameRate, LiveInput, Session};
 use tungstenite::protocol::frame::coding::CloseCode;
 use tungstenite::protocol::CloseFrame;
 use tungstenite::{Message, WebSocket};
@@ -56,9 +56,10 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
     // Frames a step sends: one per hand.
     let per_step = 1 + u32::from(shared.second.is_some());
     let (mut sent, mut acked) = (0u32, 0u32);
-    let mut last_frame = Instant::now();
+    let started = Instant::now();
+    let mut last_frame = started;
     let mut next_frame = last_frame;
-    let mut rate = Rate::new();
+    let mut rate = FrameRate::default();
     let mut frame = Vec::new();
     let (mut heard, mut pinged) = (Instant::now(), false);
     // The versions of the viewers' recording and learning this viewer was last told of.
@@ -135,7 +136,7 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                 ws.send(Message::text(message)).map_err(io)?;
             }
         }
-        let fps = rate.tick(now);
+        let fps = rate.tick((now - started).as_secs_f64());
         session.render(fps, &mut frame);
         // tungstenite takes ownership of each message: one buffer per frame is the transport's
         // cost (the engine's own buffers are reused).
@@ -206,29 +207,5 @@ fn io(e: tungstenite::Error) -> std::io::Error {
         }
         tungstenite::Error::Io(e) => e,
         e => std::io::Error::other(e),
-    }
-}
-
-/// Frames per second over the last second or so.
-struct Rate {
-    since: Instant,
-    count: u32,
-    fps: f32,
-}
-
-impl Rate {
-    fn new() -> Self {
-        Self { since: Instant::now(), count: 0, fps: 0.0 }
-    }
-
-    /// Counts a frame at `now`; returns the latest rate.
-    fn tick(&mut self, now: Instant) -> f32 {
-        self.count += 1;
-        let elapsed = (now - self.since).as_secs_f32();
-        if elapsed >= 1.0 {
-            self.fps = self.count as f32 / elapsed;
-            (self.since, self.count) = (now, 0);
-        }
-        self.fps
     }
 }
