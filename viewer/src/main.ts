@@ -395,11 +395,13 @@ window.dqhand = {
     /** The manipulation scene, null without one: the objects drawn (placed by a scene message), the one held, contacts shown, scene messages shown. */
     scene: scene.objects && { drawn: scene.objects.drawn(), held: scene.objects.held, contacts: scene.objects.contacts, updates: scene.objects.updates },
     /** The second hand (a server driving two), null without one: its side and its latest frame's wrist (world) and sequence number. */
-    secondHand: hello?.second_hand && {
-      side: hello.second_hand.side,
-      wrist: scene.secondFrame && Array.from(scene.secondFrame.header.wrist),
-      sequence: scene.secondFrame?.header.sequence ?? null,
-    },
+    secondHand: hello?.second_hand
+      ? {
+          side: hello.second_hand.side,
+          wrist: scene.secondFrame ? Array.from(scene.secondFrame.header.wrist) : null,
+          sequence: scene.secondFrame?.header.sequence ?? null,
+        }
+      : null,
     geometries: scene.renderer.info.memory.geometries,
     /** The WebXR input: modes offered, the session, records sent, the side of the hand sent. */
     xr: xr.state(),
