@@ -11,6 +11,7 @@ VALIDATOR := third_party/node_modules/gltf-validator/package.json
 OUTSIDE_POSES := third_party/node_modules/handy-work/poses/fist.handpose third_party/node_modules/iwer/lib/device/configs/hand/pinch.js
 VIEWER_DEPS := viewer/node_modules/.package-lock.json
 VIEWER_DIST := viewer/dist/index.html
+HAND_FILES := viewer/public/hands/right.glb viewer/public/hands/left.glb
 # The engine's web builds as the npm package and the page load them (make package-wasm).
 PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
@@ -47,8 +48,16 @@ $(VIEWER_DEPS): viewer/package.json viewer/package-lock.json
 	cd viewer && $(NPM) ci --no-audit --no-fund
 	touch $@
 
-$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*) $(wildcard packages/dqhand/src/*) $(PACKAGE_WASM)
+$(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/tsconfig.json $(wildcard viewer/src/*) $(wildcard packages/dqhand/src/*) $(PACKAGE_WASM) $(HAND_FILES)
 	cd viewer && $(NPM) run build
+
+# The built-in hands beside the page (Vite copies viewer/public into dist): the page's engine
+# loads them in milliseconds instead of generating them (seconds in WebAssembly). The same
+# hands, written by the command a user would run (`dqhand hand --out`).
+$(HAND_FILES) &: $(wildcard crates/dqhand/src/*.rs crates/dqhand/src/*/*.rs) crates/dqhand-cli/src/hand.rs
+	$(CARGO) build --locked -p dqhand-cli
+	mkdir -p viewer/public/hands
+	for side in right left; do $(DQHAND_DEBUG) hand --side $$side --out viewer/public/hands/$$side.glb || exit 1; done
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
 # nothing third-party is committed.
@@ -222,7 +231,7 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules viewer/node_modules viewer/dist packages/dqhand/wasm packages/dqhand/dist packages/dqhand/node_modules $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist viewer/public packages/dqhand/wasm packages/dqhand/dist packages/dqhand/node_modules $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
 
 # The built-in gesture classifier, trained on the tuning split of varied hands (deterministic;
 # `dqhand gesture-bench --outside third_party/node_modules` reports on the held-out split).

@@ -125,3 +125,28 @@ test('bad options and records are one-line errors, and the hands go on', () => {
   assert.equal(hands.step(0.1).length, 0);
   hands.dispose();
 });
+
+test('hands from skinned glTF files: the WebXR generic hands (made elsewhere) follow a recording in a scene, and fetchModel names a bad URL', async () => {
+  const generic = path.join(root, 'third_party', 'node_modules', '@webxr-input-profiles', 'assets', 'dist', 'profiles', 'generic-hand');
+  const [right, left] = ['right', 'left'].map((side) => readFileSync(path.join(generic, `${side}.glb`)));
+  // An ArrayBuffer and a Uint8Array (a Node Buffer) both do.
+  const hands = engine.hands({ scene: 'objects', models: { right: right.buffer.slice(right.byteOffset, right.byteOffset + right.byteLength), left } });
+  assert.deepEqual([hands.count, hands.side(0), hands.side(1), hands.vertexCount(1)], [2, 'left', 'right', 1360]);
+  const mesh = new HandMesh(hands, 1);
+  const lines = recording('gestures-joints.jsonl').slice(0, 300);
+  for (const line of lines) {
+    hands.pushLine(line);
+    hands.step(JSON.parse(line).t);
+    mesh.update();
+  }
+  assert.equal(hands.tracking(1), 'tracking');
+  const wrist = JSON.parse(lines.at(-1)).joints.wrist.p;
+  const centre = mesh.geometry.boundingSphere.center;
+  assert.ok(Math.hypot(centre.x - wrist[0], centre.y - wrist[1], centre.z - wrist[2]) < 0.15, 'the generic hand is where the tracked one is');
+  hands.dispose();
+  // The sides given are the hands: asking for others, or giving a hand as the wrong side, is one line.
+  assert.throws(() => engine.hands({ hands: 'left', models: { right } }), /^Error: models: right given for hands "left"$/);
+  assert.throws(() => engine.hands({ models: { right: left } }), (e) => e.message === 'right model: the file holds a left hand');
+  const { fetchModel } = await import(path.join(pkg, 'dist', 'index.js'));
+  await assert.rejects(fetchModel('http://127.0.0.1:9/none.glb'), (e) => e.message.startsWith('http://127.0.0.1:9/none.glb: ') && !e.message.includes('\n'));
+});

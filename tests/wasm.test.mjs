@@ -14,7 +14,7 @@ import { fileURLToPath } from 'node:url';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const require = createRequire(import.meta.url);
-const { Hand, Interaction, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
+const { Hand, Interaction, LocalStream, wasmMemory } = require(path.join(root, 'target', 'wasm', 'node', 'dqhand_wasm.js'));
 const dqhand = process.env.DQHAND_BIN ?? path.join(root, 'target', 'debug', 'dqhand');
 const out = mkdtempSync(path.join(tmpdir(), 'dqhand-wasm-'));
 
@@ -265,4 +265,68 @@ test('an interaction in a scene that is not built in is refused, and a broken re
   const poses = new Float32Array(wasmMemory().buffer, loop.posesPtr(), 7 * loop.objectCount);
   const trace = JSON.parse(loop.trace(0));
   scene.objects.forEach((o, i) => assert.deepEqual(Array.from(poses.slice(7 * i, 7 * i + 3)), trace.objects[o.name].p.map(Math.fround)));
+});
+
+/** Every event line of `interaction` over `lines`, and its skin `k` after the last. */
+function drive(interaction, lines, k = 0) {
+  let events = '';
+  for (const line of lines) {
+    interaction.pushLine(line);
+    if (interaction.step(JSON.parse(line).t) > 0) events += interaction.takeEvents();
+  }
+  return { events, skin: new Float32Array(wasmMemory().buffer, interaction.positionsPtr(k), 3 * interaction.vertexCount(k)).slice() };
+}
+
+/** The skin's vertex nearest to `p`, its distance. */
+function nearestVertex(skin, p) {
+  let nearest = Infinity;
+  for (let i = 0; i < skin.length; i += 3) nearest = Math.min(nearest, Math.hypot(skin[i] - p[0], skin[i + 1] - p[1], skin[i + 2] - p[2]));
+  return nearest;
+}
+
+test('hands loaded from skinned glTF: the native command\'s file is the hand the engine generates, and the WebXR generic hands work', () => {
+  const lines = recordingLines('gestures-joints.jsonl').slice(0, 900);
+  const files = Object.fromEntries(['right', 'left'].map((side) => {
+    const file = path.join(out, `${side}.glb`);
+    execFileSync(dqhand, ['hand', '--side', side, '--out', file], { stdio: 'ignore' });
+    return [side, readFileSync(file)];
+  }));
+  // The file `dqhand hand --out` writes drives as the hand the WASM engine builds itself.
+  const generated = drive(new Interaction('right', ''), lines);
+  const loaded = drive(Interaction.withModels('', files.right, undefined), lines);
+  assert.ok(generated.events.split('\n').length > 6, 'the records name gestures');
+  assert.equal(loaded.events, generated.events);
+  assert.ok(largestGap(loaded.skin, generated.skin) < 1e-5, `skins ${largestGap(loaded.skin, generated.skin)} m apart`);
+  const two = Interaction.withModels('two-hands', files.right, files.left);
+  assert.deepEqual([two.handCount, two.side(0), two.side(1)], [2, 'left', 'right']);
+
+  // Hands the project did not make: the WebXR input profiles' generic hands (1360 vertices),
+  // both at once; the right one follows the records and names their gestures.
+  const generic = path.join(root, 'third_party', 'node_modules', '@webxr-input-profiles', 'assets', 'dist', 'profiles', 'generic-hand');
+  const [right, left] = ['right', 'left'].map((side) => readFileSync(path.join(generic, `${side}.glb`)));
+  const xr = Interaction.withModels('', right, left);
+  assert.deepEqual([xr.side(0), xr.side(1), xr.vertexCount(1)], ['left', 'right', 1360]);
+  const driven = drive(xr, lines, 1);
+  assert.equal(xr.tracking(1), 'tracking');
+  const tip = JSON.parse(lines.at(-1)).joints['middle-finger-tip'].p;
+  assert.ok(nearestVertex(driven.skin, tip) < 0.01, `the generic hand's skin is ${nearestVertex(driven.skin, tip)} m from the tracked middle fingertip`);
+  const names = (events) => events.trim().split('\n').map((l) => JSON.parse(l)).filter((e) => e.event === 'start').map((e) => e.gesture);
+  assert.deepEqual(names(driven.events), names(generated.events));
+
+  // Wrong files: one line naming the file, whichever is wrong.
+  const oneLine = (start) => (e) => e instanceof Error && e.message.startsWith(start) && !e.message.includes('\n');
+  assert.throws(() => Interaction.withModels('', files.left, undefined), oneLine('right model: the file holds a left hand'));
+  assert.throws(() => Interaction.withModels('', files.right, new Uint8Array([0x67, 0x6c, 0x54, 0x46, 2, 0, 0, 0])), oneLine('left model: '));
+  assert.throws(() => Interaction.withModels('', files.right.subarray(0, 1000), undefined), oneLine('right model: '));
+  assert.throws(() => Interaction.withModels('', undefined, undefined), oneLine('withModels: no model given'));
+
+  // The viewer's engine takes the same files (as hands/right.glb and hands/left.glb), and an
+  // input configuration as JSON text.
+  const page = new LocalStream('two-hands', true, files.right, files.left, '{"grace_s": 1.5}');
+  const hello = JSON.parse(page.hello());
+  assert.match(hello.description, /^anatomical right hand, .*\(glTF file right\.glb\)$/);
+  assert.match(hello.second_hand.description, /^anatomical left hand, .*\(glTF file left\.glb\)$/);
+  page.free();
+  assert.throws(() => new LocalStream('', false, files.right, undefined, '{"grace_s": -1}'), oneLine('input configuration: grace_s: must be a positive number of seconds'));
+  assert.throws(() => new LocalStream('', false, new Uint8Array(12), undefined, undefined), oneLine('hands/right.glb: '));
 });

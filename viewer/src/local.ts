@@ -5,13 +5,23 @@
 // recording of it is saved as a file the browser downloads (it replays with `dqhand replay`).
 
 import { LocalStream, wasmMemory } from '../../packages/dqhand/wasm/dqhand_wasm.js';
-import { loadEngine } from '../../packages/dqhand/src/engine';
+import { fetchModel, loadEngine } from '../../packages/dqhand/src/engine';
 import { decodeFrame, decodeTopology, encodeCommand, type Command } from './protocol';
 import { dispatchText, type ConnectionEvents } from './connection';
 import type { RecordSink } from './sender';
 
 /** The engine's step rate (Hz): a timer's, which runs during an XR session too (the window's animation frames stop then). */
 const RATE_HZ = 60;
+
+/**
+ * The built-in hand of `side` as `make viewer` writes it beside the page (`hands/<side>.glb`,
+ * from `dqhand hand --out`): loading it takes milliseconds where generating it takes seconds in
+ * WebAssembly. Without the file (a build that left it out), undefined: the engine generates the
+ * same hand itself.
+ */
+function handFile(side: 'right' | 'left'): Promise<Uint8Array | undefined> {
+  return fetchModel(`./hands/${side}.glb`).catch(() => undefined);
+}
 
 /** The page's engine, driven by a timer; `send`, `setting` and `remember` as a server connection's. */
 export class LocalConnection {
@@ -29,15 +39,18 @@ export class LocalConnection {
   /** The page's live input (camera, WebXR) into this engine. */
   readonly input: RecordSink = { send: (record) => this.push(record), close: () => {} };
 
-  /** `scene`: a built-in scene's name or `''`; `twoHands`: a left hand too (a scene's). */
-  constructor(private readonly events: ConnectionEvents, scene: string, twoHands: boolean) {
-    void this.start(scene, twoHands);
+  /**
+   * `scene`: a built-in scene's name or `''`; `twoHands`: a left hand too (a scene's); `config`:
+   * an input configuration's JSON text (docs/formats.md), or null for the defaults.
+   */
+  constructor(private readonly events: ConnectionEvents, scene: string, twoHands: boolean, config: string | null) {
+    void this.start(scene, twoHands, config);
   }
 
-  private async start(scene: string, twoHands: boolean): Promise<void> {
+  private async start(scene: string, twoHands: boolean, config: string | null): Promise<void> {
     try {
-      await loadEngine();
-      this.stream = new LocalStream(scene, twoHands);
+      const [, right, left] = await Promise.all([loadEngine(), handFile('right'), twoHands ? handFile('left') : undefined]);
+      this.stream = new LocalStream(scene, twoHands, right, left, config ?? undefined);
     } catch (e) {
       this.events.error(`the page's engine: ${(e as Error).message}`);
       return;

@@ -122,8 +122,11 @@ const events: ConnectionEvents = {
   },
 };
 
-/** In the page: `?scene=NAME` puts the hand in a built-in scene, `&hands=2` both hands in it. */
-const local = (await engineInPage()) ? new LocalConnection(events, params.get('scene') ?? '', params.get('hands') === '2') : null;
+/**
+ * In the page: `?scene=NAME` puts the hand in a built-in scene, `&hands=2` both hands in it;
+ * `&config=JSON` is the input configuration (as `dqhand demo --config` reads from a file).
+ */
+const local = (await engineInPage()) ? new LocalConnection(events, params.get('scene') ?? '', params.get('hands') === '2', params.get('config')) : null;
 const connection = local ?? new Connection(`${wsOrigin}/stream`, events);
 /** The page's own live input to the engine: the camera's hand or an XR session's. */
 const sender = local?.input ?? new InputSender(`${wsOrigin}/input`);

@@ -1,10 +1,12 @@
 // The camera path end to end: a video of a hand in known gestures played to headless Chromium
 // as its webcam; the Camera button runs MediaPipe Hands in the page on it, the landmarks go to
-// a real `dqhand demo`, and the engine's recognised gestures and retargeted angles are compared
-// with the video's. First our own hand (rendered by the real page, scripts/webcam-video.mjs),
-// whose input the Record button records and `dqhand replay` replays to the same gesture events;
-// then a hand that is not ours, the WebXR generic hand posed from a synthetic recording
-// (scripts/generic-hand-video.mjs), against which MediaPipe's own tracking error is measured.
+// the engine, and its recognised gestures and retargeted angles are compared with the video's.
+// First our own hand (rendered by the real page, scripts/webcam-video.mjs) with a real `dqhand
+// demo` as the engine, whose input the Record button records and `dqhand replay` replays to the
+// same gesture events; then, on a plain static server with no dqhand process (the engine in the
+// page, in WebAssembly), the same video mirrored (a left hand) and a hand that is not ours, the
+// WebXR generic hand posed from a synthetic recording (scripts/generic-hand-video.mjs), against
+// which MediaPipe's own tracking error is measured.
 //
 // Every video frame carries its number (scripts/y4m.mjs, MARKER); the page is given a hook that
 // reads it off each frame handed to MediaPipe. The frames taken give the video's clock
@@ -17,10 +19,11 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
-import { dqhandBin, launchBrowser, newPage, root, startServer, waitState } from '../scripts/harness.mjs';
+import { dqhandBin, launchBrowser, newPage, root, serveStatic, startServer, waitState } from '../scripts/harness.mjs';
 import { MARKER } from '../scripts/y4m.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
+let staticServer: Awaited<ReturnType<typeof serveStatic>>;
 interface Hold {
   gesture: string;
   from_s: number;
@@ -114,14 +117,28 @@ function watchFrames([marker, size]: [typeof MARKER, [number, number]]): void {
   };
 }
 
-/** A browser whose camera plays `video` (in `dir`, of `size`), and a page of it on the server, connected. */
-async function cameraPage(video: string, size: [number, number]): Promise<{ browser: Browser; page: Page }> {
+/**
+ * A browser whose camera plays `video` (in `dir`, of `size`), and a page of it, connected: on
+ * `dqhand demo`, or on a plain static server (no dqhand process: the engine in the page, given
+ * the tests' input configuration in its URL; Record downloads the file).
+ */
+async function cameraPage(video: string, size: [number, number], host: 'server' | 'static' = 'server'): Promise<{ browser: Browser; page: Page }> {
   const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
   const p = await newPage(b, { width: 1100, height: 700 });
   await p.addInitScript(watchFrames, [MARKER, size] as [typeof MARKER, [number, number]]);
-  await p.goto(server.url);
+  await p.goto(host === 'server' ? server.url : `${staticServer.url}?config=${encodeURIComponent(JSON.stringify(CONFIG))}`);
   await waitState(p, 's.connected && s.frame !== null');
+  expect((await read<{ engine: string }>(p)).engine).toBe(host === 'server' ? 'server' : 'page');
   return { browser: b, page: p };
+}
+
+/** Clicks Record off on a page whose engine runs in it, and saves the file the browser downloads; its path. */
+async function downloadRecording(p: Page): Promise<string> {
+  const download = p.waitForEvent('download');
+  await p.click('#record');
+  const file = path.join(dir, `downloaded-${Date.now()}.jsonl`);
+  await (await download).saveAs(file);
+  return file;
 }
 
 beforeAll(async () => {
@@ -134,12 +151,14 @@ beforeAll(async () => {
   }
   writeFileSync(path.join(dir, 'config.json'), JSON.stringify(CONFIG));
   server = await startServer({ args: ['--config', path.join(dir, 'config.json'), '--recordings', path.join(dir, 'recordings')] });
+  staticServer = await serveStatic(path.join(root, 'viewer/dist'));
   ({ browser, page } = await cameraPage('hand.y4m', labels.size));
 });
 
 afterAll(async () => {
   await browser?.close();
   await server?.stop();
+  await staticServer?.stop();
   rmSync(dir, { recursive: true, force: true });
 });
 
@@ -406,7 +425,7 @@ describe('the Camera button on a video of our own hand, mirrored: a left hand', 
 
   beforeAll(async () => {
     leftLabels = renderVideo('--left');
-    ({ browser: leftBrowser, page: leftPage } = await cameraPage('hand-left.y4m', leftLabels.size));
+    ({ browser: leftBrowser, page: leftPage } = await cameraPage('hand-left.y4m', leftLabels.size, 'static'));
   });
 
   afterAll(async () => {
@@ -552,8 +571,7 @@ describe('the Camera button on a video of a hand not ours: the WebXR generic han
       trueAngles.set(t, angles_deg);
     }
 
-    ({ browser: genericBrowser, page: genericPage } = await cameraPage('generic-hand.y4m', generic.size));
-    // A new page is told of the latest recording (off) when it connects: the last message counts.
+    ({ browser: genericBrowser, page: genericPage } = await cameraPage('generic-hand.y4m', generic.size, 'static'));
     const last = 's.recordings[s.recordings.length - 1]';
     await genericPage.click('#record');
     await waitState(genericPage, `s.recordings.length > 0 && ${last}.on`);
@@ -562,9 +580,8 @@ describe('the Camera button on a video of a hand not ours: the WebXR generic han
     ({ dofs } = await read<{ dofs: string[] }>(genericPage));
     // Two passes of the video: every hold sampled twice.
     samples = await sample(genericPage, (2 * generic.frames) / generic.fps, generic);
-    await genericPage.click('#record');
+    const file = await downloadRecording(genericPage);
     await waitState(genericPage, `!${last}.on`);
-    const file = (await read<{ recordings: { path: string }[] }>(genericPage)).recordings.pop()!.path;
     taken = await framesTaken(genericPage);
     // A record's time is the page's when MediaPipe gave the hand: its frame is the last one taken before.
     recorded = readFileSync(file, 'utf8')

@@ -5,7 +5,7 @@
 // of two hands, and Record, which saves a file the browser downloads and `dqhand replay` reads.
 
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync } from 'node:fs';
+import { cpSync, mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
@@ -61,6 +61,8 @@ describe('the page on a static host, its engine in WebAssembly', () => {
     expect(s.errors).toEqual([]);
     expect(s.dofs.length).toBe(23);
     expect(await page.locator('#status').textContent()).toBe('engine in this page');
+    // The hand came from the file written beside the page (make viewer), not generated.
+    expect(await page.locator('#model-line').textContent()).toMatch(/^anatomical right hand, .*\(glTF file right\.glb\)/);
     await settle(page);
     expect(await countColour(page, SKIN)).toBeGreaterThan(3000);
     await waitState(page, `s.frame.playing && s.frame.time > ${s.frame!.time + 0.2}`);
@@ -129,6 +131,25 @@ describe('a scene of two hands in the page', () => {
     // The first hand at IWER's right one, the second at its left one (±0.25, 1.5, −0.4).
     await waitState(page, 'Math.abs(s.frame.wrist[0] - 0.25) < 0.15 && Math.abs(s.secondHand.wrist[0] + 0.25) < 0.15');
     expect((await state(page)).errors).toEqual([]);
+    expect(await page.locator('#model-line').textContent()).toMatch(/left hand, .*\(glTF file left\.glb\)/);
     await page.close();
+  });
+});
+
+describe('a static copy without the hand files', () => {
+  test('the page generates the same hand itself', async () => {
+    const copy = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'dqhand-dist-'));
+    cpSync(path.join(root, 'viewer/dist'), copy, { recursive: true, filter: (f) => !f.endsWith(`${path.sep}hands`) });
+    const bare = await serveStatic(copy);
+    try {
+      const page = await emulatedPage(browser);
+      await page.goto(bare.url);
+      await waitState(page, 's.connected && s.framesReceived > 3');
+      expect(await page.locator('#model-line').textContent()).toMatch(/^anatomical right hand, length 0\.19 m, breadth 0\.085 m, 8668 vertices, /);
+      expect((await state(page)).errors).toEqual([]);
+      await page.close();
+    } finally {
+      await bare.stop();
+    }
   });
 });

@@ -31,7 +31,9 @@ use dqhand::input::json_record::parse_record;
 use dqhand::input::{InputConfig, Record};
 use dqhand::grasp::GraspParams;
 use dqhand::interaction::{frame_trace, scene_shapes, ManipulationLoop};
+use dqhand::io::load_gltf_slice;
 use dqhand::kinematics::{JointModel, Pose, Side};
+use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::{Deformed, Deformer, Kernel, Method, MethodSet, SkinLayer, SkinnedMesh};
 use glam::Affine3A;
@@ -60,6 +62,11 @@ fn side_of(side: &str) -> Result<Side, JsError> {
 /// The library's error as a JavaScript `Error` with its one-line message.
 fn js(e: dqhand::Error) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// A skinned glTF hand from `bytes`; `name` names the file in errors and in its description.
+fn load_model(bytes: &[u8], name: &str) -> Result<Arc<Model>, JsError> {
+    load_gltf_slice(bytes, std::path::Path::new(name)).map(Arc::new).map_err(js)
 }
 
 #[wasm_bindgen]
@@ -357,18 +364,53 @@ impl Interaction {
     /// measurements that are not a hand's.
     #[wasm_bindgen(constructor)]
     pub fn new(hands: &str, scene: &str, length: Option<f32>, breadth: Option<f32>) -> Result<Interaction, JsError> {
+        let defaults = HandParams::default();
+        let (length, breadth) = (length.unwrap_or(defaults.length), breadth.unwrap_or(defaults.breadth));
+        let hand = |side| build(&HandParams { length, breadth, side, ..HandParams::default() }).map(Arc::new).map_err(js);
+        let models = match hands {
+            "both" => vec![hand(Side::Left)?, hand(Side::Right)?],
+            one => vec![hand(side_of(one).map_err(|_| JsError::new(&format!("hands {one:?}: expected \"left\", \"right\" or \"both\"")))?)?],
+        };
+        Self::with_hands(models, scene)
+    }
+
+    /// Hands from skinned glTF 2.0 files (`.glb` bytes or `.gltf` JSON with embedded buffers),
+    /// `right`, `left` or both, whose skeletons have the 25 WebXR hand joints (the built-in
+    /// hand as `dqhand hand --out` writes it, the WebXR input profiles' generic hands), in
+    /// `scene` as [`Self::new`]. Loading a written hand skips generating it, most of the
+    /// time a built-in hand takes to start (seconds in WebAssembly).
+    ///
+    /// # Errors
+    /// Neither file given; a file that is not a skinned glTF (its problem on one line, naming
+    /// the file's side); a hand that is not of the side it was given as; a scene as
+    /// [`Self::new`].
+    #[wasm_bindgen(js_name = withModels)]
+    pub fn with_models(scene: &str, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<Interaction, JsError> {
+        let given: Vec<(Vec<u8>, Side)> = [(left, Side::Left), (right, Side::Right)].into_iter().filter_map(|(b, side)| b.map(|b| (b, side))).collect();
+        if given.is_empty() {
+            return Err(JsError::new("withModels: no model given (a right one, a left one or both)"));
+        }
+        let models = given.iter().map(|(bytes, side)| load_model(bytes, &format!("{} model", side.name()))).collect::<Result<Vec<_>, _>>()?;
+        let interaction = Self::with_hands(models, scene)?;
+        for (hand, (_, side)) in interaction.manip.hands().iter().zip(&given) {
+            if hand.side() != *side {
+                return Err(JsError::new(&format!("{} model: the file holds a {} hand", side.name(), hand.side().name())));
+            }
+        }
+        Ok(interaction)
+    }
+
+    /// The loop of `models` (one hand, or a left and a right one in that order) in `scene`.
+    fn with_hands(models: Vec<Arc<Model>>, scene: &str) -> Result<Interaction, JsError> {
         let scene = match scene.trim_start() {
             "" => Scene { table: None, objects: Vec::new(), actions: Vec::new() },
             text if text.starts_with('{') => Scene::from_json(text, "scene", std::path::Path::new("")).map_err(js)?,
             name => Scene::named(name).map_err(js)?,
         };
-        let defaults = HandParams::default();
-        let (length, breadth) = (length.unwrap_or(defaults.length), breadth.unwrap_or(defaults.breadth));
-        let hand = |side| build(&HandParams { length, breadth, side, ..HandParams::default() }).map(Arc::new).map_err(js);
         let (config, params, gestures) = (InputConfig::default(), GraspParams::default(), Some(GestureSet::builtin()));
-        let manip = match hands {
-            "both" => ManipulationLoop::two_handed([(hand(Side::Left)?, None), (hand(Side::Right)?, None)], JointModel::Full, config, gestures, &scene, params),
-            one => ManipulationLoop::new(hand(side_of(one).map_err(|_| JsError::new(&format!("hands {one:?}: expected \"left\", \"right\" or \"both\"")))?)?, JointModel::Full, None, config, gestures, &scene, params),
+        let manip = match <[Arc<Model>; 2]>::try_from(models) {
+            Ok([left, right]) => ManipulationLoop::two_handed([(left, None), (right, None)], JointModel::Full, config, gestures, &scene, params),
+            Err(mut one) => ManipulationLoop::new(one.remove(0), JointModel::Full, None, config, gestures, &scene, params),
         }
         .map_err(js)?;
         let skins = manip

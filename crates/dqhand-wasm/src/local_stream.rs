@@ -17,7 +17,7 @@ use dqhand::scene::Scene;
 use dqhand_stream::{Applied, Command, FrameRate, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
 use wasm_bindgen::prelude::*;
 
-use crate::{js, read};
+use crate::{js, load_model, read};
 
 /// Longest step of the engine's clock, s: after a stall (a hidden tab) it resumes, not races.
 const MAX_STEP_S: f32 = 0.1;
@@ -43,16 +43,28 @@ pub struct LocalStream {
 #[wasm_bindgen]
 impl LocalStream {
     /// The built-in right hand, with `two_hands` a left one too (both follow the live input's
-    /// hand of their side), in `scene` (`""` for none, or a built-in scene's name).
+    /// hand of their side), in `scene` (`""` for none, or a built-in scene's name). `right` and
+    /// `left`, when given, are those hands already written as skinned glTF (`dqhand hand
+    /// --out`, served as `hands/right.glb` and `hands/left.glb`): loaded, not generated, which
+    /// takes most of a page's start. `config` is an input configuration (JSON text, as `dqhand
+    /// demo --config` reads from a file; docs/formats.md), the defaults when absent or empty.
     ///
     /// # Errors
-    /// A scene that is not built in; two hands with no scene (only a scene's loop drives two).
+    /// A scene that is not built in; two hands with no scene (only a scene's loop drives two);
+    /// a hand file that is not a skinned glTF hand; a configuration that is not one.
     #[wasm_bindgen(constructor)]
-    pub fn new(scene: &str, two_hands: bool) -> Result<LocalStream, JsError> {
-        let hand = |side| build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js);
-        let model = hand(Side::Right)?;
-        let left = if two_hands { Some(hand(Side::Left)?) } else { None };
-        let (joint_model, config, gestures) = (JointModel::Full, InputConfig::default(), Some(GestureSet::builtin()));
+    pub fn new(scene: &str, two_hands: bool, right: Option<Vec<u8>>, left: Option<Vec<u8>>, config: Option<String>) -> Result<LocalStream, JsError> {
+        let config = match config.as_deref().map(str::trim) {
+            None | Some("") => InputConfig::default(),
+            Some(text) => InputConfig::from_json(text).map_err(js)?,
+        };
+        let hand = |side: Side, bytes: Option<Vec<u8>>| match bytes {
+            Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name())),
+            None => build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js),
+        };
+        let model = hand(Side::Right, right)?;
+        let left = if two_hands { Some(hand(Side::Left, left)?) } else { None };
+        let (joint_model, gestures) = (JointModel::Full, Some(GestureSet::builtin()));
         let input = match (scene, &left) {
             ("", None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, None, config, gestures).map_err(js)?, SOURCE, false),
             ("", Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),

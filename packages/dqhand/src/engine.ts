@@ -64,6 +64,15 @@ export interface HandsOptions {
   /** Wrist crease to middle fingertip (m), default 0.19; breadth across the knuckles (m), default 0.085. */
   length?: number;
   breadth?: number;
+  /**
+   * Skinned glTF 2.0 hands to drive instead of built-in ones: `.glb` bytes (or `.gltf` JSON
+   * with its buffers embedded) whose skeleton has the 25 WebXR hand joints, such as a hand
+   * written by `dqhand hand --out right.glb` or the WebXR input profiles' generic hands. The
+   * sides given are the hands driven (`hands`, if set, must agree); `length` and `breadth` do
+   * not apply. Loading a written built-in hand takes milliseconds where generating it takes
+   * seconds: see `fetchModel`.
+   */
+  models?: { right?: Uint8Array | ArrayBuffer; left?: Uint8Array | ArrayBuffer };
 }
 
 export interface PosedHandOptions {
@@ -99,6 +108,18 @@ export class Engine {
   posedHand(options: PosedHandOptions = {}): PosedHand {
     return new PosedHand(options);
   }
+}
+
+/**
+ * The bytes of the hand model at `url` (a `.glb`), for `HandsOptions.models`. Throws an `Error`
+ * of one line naming the URL when it cannot be fetched.
+ */
+export async function fetchModel(url: string | URL): Promise<Uint8Array> {
+  const answer = await fetch(url).catch((e: unknown) => {
+    throw new Error(`${String(url)}: ${(e as Error).message}`);
+  });
+  if (!answer.ok) throw new Error(`${String(url)}: HTTP ${answer.status} ${answer.statusText}`.trim());
+  return new Uint8Array(await answer.arrayBuffer());
 }
 
 let loading: Promise<Engine> | null = null;
@@ -158,7 +179,12 @@ export class Hands implements SkinSource {
 
   private static make(o: HandsOptions): Interaction {
     const scene = o.scene == null ? '' : typeof o.scene === 'string' ? o.scene : JSON.stringify(o.scene);
-    return new Interaction(o.hands ?? 'right', scene, o.length, o.breadth);
+    if (!o.models) return new Interaction(o.hands ?? 'right', scene, o.length, o.breadth);
+    const { right, left } = o.models;
+    const given = right && left ? 'both' : left ? 'left' : 'right';
+    if (o.hands !== undefined && o.hands !== given) throw new Error(`models: ${right || left ? given : 'none'} given for hands ${JSON.stringify(o.hands)}`);
+    const bytes = (b?: Uint8Array | ArrayBuffer) => (b === undefined || b instanceof Uint8Array ? b : new Uint8Array(b));
+    return Interaction.withModels(scene, bytes(right), bytes(left));
   }
 
   /** How many hands (1 or 2). */

@@ -179,7 +179,8 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
         "scene": 0,
         "scenes": [{ "nodes": roots }],
         "nodes": nodes,
-        "meshes": [{ "name": "hand", "primitives": [{ "attributes": attributes, "indices": indices, "material": 0 }] }],
+        // The model's description as the mesh's name: a loader shows what the file holds.
+        "meshes": [{ "name": model.description, "primitives": [{ "attributes": attributes, "indices": indices, "material": 0 }] }],
         "materials": skin_material(),
         "skins": [{ "name": "hand", "inverseBindMatrices": ibm, "joints": (0..joints.len()).collect::<Vec<_>>(), "skeleton": roots[0] }],
     });

@@ -228,7 +228,11 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     let (mesh, mesh_warnings) = SkinnedMesh::new(data)?;
     warnings.extend(mesh_warnings);
     let name = path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into_owned());
-    Ok(Model { description: format!("glTF file {name}"), skeleton, mesh: std::sync::Arc::new(mesh), warnings })
+    // A named mesh says what the file holds (dqhand names it with the model's description);
+    // kept to one short line, as descriptions are shown.
+    let mesh_name: String = first.mesh().and_then(|m| m.name()).unwrap_or("").chars().filter(|c| !c.is_control()).take(120).collect();
+    let description = if mesh_name.trim().is_empty() { format!("glTF file {name}") } else { format!("{} (glTF file {name})", mesh_name.trim()) };
+    Ok(Model { description, skeleton, mesh: std::sync::Arc::new(mesh), warnings })
 }
 
 /// How many JOINTS/WEIGHTS sets (of four influences) a primitive has: 1 or 2.
