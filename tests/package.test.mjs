@@ -29,15 +29,19 @@ test('a hand mesh follows a recording through its own attributes: the engine\'s 
   const arrays = [position.array, mesh.geometry.attributes.normal.array];
   let events = 0;
   let centre = null;
+  const views = new Set();
   for (const line of recording('gestures-joints.jsonl').slice(0, 400)) {
     hands.pushLine(line);
     events += hands.step(JSON.parse(line).t).length;
     mesh.update();
-    const { positions, normals } = hands.skin(0);
+    const [positions, normals] = [hands.positions(0), hands.normals(0)];
     assert.deepEqual(mesh.geometry.attributes.position.array, positions);
     assert.deepEqual(mesh.geometry.attributes.normal.array, normals);
+    views.add(positions).add(normals);
     centre = mesh.geometry.boundingSphere.center.clone();
   }
+  // The same two views of the engine's memory every frame (its memory does not grow once running).
+  assert.equal(views.size, 2);
   // The attributes keep their arrays (three.js uploads them again; nothing new per frame).
   assert.equal(mesh.geometry.attributes.position.array, arrays[0]);
   assert.equal(mesh.geometry.attributes.normal.array, arrays[1]);
@@ -149,4 +153,35 @@ test('hands from skinned glTF files: the WebXR generic hands (made elsewhere) fo
   assert.throws(() => engine.hands({ models: { right: left } }), (e) => e.message === 'right model: the file holds a left hand');
   const { fetchModel } = await import(path.join(pkg, 'dist', 'index.js'));
   await assert.rejects(fetchModel('http://127.0.0.1:9/none.glb'), (e) => e.message.startsWith('http://127.0.0.1:9/none.glb: ') && !e.message.includes('\n'));
+});
+
+test('a lone hand whose MediaPipe label flickers keeps its side; a label that holds for 5 frames changes it', () => {
+  const hands = engine.hands({ hands: 'both' });
+  const [aspect, fx] = [4 / 3, 1 / (2 * Math.tan(Math.PI / 6))];
+  /** MediaPipe's results for a recorded hand (the engine's axes back to the camera's, half a metre ahead), labelled `label`. */
+  const results = (landmarks, label) => {
+    const world = landmarks.map(([x, y, z]) => ({ x: -x, y: -y, z }));
+    const image = world.map((w) => ({ x: 0.5 + (fx * w.x) / (w.z + 0.5), y: 0.5 + (fx * aspect * w.y) / (w.z + 0.5), z: 0 }));
+    return { multiHandWorldLandmarks: [world], multiHandLandmarks: [image], multiHandedness: [{ label }] };
+  };
+  const lines = recording('gestures-landmarks.jsonl').slice(0, 40).map((l) => JSON.parse(l).landmarks);
+  const right = hands.handOf('right');
+  let t = 0;
+  const frame = (label) => {
+    t += 1 / 30;
+    const pushed = hands.pushMediaPipe(results(lines[Math.round(t * 30) % lines.length], label), t, aspect);
+    hands.step(t);
+    return pushed;
+  };
+  // MediaPipe's "Right" is the user's left hand (its labels assume a mirrored image).
+  for (let i = 0; i < 10; i++) assert.equal(frame('Right'), 1);
+  assert.deepEqual([hands.tracking(hands.handOf('left')), hands.tracking(right)], ['tracking', 'waiting']);
+  // Four frames labelled the other hand: still the left one, the right hand still waits.
+  for (let i = 0; i < 4; i++) assert.equal(frame('Left'), 1);
+  assert.equal(hands.tracking(right), 'waiting');
+  assert.equal(hands.counts().accepted, 14);
+  // The fifth in a row: the label is believed.
+  frame('Left');
+  assert.equal(hands.tracking(right), 'tracking');
+  hands.dispose();
 });

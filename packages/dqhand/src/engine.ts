@@ -6,7 +6,7 @@
 
 import init, { Hand, Interaction, wasmMemory } from '../wasm/dqhand_wasm.js';
 import { simdSupported } from './simd.js';
-import { type Point, type Side, type Vec3, placeLandmarks, userSide } from './landmarks.js';
+import { type Point, type Side, type Vec3, placeLandmarks, SideFilter, userSide } from './landmarks.js';
 import { XRJoints } from './xr.js';
 
 /** A skinning method: linear (LB), quaternion (QB) or dual quaternion blending (DQB, the default). */
@@ -29,8 +29,13 @@ export interface SkinSource {
   vertexCount(hand: number): number;
   /** Its triangles, three vertex indices each. */
   indices(hand: number): Uint32Array;
-  /** Views of the skinned positions and normals (x y z per vertex, world metres), valid until the next call into the engine. */
-  skin(hand: number): { positions: Float32Array; normals: Float32Array };
+  /**
+   * A view of the skinned positions (x y z per vertex, world metres) in the engine's memory,
+   * valid until the next call into the engine; the same view each frame unless the memory grew.
+   */
+  positions(hand: number): Float32Array;
+  /** A view of the skinned normals, as `positions`. */
+  normals(hand: number): Float32Array;
 }
 
 /** What `step` reports: a gesture begun or ended (`hand` `'both'` for a gesture of both hands), an object grasped or let go. */
@@ -163,6 +168,7 @@ export class Hands implements SkinSource {
   private readonly poseView = new MemoryView();
   private readonly xr = new XRJoints();
   private readonly landmarks = new Float32Array(63);
+  private readonly sideFilter = new SideFilter();
   private shapes: ({ name: string } & ObjectShape)[] | null = null;
   /** The scene's table top, null without one. */
   private tableTop: { height: number; centre: [number, number]; half: [number, number] } | null = null;
@@ -211,10 +217,12 @@ export class Hands implements SkinSource {
     return this.inner.indices(k);
   }
 
-  skin(k: number): { positions: Float32Array; normals: Float32Array } {
-    const n = 3 * this.inner.vertexCount(k);
-    const v = this.views[k];
-    return { positions: v.positions.get(this.inner.positionsPtr(k), n), normals: v.normals.get(this.inner.normalsPtr(k), n) };
+  positions(k: number): Float32Array {
+    return this.views[k].positions.get(this.inner.positionsPtr(k), 3 * this.inner.vertexCount(k));
+  }
+
+  normals(k: number): Float32Array {
+    return this.views[k].normals.get(this.inner.normalsPtr(k), 3 * this.inner.vertexCount(k));
   }
 
   /** Skins with `method` from now on. */
@@ -255,9 +263,9 @@ export class Hands implements SkinSource {
    * Pushes the hands of one MediaPipe Hands result (`multiHandWorldLandmarks`,
    * `multiHandLandmarks`, `multiHandedness`) at `t` s, placed before the camera with the hand's
    * middle `anchor` m in the world at half a metre from it (the camera facing the user; the
-   * image not mirrored). A hand MediaPipe labels as the other side now and then is taken as it
-   * says (the viewer steadies labels over frames: `SideFilter` in landmarks.ts). Returns how
-   * many hands were pushed.
+   * image not mirrored). A lone hand's label is steadied over frames (`SideFilter`: MediaPipe
+   * flips it now and then, which would mirror the hand across the world); of two hands
+   * labelled alike only the first drives. Returns how many hands were pushed.
    */
   pushMediaPipe(
     results: { multiHandWorldLandmarks?: Point[][]; multiHandLandmarks?: Point[][]; multiHandedness?: { label: string }[] },
@@ -267,20 +275,23 @@ export class Hands implements SkinSource {
   ): number {
     const world = results.multiHandWorldLandmarks ?? [];
     const image = results.multiHandLandmarks ?? [];
-    let pushed = 0;
-    const sides = world.map((_, i) => userSide(results.multiHandedness?.[i]?.label === 'Left' ? 'Left' : 'Right'));
-    world.forEach((w, i) => {
+    if (world.length !== 1) this.sideFilter.reset(); // none, or hands told apart by their labels
+    let [pushed, seen] = [0, 0];
+    for (let i = 0; i < world.length; i++) {
+      const labelled = userSide(results.multiHandedness?.[i]?.label === 'Left' ? 'Left' : 'Right');
+      const side = world.length === 1 ? this.sideFilter.update(labelled) : labelled;
       // Two hands labelled alike are one hand seen twice as far as anyone can tell: only the first drives.
-      if ((this.count === 1 && this.side(0) !== sides[i]) || sides.indexOf(sides[i]) !== i) return;
-      const side = sides[i];
-      if (!image[i] || !placeLandmarks(w, image[i], aspect, anchor, this.landmarks)) return;
+      const bit = side === 'left' ? 1 : 2;
+      if (seen & bit) continue;
+      seen |= bit;
+      if ((this.count === 1 && this.side(0) !== side) || !image[i] || !placeLandmarks(world[i], image[i], aspect, anchor, this.landmarks)) continue;
       try {
         this.inner.pushLandmarks(side, t, this.landmarks);
         pushed++;
       } catch {
         // Refused (counted); the hand keeps its last pose.
       }
-    });
+    }
     return pushed;
   }
 
@@ -409,9 +420,12 @@ export class PosedHand implements SkinSource {
     return this.inner.indices();
   }
 
-  skin(): { positions: Float32Array; normals: Float32Array } {
-    const n = 3 * this.inner.vertexCount;
-    return { positions: this.views.positions.get(this.inner.positionsPtr(), n), normals: this.views.normals.get(this.inner.normalsPtr(), n) };
+  positions(): Float32Array {
+    return this.views.positions.get(this.inner.positionsPtr(), 3 * this.inner.vertexCount);
+  }
+
+  normals(): Float32Array {
+    return this.views.normals.get(this.inner.normalsPtr(), 3 * this.inner.vertexCount);
   }
 
   dispose(): void {

@@ -32,10 +32,9 @@ export class HandMesh extends Mesh<BufferGeometry, Material> {
 
   /** Copies the engine's latest skin into the attributes (and the bounds three.js culls and picks by). */
   update(): void {
-    const { positions, normals } = this.source.skin(this.hand);
     const { position, normal } = this.geometry.attributes as Record<string, BufferAttribute>;
-    (position.array as Float32Array).set(positions);
-    (normal.array as Float32Array).set(normals);
+    (position.array as Float32Array).set(this.source.positions(this.hand));
+    (normal.array as Float32Array).set(this.source.normals(this.hand));
     position.needsUpdate = normal.needsUpdate = true;
     this.geometry.computeBoundingSphere();
     this.geometry.computeBoundingBox();
