@@ -54,10 +54,13 @@ $(VIEWER_DIST): $(VIEWER_DEPS) viewer/index.html viewer/vite.config.ts viewer/ts
 # The built-in hands beside the page (Vite copies viewer/public into dist): the page's engine
 # loads them in milliseconds instead of generating them (seconds in WebAssembly). The same
 # hands, written by the command a user would run (`dqhand hand --out`).
-$(HAND_FILES) &: $(wildcard crates/dqhand/src/*.rs crates/dqhand/src/*/*.rs) crates/dqhand-cli/src/hand.rs
+# Written to target/ first and copied only when they changed: an edit elsewhere in the
+# library writes them again (two seconds) but does not rebuild the page.
+$(HAND_FILES) &: $(wildcard crates/dqhand/src/*.rs crates/dqhand/src/*/*.rs) crates/dqhand-cli/src/hand.rs crates/dqhand-cli/src/main.rs Cargo.lock
 	$(CARGO) build --locked -p dqhand-cli
-	mkdir -p viewer/public/hands
-	for side in right left; do $(DQHAND_DEBUG) hand --side $$side --out viewer/public/hands/$$side.glb || exit 1; done
+	mkdir -p viewer/public/hands target/hands
+	for side in right left; do $(DQHAND_DEBUG) hand --side $$side --out target/hands/$$side.glb || exit 1; done
+	install -C -m 644 target/hands/right.glb target/hands/left.glb viewer/public/hands/
 
 # Third-party test assets and tools come from the npm registry through third_party/package-lock.json;
 # nothing third-party is committed.

@@ -40,7 +40,8 @@ test('a hand mesh follows a recording through its own attributes: the engine\'s 
     views.add(positions).add(normals);
     centre = mesh.geometry.boundingSphere.center.clone();
   }
-  // The same two views of the engine's memory every frame (its memory does not grow once running).
+  // The same two views of the engine's memory every frame: made again only when that memory
+  // grows, which it does not once the hands run.
   assert.equal(views.size, 2);
   // The attributes keep their arrays (three.js uploads them again; nothing new per frame).
   assert.equal(mesh.geometry.attributes.position.array, arrays[0]);
@@ -150,9 +151,16 @@ test('hands from skinned glTF files: the WebXR generic hands (made elsewhere) fo
   hands.dispose();
   // The sides given are the hands: asking for others, or giving a hand as the wrong side, is one line.
   assert.throws(() => engine.hands({ hands: 'left', models: { right } }), /^Error: models: right given for hands "left"$/);
-  assert.throws(() => engine.hands({ models: { right: left } }), (e) => e.message === 'right model: the file holds a left hand');
+  assert.throws(() => engine.hands({ models: { right: left } }), (e) => e.message === 'right model: the file holds a left hand, given as the right one');
   const { fetchModel } = await import(path.join(pkg, 'dist', 'index.js'));
   await assert.rejects(fetchModel('http://127.0.0.1:9/none.glb'), (e) => e.message.startsWith('http://127.0.0.1:9/none.glb: ') && !e.message.includes('\n'));
+  // A server that answers, but not with the file: its status, naming the URL.
+  const { createServer } = await import('node:http');
+  const server = createServer((_, res) => res.writeHead(404, 'Not Found').end());
+  await new Promise((done) => server.listen(0, '127.0.0.1', done));
+  const url = `http://127.0.0.1:${server.address().port}/hands/right.glb`;
+  await assert.rejects(fetchModel(url), (e) => e.message === `${url}: HTTP 404 Not Found`);
+  server.close();
 });
 
 test('a lone hand whose MediaPipe label flickers keeps its side; a label that holds for 5 frames changes it', () => {

@@ -316,6 +316,7 @@ test('hands loaded from skinned glTF: the native command\'s file is the hand the
   // Wrong files: one line naming the file, whichever is wrong.
   const oneLine = (start) => (e) => e instanceof Error && e.message.startsWith(start) && !e.message.includes('\n');
   assert.throws(() => Interaction.withModels('', files.left, undefined), oneLine('right model: the file holds a left hand'));
+  assert.throws(() => Interaction.withModels('', files.right, files.right), oneLine('left model: the file holds a right hand'));
   assert.throws(() => Interaction.withModels('', files.right, new Uint8Array([0x67, 0x6c, 0x54, 0x46, 2, 0, 0, 0])), oneLine('left model: '));
   assert.throws(() => Interaction.withModels('', files.right.subarray(0, 1000), undefined), oneLine('right model: '));
   assert.throws(() => Interaction.withModels('', undefined, undefined), oneLine('withModels: no model given'));
@@ -329,4 +330,5 @@ test('hands loaded from skinned glTF: the native command\'s file is the hand the
   page.free();
   assert.throws(() => new LocalStream('', false, files.right, undefined, '{"grace_s": -1}'), oneLine('input configuration: grace_s: must be a positive number of seconds'));
   assert.throws(() => new LocalStream('', false, new Uint8Array(12), undefined, undefined), oneLine('hands/right.glb: '));
+  assert.throws(() => new LocalStream('two-hands', true, files.left, files.right, undefined), oneLine('hands/right.glb: the file holds a left hand'));
 });

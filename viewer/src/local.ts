@@ -16,11 +16,13 @@ const RATE_HZ = 60;
 /**
  * The built-in hand of `side` as `make viewer` writes it beside the page (`hands/<side>.glb`,
  * from `dqhand hand --out`): loading it takes milliseconds where generating it takes seconds in
- * WebAssembly. Without the file (a build that left it out), undefined: the engine generates the
- * same hand itself.
+ * WebAssembly. Without the file (a build that left it out, or a host that answers with something
+ * else), undefined: the engine generates the same hand itself.
  */
-function handFile(side: 'right' | 'left'): Promise<Uint8Array | undefined> {
-  return fetchModel(`./hands/${side}.glb`).catch(() => undefined);
+async function handFile(side: 'right' | 'left'): Promise<Uint8Array | undefined> {
+  const bytes = await fetchModel(`./hands/${side}.glb`).catch(() => undefined);
+  // A host that answers every path with the page (a single-page app's rewrite) gives no GLB.
+  return bytes && bytes.length >= 12 && new TextDecoder().decode(bytes.subarray(0, 4)) === 'glTF' ? bytes : undefined;
 }
 
 /** The page's engine, driven by a timer; `send`, `setting` and `remember` as a server connection's. */

@@ -129,7 +129,7 @@ describe('a scene of two hands in the page', () => {
     // The objects are placed by the first scene message, which the input's first record brings.
     await waitState(page, 's.xr.active && s.input && s.input.tracking === "tracking" && s.scene.drawn.join() === "box,baton"');
     // The first hand at IWER's right one, the second at its left one (±0.25, 1.5, −0.4).
-    await waitState(page, 'Math.abs(s.frame.wrist[0] - 0.25) < 0.15 && Math.abs(s.secondHand.wrist[0] + 0.25) < 0.15');
+    await waitState(page, 'Math.abs(s.frame.wrist[0] - 0.25) < 0.15 && s.secondHand.wrist && Math.abs(s.secondHand.wrist[0] + 0.25) < 0.15');
     expect((await state(page)).errors).toEqual([]);
     expect(await page.locator('#model-line').textContent()).toMatch(/left hand, .*\(glTF file left\.glb\)/);
     await page.close();

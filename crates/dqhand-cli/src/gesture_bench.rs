@@ -29,6 +29,7 @@ use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 use serde_json::{json, Value};
 
+use crate::both_hands_score::BothHandsScore;
 use crate::recording::{write_recording, Format, InputArgs, RecordingReader};
 use crate::synthesize::synthetic_format;
 
@@ -108,11 +109,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let sources: anyhow::Result<Vec<SourceRun>> = SOURCES.iter().map(|s| SourceRun::measure(s, args, &model, &dir, &gestures)).collect();
     let _ = std::fs::remove_dir_all(&dir);
     let mut sources = sources?;
+    let mut both_hands = None;
     if let Some(node_modules) = &args.outside {
-        sources.push(SourceRun::outside(node_modules, args, &model, &gestures)?);
+        let poses = crate::outside_poses::load(node_modules)?;
+        sources.push(SourceRun::outside(&poses, args, &model, &gestures)?);
+        both_hands = Some(BothHandsScore::measure(&poses, OUTSIDE_REPEATS, args.seed, &gestures)?);
     }
     let retarget = RetargetRun::measure(args, &model)?;
-    let report = report(args, &sources, &retarget);
+    let mut report = report(args, &sources, &retarget);
+    report["both_hands"] = both_hands.map_or(Value::Null, |b| b.to_json(OUTSIDE.target.unwrap_or(0.0)));
     if args.json {
         println!("{report}");
     } else {
@@ -156,11 +161,10 @@ impl SourceRun {
     }
 
     /// Other people's poses, each hand's played as one recording ([`outside_poses`]).
-    fn outside(node_modules: &Path, args: &Args, model: &Arc<Model>, gestures: &GestureSet) -> anyhow::Result<Self> {
-        let poses = crate::outside_poses::load(node_modules)?;
+    fn outside(poses: &[crate::outside_poses::OutsidePose], args: &Args, model: &Arc<Model>, gestures: &GestureSet) -> anyhow::Result<Self> {
         let mut run = Self { source: &OUTSIDE, undriven: Vec::new(), scores: Vec::new(), push_us: Vec::new(), records: 0, loop_s: 0.0 };
         for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-            let s = crate::outside_poses::sequence(&poses, side, OUTSIDE_REPEATS, args.seed.wrapping_add(k as u64));
+            let s = crate::outside_poses::sequence(poses, side, OUTSIDE_REPEATS, args.seed.wrapping_add(k as u64));
             let gesture_loop = GestureLoop::new(model.clone(), JointModel::Full, None, dqhand::input::InputConfig::default(), Some(gestures.clone()))?;
             let events = run.play(RecordingReader::Records(s.records.into(), 0), gesture_loop, side)?;
             run.scores.push(RecognitionScore::new(&s.labels, s.idle, &events));
@@ -469,6 +473,25 @@ fn print_tables(r: &Value) {
             f(&s["push_us"]["median"]),
             f(&s["records_per_s"])
         );
+    }
+    let b = &r["both_hands"];
+    if !b.is_null() {
+        println!(
+            "outside poses, both hands at once ({}): {} holds; each hand's gesture at the end of its hold {}/{} ({:.1} %, target ≥ {:.0} %): {}; the gesture of both hands {}/{}",
+            b["poses"].as_str().unwrap_or(""),
+            u(&b["holds"]),
+            u(&b["hands_named"]),
+            u(&b["hands"]),
+            f(&b["hands_rate"]) * 100.0,
+            f(&b["target"]) * 100.0,
+            pass(b["hands_pass"] == true),
+            u(&b["two_hand_named"]),
+            u(&b["two_hand"])
+        );
+        let misses: Vec<&str> = b["misses"].as_array().into_iter().flatten().filter_map(Value::as_str).collect();
+        if !misses.is_empty() {
+            println!("  missed: {}", misses.join("; "));
+        }
     }
     println!();
     println!("per gesture: in time / holds, precision (right starts / starts)");

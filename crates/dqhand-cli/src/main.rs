@@ -5,6 +5,7 @@
 
 mod bench;
 mod bench_stream;
+mod both_hands_score;
 mod calibrate;
 mod demo;
 mod feed;

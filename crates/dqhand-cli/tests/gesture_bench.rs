@@ -58,6 +58,12 @@ fn a_small_run_reports_every_measure_and_meets_the_accuracy_targets() {
     assert!(number(&measured["rate"], "landmarks") >= 0.8, "{measured}");
     assert!(number(&sources[2]["rate"], "landmarks, light") >= 0.95, "{}", sources[2]);
     assert!(sources[5]["holds"].as_u64().unwrap() >= 48, "every outside pose, three times per hand");
+    // Both hands of handy-work's captures at once, each hand recognised by itself and the
+    // gesture of both hands (both palms open, held together) from the two.
+    let both = &r["both_hands"];
+    assert_eq!((both["holds"].as_u64(), both["hands"].as_u64()), (Some(45), Some(90)), "7 captures, 7 mixed pairs, 1 held together, 3 rounds: {both}");
+    assert!(number(&both["hands_rate"], "both hands") >= 0.97 && both["hands_pass"] == true, "{both}");
+    assert!(both["two_hand"].as_u64().unwrap() >= 30 && number(&both["two_hand_rate"], "two-hand") >= 0.9, "{both}");
     // Our own hand's noise-free joints come back within the 1° (much better, in fact).
     let own = &r["retarget"]["own_hand"];
     assert!(number(&own["scores"]["mean_deg"], "mean") <= 1.0 && own["mean_pass"] == true, "{own}");

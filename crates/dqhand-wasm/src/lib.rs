@@ -28,7 +28,7 @@ use dqhand::grasp::GraspEvent;
 use dqhand::hand::{build, HandParams};
 use dqhand::input::array_record::{joints_record, landmarks_record};
 use dqhand::input::json_record::parse_record;
-use dqhand::input::{InputConfig, Record};
+use dqhand::input::{rest_side, InputConfig, Record};
 use dqhand::grasp::GraspParams;
 use dqhand::interaction::{frame_trace, scene_shapes, ManipulationLoop};
 use dqhand::io::load_gltf_slice;
@@ -64,9 +64,15 @@ fn js(e: dqhand::Error) -> JsError {
     JsError::new(&e.to_string())
 }
 
-/// A skinned glTF hand from `bytes`; `name` names the file in errors and in its description.
-fn load_model(bytes: &[u8], name: &str) -> Result<Arc<Model>, JsError> {
-    load_gltf_slice(bytes, std::path::Path::new(name)).map(Arc::new).map_err(js)
+/// A skinned glTF hand from `bytes`, given as the `side` one; `name` names the file in errors
+/// and in its description.
+fn load_model(bytes: &[u8], name: &str, side: Side) -> Result<Arc<Model>, JsError> {
+    let model = load_gltf_slice(bytes, std::path::Path::new(name)).map_err(js)?;
+    match rest_side(&model.skeleton) {
+        Ok(found) if found == side => Ok(Arc::new(model)),
+        Ok(found) => Err(JsError::new(&format!("{name}: the file holds a {} hand, given as the {} one", found.name(), side.name()))),
+        Err(e) => Err(JsError::new(&format!("{name}: {e}"))),
+    }
 }
 
 #[wasm_bindgen]
@@ -390,14 +396,8 @@ impl Interaction {
         if given.is_empty() {
             return Err(JsError::new("withModels: no model given (a right one, a left one or both)"));
         }
-        let models = given.iter().map(|(bytes, side)| load_model(bytes, &format!("{} model", side.name()))).collect::<Result<Vec<_>, _>>()?;
-        let interaction = Self::with_hands(models, scene)?;
-        for (hand, (_, side)) in interaction.manip.hands().iter().zip(&given) {
-            if hand.side() != *side {
-                return Err(JsError::new(&format!("{} model: the file holds a {} hand", side.name(), hand.side().name())));
-            }
-        }
-        Ok(interaction)
+        let models = given.iter().map(|(bytes, side)| load_model(bytes, &format!("{} model", side.name()), *side)).collect::<Result<Vec<_>, _>>()?;
+        Self::with_hands(models, scene)
     }
 
     /// The loop of `models` (one hand, or a left and a right one in that order) in `scene`.

@@ -59,7 +59,7 @@ impl LocalStream {
             Some(text) => InputConfig::from_json(text).map_err(js)?,
         };
         let hand = |side: Side, bytes: Option<Vec<u8>>| match bytes {
-            Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name())),
+            Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name()), side),
             None => build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js),
         };
         let model = hand(Side::Right, right)?;

@@ -212,3 +212,18 @@ fn hand_size_is_measured_from_joints() {
         }
     }
 }
+
+#[test]
+fn a_models_side_is_read_from_its_rest_geometry_as_its_retargeter_reads_it() {
+    for side in [Side::Left, Side::Right] {
+        let model = hand(0.17, 0.08, side);
+        assert_eq!(dqhand::input::rest_side(&model.skeleton).unwrap(), side);
+        let rig = HandRig::new(&model.skeleton, JointModel::Full).unwrap();
+        assert_eq!(Retargeter::new(&rig).unwrap().side(), side);
+    }
+    // A skeleton without the WebXR joints has no side to read.
+    let root = dqhand::kinematics::Joint { name: "root".into(), parent: None, rest: Default::default() };
+    let bare = dqhand::kinematics::Skeleton::new(vec![root]).unwrap();
+    let err = dqhand::input::rest_side(&bare).unwrap_err().to_string();
+    assert!(err.contains("wrist"), "{err}");
+}

@@ -154,6 +154,7 @@ class MemoryView {
 }
 
 const NO_EVENTS: readonly HandEvent[] = Object.freeze([]);
+const NO_HANDS: readonly Point[][] = Object.freeze([]);
 
 /**
  * One or two hands driven by the user's tracked hands: per frame, push what the trackers give
@@ -273,10 +274,11 @@ export class Hands implements SkinSource {
     aspect: number,
     anchor: Vec3 = [0, 1.2, -0.3],
   ): number {
-    const world = results.multiHandWorldLandmarks ?? [];
-    const image = results.multiHandLandmarks ?? [];
+    const world = results.multiHandWorldLandmarks ?? NO_HANDS;
+    const image = results.multiHandLandmarks ?? NO_HANDS;
     if (world.length !== 1) this.sideFilter.reset(); // none, or hands told apart by their labels
-    let [pushed, seen] = [0, 0];
+    let pushed = 0;
+    let seen = 0;
     for (let i = 0; i < world.length; i++) {
       const labelled = userSide(results.multiHandedness?.[i]?.label === 'Left' ? 'Left' : 'Right');
       const side = world.length === 1 ? this.sideFilter.update(labelled) : labelled;

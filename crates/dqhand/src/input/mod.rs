@@ -30,5 +30,5 @@ pub use one_euro::{Filtered, OneEuro, OneEuroFilter, OneEuroParams, OneEuroRotat
 pub use pipeline::{InputPipeline, Tracking, MAX_LEAD_S};
 pub use record::{GloveSample, HandData, JointSet, Record, RigidPose, TrackedJoint, JOINT_COUNT, LANDMARK_COUNT, MAX_GLOVE_SENSORS};
 pub use rejection::{RejectKind, Rejection, Rejections};
-pub use retarget::{Retargeter, CONTACT_FADE, CONTACT_FULL, CONTACT_MARGIN};
+pub use retarget::{rest_side, Retargeter, CONTACT_FADE, CONTACT_FULL, CONTACT_MARGIN};
 pub use tracker_mount::MountingOffset;

@@ -87,6 +87,30 @@ pub struct Retargeter {
     chains: [core::ops::Range<usize>; 5],
 }
 
+/// The side of a hand from its joints (WebXR order) and its wrist's +Y (the back of the hand):
+/// index knuckle to middle knuckle, crossed with the palm's length, points to the back of a
+/// left hand.
+fn handedness(positions: &[Vec3; JOINT_COUNT], wrist_y: Vec3) -> Side {
+    let h = (positions[INDEX_MCP] - positions[MIDDLE_MCP]).cross(positions[MIDDLE_MCP] - positions[WRIST]).dot(wrist_y);
+    if h > 0.0 {
+        Side::Left
+    } else {
+        Side::Right
+    }
+}
+
+/// The side of a hand model rigged with the 25 WebXR joints, from its rest geometry (what a
+/// retargeter for it finds), without building one: to check a file given as one side's hand.
+///
+/// # Errors
+/// [`crate::Error::MissingJoint`] naming a WebXR joint the skeleton lacks.
+pub fn rest_side(skeleton: &crate::kinematics::Skeleton) -> crate::Result<Side> {
+    let index = *JointPositions::new(skeleton)?.indices();
+    let rest_world = skeleton.rest_world();
+    let positions: [Vec3; JOINT_COUNT] = core::array::from_fn(|i| Vec3::from(rest_world[index[i]].translation));
+    Ok(handedness(&positions, rest_world[index[WRIST]].matrix3.y_axis.into()))
+}
+
 impl Retargeter {
     /// A retargeter for `rig`, whose skeleton must have all 25 WebXR joints (the built-in
     /// hand and WebXR-rigged glTF hands do).
@@ -102,10 +126,7 @@ impl Retargeter {
         let rest_palm = palm_frame(&positions).expect("the rig's rest palm spans a frame");
         let palm_length = (positions[MIDDLE_MCP] - positions[WRIST]).length();
         let metacarpal_base = METACARPALS.map(|m| rest_palm.transpose() * (positions[m] - positions[WRIST]) / palm_length);
-        let handedness = (positions[INDEX_MCP] - positions[MIDDLE_MCP])
-            .cross(positions[MIDDLE_MCP] - positions[WRIST])
-            .dot(rest_world[index[WRIST]].matrix3.y_axis.into());
-        let side = if handedness > 0.0 { Side::Left } else { Side::Right };
+        let side = handedness(&positions, rest_world[index[WRIST]].matrix3.y_axis.into());
 
         let motions: Vec<Motion> = rig.model().dofs().map(|d| d.motion).collect();
         let mut steps = Vec::new();
