@@ -1,7 +1,7 @@
 //! The scene's rigid bodies in a rapier world.
 
 use glam::{Affine3A, Quat, Vec3};
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle, RigidBodyType};
+use rapier3d::prelude::{ActiveHooks, ColliderBuilder, ColliderHandle, ColliderSet, PairFilterContext, PhysicsHooks, RigidBodyBuilder, RigidBodyHandle, RigidBodyType, SolverFlags};
 use rapier3d::pipeline::PhysicsWorld;
 use parry3d::math::Pose;
 
@@ -33,6 +33,31 @@ const PLACED_M: f32 = 1e-6;
 /// See [`PLACED_M`].
 const PLACED_RAD: f32 = 1e-6;
 
+/// A hand's proxy this near an object let go passes through it until they are this far apart,
+/// m ([`ScenePhysics::release`]).
+const CLEAR_M: f32 = 0.002;
+
+/// The pairs of an object let go and a hand's proxy within [`CLEAR_M`] of it then, which the
+/// solver leaves alone until they are [`CLEAR_M`] apart (rapier asks this filter of every pair
+/// of an object with its hook on).
+struct LetGo {
+    /// (object's collider, proxy's collider).
+    pairs: Vec<(ColliderHandle, ColliderHandle)>,
+}
+
+impl PhysicsHooks for LetGo {
+    fn filter_contact_pair(&self, c: &PairFilterContext) -> Option<SolverFlags> {
+        let pair = |a, b| self.pairs.contains(&(a, b));
+        (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then_some(SolverFlags::COMPUTE_RIGID_IMPULSES)
+    }
+}
+
+/// Whether colliders `a` and `b` of `colliders` are nearer than `gap` (overlapping ones are 0 apart).
+fn nearer(colliders: &ColliderSet, a: ColliderHandle, b: ColliderHandle, gap: f32) -> bool {
+    let (a, b) = (&colliders[a], &colliders[b]);
+    parry3d::query::distance(a.position(), a.shape(), b.position(), b.shape()).is_ok_and(|d| d.distance < gap)
+}
+
 /// Whether `a` and `b` are within [`PLACED_M`] and [`PLACED_RAD`] of each other.
 fn near(a: &Pose, b: &Pose) -> bool {
     a.translation.distance(b.translation) <= PLACED_M && 2.0 * (a.rotation.inverse() * b.rotation).xyz().length() <= PLACED_RAD
@@ -42,6 +67,10 @@ fn near(a: &Pose, b: &Pose) -> bool {
 pub struct ScenePhysics {
     world: PhysicsWorld,
     bodies: Vec<RigidBodyHandle>,
+    /// Each object's collider.
+    colliders: Vec<ColliderHandle>,
+    /// Objects let go and the proxies round them then, not yet clear.
+    let_go: LetGo,
     /// Where the file puts each object.
     initial: Vec<Pose>,
     /// Per object, whether a hand holds it (it moves kinematically).
@@ -49,7 +78,7 @@ pub struct ScenePhysics {
     /// Each rendered hand's proxies as kinematic bodies, with their joints: a free object
     /// meets the hands (a released ball rests on the fingers, a rolling one stops at them)
     /// instead of passing into them.
-    hands: Vec<Vec<(RigidBodyHandle, usize)>>,
+    hands: Vec<Vec<(RigidBodyHandle, usize, ColliderHandle)>>,
     /// The objects the last step put back, out of reach ([`REACH_M`], or under the floor).
     returned: Vec<usize>,
     /// The floor's height and the reach across, m (for this scene's objects).
@@ -66,13 +95,15 @@ impl ScenePhysics {
         world.gravity = Vec3::new(0.0, -GRAVITY, 0.0);
         world.integration_parameters.max_ccd_substeps = 4;
         let mut bodies = Vec::with_capacity(scene.objects.len());
+        let mut handles = Vec::with_capacity(scene.objects.len());
         let mut initial = Vec::with_capacity(scene.objects.len());
         for (o, c) in scene.objects.iter().zip(colliders.objects()) {
             let pose = Pose::from_parts(o.position, o.rotation);
             let body = RigidBodyBuilder::dynamic().pose(pose).ccd_enabled(true).build();
             let collider = ColliderBuilder::new(c.solid.clone()).mass(o.mass).friction(o.friction).restitution(o.restitution).build();
-            let (handle, _) = world.insert(body, collider);
+            let (handle, collider) = world.insert(body, collider);
             bodies.push(handle);
+            handles.push(collider);
             initial.push(pose);
         }
         if let Some(slab) = colliders.table_collider() {
@@ -87,7 +118,8 @@ impl ScenePhysics {
         let slab = ColliderBuilder::cuboid(2.0 * reach, 0.5, 2.0 * reach).translation(Vec3::new(0.0, floor - 0.5, 0.0));
         world.insert_collider(slab.friction(TABLE_FRICTION).restitution(TABLE_RESTITUTION).build(), None);
         let returned = Vec::with_capacity(bodies.len());
-        Self { world, held: vec![false; bodies.len()], bodies, initial, hands: Vec::new(), returned, floor, reach }
+        let let_go = LetGo { pairs: Vec::new() };
+        Self { world, held: vec![false; bodies.len()], bodies, colliders: handles, let_go, initial, hands: Vec::new(), returned, floor, reach }
     }
 
     /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves; returns its
@@ -98,10 +130,13 @@ impl ScenePhysics {
             .iter()
             .map(|p| {
                 let body = RigidBodyBuilder::kinematic_position_based().build();
-                (self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build()).0, p.joint)
+                let (body, collider) = self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build());
+                (body, p.joint, collider)
             })
             .collect();
         self.hands.push(hand);
+        // Room for every proxy of every hand in every object: no allocation when letting go.
+        self.let_go.pairs.reserve(self.hands.iter().map(Vec::len).sum::<usize>() * self.bodies.len());
         self.hands.len() - 1
     }
 
@@ -114,7 +149,7 @@ impl ScenePhysics {
     /// alone.
     pub fn move_hand(&mut self, hand: usize, world: Option<&[Affine3A]>) {
         // Rapier marks every body borrowed mutably as changed: only those that change are.
-        for &(h, joint) in &self.hands[hand] {
+        for &(h, joint, _) in &self.hands[hand] {
             let placed = &self.world.bodies[h];
             let Some(world) = world else {
                 if placed.is_enabled() {
@@ -130,6 +165,16 @@ impl ScenePhysics {
             body.set_enabled(true);
             body.set_position(pose, true);
             body.set_next_kinematic_position(pose);
+        }
+    }
+
+    /// Objects with hooks but no pair let go left lose them.
+    fn unhook(&mut self) {
+        for &object in &self.colliders {
+            let collider = &self.world.colliders[object];
+            if !collider.active_hooks().is_empty() && !self.let_go.pairs.iter().any(|p| p.0 == object) {
+                self.world.colliders[object].set_active_hooks(ActiveHooks::empty());
+            }
         }
     }
 
@@ -151,6 +196,9 @@ impl ScenePhysics {
     /// `translation`, pushing what it meets on the way.
     pub fn hold(&mut self, i: usize, rotation: Quat, translation: Vec3) {
         if !self.held[i] {
+            let object = self.colliders[i];
+            self.let_go.pairs.retain(|p| p.0 != object);
+            self.unhook();
             self.world.bodies[self.bodies[i]].set_body_type(RigidBodyType::KinematicPositionBased, true);
             self.held[i] = true;
         }
@@ -158,7 +206,24 @@ impl ScenePhysics {
     }
 
     /// Object `i` leaves the hands with its origin moving at `linvel` and turning at `angvel`.
+    /// The fingers are round it then, touching it or a fraction of a millimetre inside (the
+    /// grasp held it kinematically): the solver would push them apart, and an object settling
+    /// past them would be nudged away (a ball set down by a still hand rolled 21 mm, by a
+    /// headset-tracked one 30 cm). So each proxy within [`CLEAR_M`] of it passes through it
+    /// until they are [`CLEAR_M`] apart ([`Self::step`]); the other proxies still hold it off.
+    /// The rendered hand stops at it whatever the physics does (the contact constraint).
     pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3) {
+        let object = self.colliders[i];
+        for &(body, _, proxy) in self.hands.iter().flatten() {
+            if self.world.bodies[body].is_enabled() && nearer(&self.world.colliders, object, proxy, CLEAR_M) {
+                self.let_go.pairs.push((object, proxy));
+            }
+        }
+        // The filter is asked only while the object has such pairs (rapier allocates more
+        // per frame for a collider with hooks).
+        if self.let_go.pairs.iter().any(|p| p.0 == object) {
+            self.world.colliders[object].set_active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS);
+        }
         self.held[i] = false;
         let body = &mut self.world.bodies[self.bodies[i]];
         body.set_body_type(RigidBodyType::Dynamic, true);
@@ -171,6 +236,8 @@ impl ScenePhysics {
     /// Every object back where the file puts it, at rest, none held.
     pub fn reset(&mut self) {
         self.held.fill(false);
+        self.let_go.pairs.clear();
+        self.unhook();
         for i in 0..self.bodies.len() {
             self.put_back(i);
         }
@@ -189,7 +256,13 @@ impl ScenePhysics {
     /// room ([`REACH_M`] across, or through the floor) is put back ([`Self::returned`]).
     pub fn step(&mut self, dt: f32) {
         self.world.integration_parameters.dt = dt;
-        self.world.step();
+        self.world.step_with_events(&self.let_go, &());
+        if !self.let_go.pairs.is_empty() {
+            let (colliders, bodies, hands) = (&self.world.colliders, &self.world.bodies, &self.hands);
+            let enabled = |proxy| hands.iter().flatten().any(|&(b, _, h)| h == proxy && bodies[b].is_enabled());
+            self.let_go.pairs.retain(|&(object, proxy)| enabled(proxy) && nearer(colliders, object, proxy, CLEAR_M));
+            self.unhook();
+        }
         self.returned.clear();
         for i in 0..self.bodies.len() {
             let p = self.world.bodies[self.bodies[i]].position().translation;
