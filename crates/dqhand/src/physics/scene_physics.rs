@@ -41,13 +41,13 @@ const CLEAR_M: f32 = 0.002;
 /// solver leaves alone until they are [`CLEAR_M`] apart (rapier asks this filter of every pair
 /// of an object with its hook on).
 struct LetGo {
-    /// (object's collider, proxy's collider).
-    pairs: Vec<(ColliderHandle, ColliderHandle)>,
+    /// The object's collider, the proxy's collider and the proxy's body.
+    pairs: Vec<(ColliderHandle, ColliderHandle, RigidBodyHandle)>,
 }
 
 impl PhysicsHooks for LetGo {
     fn filter_contact_pair(&self, c: &PairFilterContext) -> Option<SolverFlags> {
-        let pair = |a, b| self.pairs.contains(&(a, b));
+        let pair = |a, b| self.pairs.iter().any(|p| (p.0, p.1) == (a, b));
         (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then_some(SolverFlags::COMPUTE_RIGID_IMPULSES)
     }
 }
@@ -216,7 +216,7 @@ impl ScenePhysics {
         let object = self.colliders[i];
         for &(body, _, proxy) in self.hands.iter().flatten() {
             if self.world.bodies[body].is_enabled() && nearer(&self.world.colliders, object, proxy, CLEAR_M) {
-                self.let_go.pairs.push((object, proxy));
+                self.let_go.pairs.push((object, proxy, body));
             }
         }
         // The filter is asked only while the object has such pairs (rapier allocates more
@@ -258,9 +258,8 @@ impl ScenePhysics {
         self.world.integration_parameters.dt = dt;
         self.world.step_with_events(&self.let_go, &());
         if !self.let_go.pairs.is_empty() {
-            let (colliders, bodies, hands) = (&self.world.colliders, &self.world.bodies, &self.hands);
-            let enabled = |proxy| hands.iter().flatten().any(|&(b, _, h)| h == proxy && bodies[b].is_enabled());
-            self.let_go.pairs.retain(|&(object, proxy)| enabled(proxy) && nearer(colliders, object, proxy, CLEAR_M));
+            let (colliders, bodies) = (&self.world.colliders, &self.world.bodies);
+            self.let_go.pairs.retain(|&(object, proxy, body)| bodies[body].is_enabled() && nearer(colliders, object, proxy, CLEAR_M));
             self.unhook();
         }
         self.returned.clear();
