@@ -13,6 +13,7 @@ use dqhand::input::InputConfig;
 use dqhand::interaction::benchmark::NO_GESTURE;
 use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
+use dqhand::model::Model;
 use dqhand::scene::Scene;
 use serde_json::{json, Value};
 
@@ -49,15 +50,16 @@ fn expected(hold: &PairHold) -> Option<Option<&'static str>> {
 }
 
 impl BothHandsScore {
-    /// Plays `poses`' pairs (`repeats` rounds, `seed`) into a two-handed loop of built-in
-    /// hands with `gestures` and the built-in two-hand gestures, and reads each hold's end.
+    /// Plays `poses`' pairs (`repeats` rounds, `seed`) into a two-handed loop of `right` (the
+    /// bench's built-in hand) and the built-in left one, with `gestures` and the built-in
+    /// two-hand gestures, and reads each hold's end.
     ///
     /// # Errors
-    /// A hand that cannot be built, or a loop that cannot be made.
-    pub fn measure(poses: &[OutsidePose], repeats: usize, seed: u64, gestures: &GestureSet) -> anyhow::Result<Self> {
-        let hand = |side| ModelSource::Builtin(HandParams { side, ..HandParams::default() }).load().map(Arc::new);
+    /// The left hand cannot be built, or the loop cannot be made.
+    pub fn measure(right: &Arc<Model>, poses: &[OutsidePose], repeats: usize, seed: u64, gestures: &GestureSet) -> anyhow::Result<Self> {
+        let left = Arc::new(ModelSource::Builtin(HandParams { side: Side::Left, ..HandParams::default() }).load()?);
         let nothing = Scene { table: None, objects: Vec::new(), actions: Vec::new() };
-        let hands = [(hand(Side::Left)?, None), (hand(Side::Right)?, None)];
+        let hands = [(left, None), (Arc::clone(right), None)];
         let mut manip = ManipulationLoop::two_handed(hands, JointModel::Full, InputConfig::default(), Some(gestures.clone()), &nothing, GraspParams::default())?;
         let (records, holds) = both_hands(poses, repeats, seed);
         let [left, right] = [Side::Left, Side::Right].map(|s| manip.hand_of(s));

@@ -113,7 +113,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(node_modules) = &args.outside {
         let poses = crate::outside_poses::load(node_modules)?;
         sources.push(SourceRun::outside(&poses, args, &model, &gestures)?);
-        both_hands = Some(BothHandsScore::measure(&poses, OUTSIDE_REPEATS, args.seed, &gestures)?);
+        both_hands = Some(BothHandsScore::measure(&model, &poses, OUTSIDE_REPEATS, args.seed, &gestures)?);
     }
     let retarget = RetargetRun::measure(args, &model)?;
     let mut report = report(args, &sources, &retarget);

@@ -46,9 +46,10 @@ struct LetGo {
 }
 
 impl PhysicsHooks for LetGo {
+    /// A listed pair is left out; any other is solved as rapier solves a pair with no hook.
     fn filter_contact_pair(&self, c: &PairFilterContext) -> Option<SolverFlags> {
         let pair = |a, b| self.pairs.iter().any(|p| (p.0, p.1) == (a, b));
-        (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then_some(SolverFlags::COMPUTE_RIGID_IMPULSES)
+        (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then(SolverFlags::default)
     }
 }
 
