@@ -39,7 +39,7 @@ pub fn run(model: Model, seconds: f64, json_out: bool) -> anyhow::Result<()> {
     for r in &RUNS {
         let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, 0))?;
         let address = listener.local_addr()?;
-        let shared = server::Shared { model: model.clone(), second: None, joint_model: JointModel::Full, assets: None, fps: r.target_fps, feed: None };
+        let shared = server::Shared { model: model.clone(), second: None, joint_model: JointModel::Full, assets: None, fps: r.target_fps, feed: None, page: server::PageEngine::new(Err("no live input".into())) };
         std::thread::spawn(move || server::serve(listener, shared));
         let (mut ws, _) = tungstenite::connect(format!("ws://{address}/stream"))?;
         ws.send(Message::text(json!({ "type": "view", "methods": ["lb", "qb", "dqb"] }).to_string()))?;

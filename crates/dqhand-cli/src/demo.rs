@@ -18,11 +18,14 @@ use dqhand::interaction::GestureLoop;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
 use dqhand::skin::Method;
-use dqhand_stream::LiveInput;
+use dqhand::gesture::GestureSet;
+use dqhand::input::{Calibration, InputConfig, MappingTable};
+use dqhand_stream::{EngineSettings, LiveInput};
 
 use crate::feed::Feed;
 use crate::live::LiveRecords;
 use crate::live_learning::LiveLearning;
+use crate::relay::RecordRelay;
 use crate::recording::{gesture_set, Format, InputArgs, RecordingReader};
 use crate::server;
 use crate::synthesize::TWO_HANDS_SCENE;
@@ -157,7 +160,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bound = listener.local_addr()?;
     let model = Arc::new(model);
     let left = args.two_hands().then(|| args.left_model.left().load().with_context(|| format!("--left-model {}", args.left_model))).transpose()?.map(Arc::new);
-    let feed = live_input(args, &model, left.as_ref(), bound.ip())?;
+    let (feed, settings) = live_input(args, &model, left.as_ref(), bound.ip())?;
     let url = format!("http://{}/", if bound.ip().is_unspecified() { SocketAddr::new([127, 0, 0, 1].into(), bound.port()) } else { bound });
     println!("{}", model.description);
     if bound.ip().is_loopback() {
@@ -171,15 +174,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         open_browser(&url);
     }
     let second = left.map(|l| (l, Side::Left));
-    let shared = server::Shared { model, second, joint_model: args.joint_model, assets: Some(assets), fps: args.fps, feed: Some(feed) };
+    let page = server::PageEngine::new(settings);
+    let shared = server::Shared { model, second, joint_model: args.joint_model, assets: Some(assets), fps: args.fps, feed: Some(feed), page };
     server::serve(listener, shared)?;
     Ok(())
 }
 
 /// The live input: the recording played, or the UDP port, or only the `/input` WebSocket
 /// (always open), each record recognised and every viewer following; with a `left` model,
-/// of two hands.
-fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: IpAddr) -> anyhow::Result<Arc<Feed>> {
+/// of two hands. With it, the settings a page runs the same engine with, or why it cannot.
+fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: IpAddr) -> anyhow::Result<(Arc<Feed>, Result<EngineSettings, String>)> {
     let gestures = gesture_set(args.gestures_file.as_deref(), true)?.expect("recognition on");
     let mut config = args.common.config()?;
     if args.common.config.is_none() {
@@ -187,6 +191,7 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         config.actions.retain(|a| gestures.gestures().iter().any(|g| g.name() == a.gesture));
     }
     let mapper = Some(args.common.mapper(args.joint_model)?);
+    let settings = page_settings(args, &config, &gestures)?;
     let scene = args.scene_name().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
     let played = match (&args.input, &scene, args.udp) {
         (Some(path), _, _) => Some(Played::File(path.clone())),
@@ -224,7 +229,8 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         }
     };
     let learning = LiveLearning::new(Arc::clone(model), args.common.config()?, Some(args.recordings.clone()));
-    let feed = Arc::new(Feed { input, records, learning, clients: AtomicUsize::new(0) });
+    let relay = RecordRelay::new(args.common.table()?.layout().sensors().iter().map(|s| s.name.clone()).collect());
+    let feed = Arc::new(Feed { input, records, learning, relay, clients: AtomicUsize::new(0) });
     let reporter = Arc::clone(&feed);
     std::thread::spawn(move || reporter.report());
     let played_now = played.is_some();
@@ -261,7 +267,32 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         });
     }
     println!("input WebSocket: /input on this server, one JSON record per message");
-    Ok(feed)
+    Ok((feed, settings))
+}
+
+/// What a page needs to run the demo's engine itself ([`EngineSettings`]), or why it cannot:
+/// a scene file (its meshes are this machine's files).
+///
+/// # Errors
+/// A glove table or calibration file that cannot be read (the demo reads them too).
+fn page_settings(args: &Args, config: &InputConfig, gestures: &GestureSet) -> anyhow::Result<Result<EngineSettings, String>> {
+    let scene = match args.scene_name() {
+        Some(name) if !Scene::BUILTIN.contains(&name) => {
+            return Ok(Err(format!("scene {name}: a scene file's meshes are this machine's files; the page shows this server's stream")));
+        }
+        name => name.map(str::to_owned),
+    };
+    let glove = match args.common.glove.as_str() {
+        name if MappingTable::BUILTIN.contains(&name) => name.to_owned(),
+        path => std::fs::read_to_string(path).with_context(|| format!("--glove {path}"))?,
+    };
+    let table = args.common.table()?;
+    let calibration = match &args.common.calib {
+        Some(path) => Calibration::load(path)?,
+        None => Calibration::default_for(&table),
+    };
+    let (hands, joint_model) = (1 + u8::from(args.two_hands()), args.joint_model.as_str().to_owned());
+    Ok(Ok(EngineSettings { hands, scene, joint_model, config: config.clone(), gestures: gestures.to_json(), glove, calibration }))
 }
 
 /// The built page: `--viewer`, else the first of these with an `index.html`: `viewer/dist`

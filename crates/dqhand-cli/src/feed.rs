@@ -1,5 +1,6 @@
 //! What feeds the demo's live input: a recording played in real time (looping), a UDP
-//! stream, and the `/input` WebSocket of the server, each from its own thread.
+//! stream, and the `/input` WebSocket of the server, each from its own thread. Every record
+//! taken is also relayed to the pages that run the engine themselves.
 
 use std::io::ErrorKind;
 use std::net::UdpSocket;
@@ -11,6 +12,7 @@ use dqhand_stream::LiveInput;
 
 use crate::live::{LiveRecords, MAX_DATAGRAM_BYTES};
 use crate::live_learning::LiveLearning;
+use crate::relay::RecordRelay;
 use crate::recording::RecordingReader;
 
 /// The demo's live input and how bytes reach it.
@@ -19,6 +21,8 @@ pub struct Feed {
     pub records: LiveRecords,
     /// Gestures learned from the viewers' Input panel.
     pub learning: LiveLearning,
+    /// The records taken, for the pages that run the engine themselves.
+    pub relay: RecordRelay,
     /// `/input` connections open now (each holds a thread; see [`MAX_INPUT_CLIENTS`]).
     pub clients: AtomicUsize,
 }
@@ -43,7 +47,10 @@ impl Feed {
             self.input.reject(rejection.clone());
             return Err(rejection);
         }
-        self.input.push(record, |r| self.records.keep(r))
+        self.input.push(record, |r| {
+            self.records.keep(r);
+            self.relay.publish(r);
+        })
     }
 
     /// Receives datagrams forever (until the socket fails).
@@ -104,7 +111,7 @@ impl Feed {
                     }
                     _ => {}
                 }
-                let _ = self.input.push(&record, |_| {}); // refusals are counted and shown
+                let _ = self.input.push(&record, |r| self.relay.publish(r)); // refusals are counted and shown
             }
             if first.is_none() {
                 anyhow::bail!("{name}: no record to play");

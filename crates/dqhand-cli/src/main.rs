@@ -23,6 +23,7 @@ mod metrics;
 mod outside_poses;
 mod peers;
 mod recording;
+mod relay;
 mod replay;
 mod server;
 mod skin;

@@ -879,3 +879,113 @@ fn loadtest_serves_every_viewer_and_survives_the_abuse() {
     check(w["watcher_fps"].as_f64().unwrap() >= FPS_FLOOR && w["watcher_longest_gap_s"].as_f64().unwrap() <= LONGEST_WAIT_S, "a viewer beside the one that never reads keeps getting frames");
     assert!(failed.is_empty(), "failed: {failed:#?}\nthe load test's report: {r:#}");
 }
+
+/// A GET's status and body as bytes (a hand's GLB is not text).
+fn get_bytes(address: &str, path: &str) -> (u16, Vec<u8>) {
+    let mut s = TcpStream::connect(address).unwrap();
+    s.write_all(format!("GET {path} HTTP/1.1\r\nHost: {address}\r\n\r\n").as_bytes()).unwrap();
+    let mut response = Vec::new();
+    let _ = s.read_to_end(&mut response);
+    let end = response.windows(4).position(|w| w == b"\r\n\r\n").unwrap() + 4;
+    let status = String::from_utf8_lossy(&response[..end]).split(' ').nth(1).and_then(|c| c.parse().ok()).unwrap_or(0);
+    (status, response[end..].to_vec())
+}
+
+/// The relay's next text message (records on the way are left out).
+fn relay_text(ws: &mut Client) -> Value {
+    loop {
+        if let Message::Text(t) = ws.read().unwrap() {
+            return serde_json::from_str(&t).unwrap();
+        }
+    }
+}
+
+/// The relay: `engine.json` gives a page the demo's engine (its settings, with the glove and
+/// joint model given on the command line, and its hand as a file); a page on `/relay` is told
+/// the recording state and the gestures, then gets every record the input takes, as it was
+/// sent (a refused one is not relayed); its `record` writes the live input to disk, and
+/// anything else it sends is refused with the reason. A scene file gives no relay (its meshes
+/// are this machine's files), and says why.
+#[test]
+fn the_relay_gives_a_page_the_engine_and_every_record_taken() {
+    let dir = site("relay");
+    let config = dir.join("config.json");
+    std::fs::write(&config, r#"{"grace_s": 5.0, "max_latency_s": 5.0}"#).unwrap();
+    let recordings = dir.join("recordings");
+    let server = start("relay-server", &["--config", config.to_str().unwrap(), "--recordings", recordings.to_str().unwrap(), "--glove", "5dt-5", "--joint-model", "paper"]);
+    let (status, body) = get(&server.address, "/engine.json");
+    assert_eq!(status, 200);
+    let engine: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!((&engine["relay"], &engine["why"], &engine["hands"]), (&"/relay".into(), &Value::Null, &serde_json::json!(["/engine/hands/right.glb"])), "{engine}");
+    let settings = dqhand_stream::EngineSettings::from_json(&engine["settings"].to_string()).unwrap();
+    assert_eq!((settings.hands, settings.scene.as_deref(), settings.glove.as_str(), settings.joint_model.as_str()), (1, None, "5dt-5", "paper"));
+    assert_eq!((settings.config.grace_s, settings.config.max_latency_s), (5.0, 5.0), "the configuration given");
+    assert_eq!(settings.sensors().unwrap().len(), 5, "the 5DT 5-sensor glove's");
+    assert!(settings.gesture_set().unwrap().gestures().len() >= 12);
+    let (status, glb) = get_bytes(&server.address, "/engine/hands/right.glb");
+    assert_eq!(status, 200);
+    let hand = dqhand::io::load_gltf_slice(&glb, std::path::Path::new("right.glb")).unwrap();
+    let builtin = dqhand::hand::build(&Default::default()).unwrap();
+    assert_eq!((hand.mesh.positions().len(), hand.skeleton.joints().len()), (builtin.mesh.positions().len(), builtin.skeleton.joints().len()), "the server's hand");
+    assert_eq!(get(&server.address, "/engine/hands/left.glb").0, 404, "one hand here");
+
+    let (mut page, _) = tungstenite::connect(format!("ws://{}/relay", server.address)).unwrap();
+    if let MaybeTlsStream::Plain(s) = page.get_mut() {
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    }
+    assert_eq!(relay_text(&mut page), serde_json::json!({"type": "recording", "on": false, "path": null, "records": 0, "failed": false}));
+    let gestures = relay_text(&mut page);
+    assert_eq!(gestures["type"], "gestures");
+    assert_eq!(gestures["gestures"], settings.gestures, "the gestures of engine.json");
+    assert_eq!(relay_text(&mut page)["state"], "idle");
+    page.send(Message::text(r#"{"type":"heatmap","on":true}"#)).unwrap();
+    let refused = relay_text(&mut page);
+    assert!(refused["message"].as_str().unwrap().starts_with("relay: only record and learn"), "{refused}");
+    page.send(Message::text("{")).unwrap();
+    assert!(relay_text(&mut page)["message"].as_str().unwrap().starts_with("not a valid command"));
+
+    let (lines, _) = recording("relay-rec");
+    let (mut input, _) = tungstenite::connect(format!("ws://{}/input", server.address)).unwrap();
+    page.send(Message::text(r#"{"type":"record","on":true}"#)).unwrap();
+    let started = relay_text(&mut page);
+    assert_eq!((&started["type"], &started["on"]), (&"recording".into(), &true.into()), "{started}");
+    for (i, line) in lines[..100].iter().enumerate() {
+        input.send(Message::text(line.as_str())).unwrap();
+        if i == 50 {
+            input.send(Message::text(r#"{"t": 0.0, "landmarks": []}"#)).unwrap();
+            assert!(matches!(input.read().unwrap(), Message::Text(t) if t.contains("error")));
+        }
+    }
+    let mut relayed = Vec::new();
+    while relayed.len() < 100 {
+        match page.read().unwrap() {
+            Message::Binary(b) => relayed.push(serde_json::from_slice::<Value>(&b).unwrap()),
+            Message::Text(t) => panic!("only records now: {t}"),
+            _ => {}
+        }
+    }
+    for (sent, got) in lines[..100].iter().zip(&relayed) {
+        let sent: Value = serde_json::from_str(sent).unwrap();
+        assert_eq!((&got["t"], &got["hand"]), (&sent["t"], &sent["hand"]));
+        let joints = sent["joints"].as_object().unwrap();
+        assert_eq!(got["joints"].as_object().unwrap().len(), joints.len(), "every joint");
+        for (name, joint) in joints {
+            for key in ["p", "q"] {
+                let numbers = |v: &Value| v.as_array().map(|a| a.iter().map(|x| x.as_f64().unwrap()).collect::<Vec<_>>()).unwrap_or_default();
+                let (a, b) = (numbers(&joint[key]), numbers(&got["joints"][name][key]));
+                assert!(a.len() == b.len() && a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-6), "{name} {key}: sent {a:?}, relayed {b:?}");
+            }
+        }
+    }
+    page.send(Message::text(r#"{"type":"record","on":false}"#)).unwrap();
+    let stopped = relay_text(&mut page);
+    assert_eq!((&stopped["on"], &stopped["records"]), (&false.into(), &100.into()), "{stopped}");
+    let path = PathBuf::from(stopped["path"].as_str().unwrap());
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 100);
+
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, r#"{"objects": [{"name": "ball", "shape": "sphere", "radius": 0.04, "position": [0, 0.05, 0], "mass": 0.15}]}"#).unwrap();
+    let server = start("relay-scene-file", &["--scene", scene.to_str().unwrap()]);
+    let engine: Value = serde_json::from_str(&get(&server.address, "/engine.json").1).unwrap();
+    assert!(engine["relay"].is_null() && engine["why"].as_str().unwrap().contains("scene file"), "{engine}");
+}

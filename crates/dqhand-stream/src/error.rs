@@ -10,6 +10,9 @@ pub enum Error {
     /// A message of the viewer stream's binary format is malformed.
     #[error("stream message: {0}")]
     Frame(String),
+    /// A page's engine settings (`engine.json`) are not settings.
+    #[error("engine settings: {0}")]
+    Settings(String),
     /// A gesture action names no action of the viewer.
     #[error("actions: {0:?} is not a viewer action (next_method, split_view, toggle_heatmap)")]
     UnknownAction(String),

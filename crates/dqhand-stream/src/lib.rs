@@ -8,6 +8,7 @@
 
 mod action;
 mod command;
+mod engine_settings;
 mod error;
 pub mod frame;
 mod frame_rate;
@@ -16,6 +17,7 @@ mod session;
 
 pub use action::{Action, ViewerAction};
 pub use command::{Command, LearnRequest, MAX_COMMAND_BYTES};
+pub use engine_settings::EngineSettings;
 pub use error::{Error, Result};
 pub use frame::{FrameHeader, FrameView, FrameWriter, Topology};
 pub use frame_rate::FrameRate;

@@ -311,15 +311,16 @@ impl Skinner {
     }
 }
 
-/// Reads one line of a recording into `record` (`side`: the hand of records that do not say):
+/// Reads one line of a recording into `record` (`side`: the hand of records that do not say;
+/// `sensors`: the glove's, naming a glove record's values):
 /// `false` for a blank line; a line that cannot be read goes to `reject` (the loop counts it,
 /// as the native one does) and is an error of one line.
-fn read(line: &str, side: Side, record: &mut Record, reject: impl FnOnce(dqhand::input::Rejection)) -> Result<bool, JsError> {
+fn read<S: AsRef<str>>(line: &str, side: Side, sensors: &[S], record: &mut Record, reject: impl FnOnce(dqhand::input::Rejection)) -> Result<bool, JsError> {
     let line = line.trim();
     if line.is_empty() {
         return Ok(false);
     }
-    parse_record::<&str>(line, side, &[], record).map_err(|rejection| {
+    parse_record(line, side, sensors, record).map_err(|rejection| {
         let message = JsError::new(&rejection.to_string());
         reject(rejection);
         message
@@ -513,7 +514,7 @@ impl Interaction {
     #[wasm_bindgen(js_name = pushLine)]
     pub fn push_line(&mut self, line: &str) -> Result<(), JsError> {
         let side = self.manip.hands()[0].side();
-        if read(line, side, &mut self.record, |r| self.manip.reject(r))? {
+        if read::<&str>(line, side, &[], &mut self.record, |r| self.manip.reject(r))? {
             self.take(Ok(()))?;
         }
         Ok(())

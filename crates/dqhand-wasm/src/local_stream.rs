@@ -12,9 +12,9 @@ use dqhand::grasp::GraspParams;
 use dqhand::hand::{build, HandParams};
 use dqhand::input::{InputConfig, Record};
 use dqhand::interaction::{GestureLoop, ManipulationLoop};
-use dqhand::kinematics::{JointModel, Side};
+use dqhand::kinematics::Side;
 use dqhand::scene::Scene;
-use dqhand_stream::{Applied, Command, FrameRate, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
+use dqhand_stream::{Applied, Command, EngineSettings, FrameRate, InputView, LiveInput, Session, MAX_COMMAND_BYTES};
 use wasm_bindgen::prelude::*;
 
 use crate::{js, load_model, read};
@@ -23,6 +23,8 @@ use crate::{js, load_model, read};
 const MAX_STEP_S: f32 = 0.1;
 /// What the hello names as the live input.
 const SOURCE: &str = "this page (camera or WebXR)";
+/// ... and as the input `dqhand demo` relays.
+const RELAYED: &str = "dqhand demo's live input, relayed";
 
 /// One viewer's engine and the live input it follows, in the page.
 #[wasm_bindgen]
@@ -35,6 +37,8 @@ pub struct LocalStream {
     /// Text messages for the page since it last took them.
     texts: Vec<String>,
     record: Record,
+    /// The glove's sensor names: how a glove record names its values.
+    sensors: Vec<String>,
     rate: FrameRate,
     /// The engine's clock: the steps' times added up (s).
     clock: f64,
@@ -58,31 +62,64 @@ impl LocalStream {
             None | Some("") => InputConfig::default(),
             Some(text) => InputConfig::from_json(text).map_err(js)?,
         };
+        let scene = (!scene.is_empty()).then(|| scene.to_owned());
+        Self::build(&EngineSettings { hands: 1 + u8::from(two_hands), scene, config, ..EngineSettings::default() }, right, left, SOURCE)
+    }
+
+    /// The engine `dqhand demo` runs, from the settings it gives in `engine.json` (JSON text,
+    /// [`EngineSettings`]): its hands (`right`, `left` as the server serves them), scene, joint
+    /// model, configuration, gestures and glove, so that the records it relays drive this
+    /// engine as they would its own.
+    ///
+    /// # Errors
+    /// Settings that are not settings, or any of [`Self::new`]'s.
+    #[wasm_bindgen(js_name = fromSettings)]
+    pub fn from_settings(settings: &str, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<LocalStream, JsError> {
+        let settings = EngineSettings::from_json(settings).map_err(|e| JsError::new(&e.to_string()))?;
+        Self::build(&settings, right, left, RELAYED)
+    }
+
+    fn build(settings: &EngineSettings, right: Option<Vec<u8>>, left: Option<Vec<u8>>, source: &str) -> Result<LocalStream, JsError> {
+        let stream = |e: dqhand_stream::Error| JsError::new(&e.to_string());
         let hand = |side: Side, bytes: Option<Vec<u8>>| match bytes {
             Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name()), side),
             None => build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js),
         };
         let model = hand(Side::Right, right)?;
-        let left = if two_hands { Some(hand(Side::Left, left)?) } else { None };
-        let (joint_model, gestures) = (JointModel::Full, Some(GestureSet::builtin()));
-        let input = match (scene, &left) {
-            ("", None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, None, config, gestures).map_err(js)?, SOURCE, false),
-            ("", Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),
-            (name, left) => {
+        let left = if settings.hands == 2 { Some(hand(Side::Left, left)?) } else { None };
+        let joint_model = settings.joint_model().map_err(stream)?;
+        let (mapper, gestures) = (Some(settings.mapper().map_err(stream)?), Some(settings.gesture_set().map_err(stream)?));
+        let config = settings.config.clone();
+        let input = match (settings.scene.as_deref(), &left) {
+            (None, None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, false),
+            (None, Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),
+            (Some(name), left) => {
                 let scene = Scene::named(name).map_err(js)?;
                 let manip = match left {
-                    Some(left) => ManipulationLoop::two_handed([(Arc::clone(left), None), (Arc::clone(&model), None)], joint_model, config, gestures, &scene, GraspParams::default()),
-                    None => ManipulationLoop::new(Arc::clone(&model), joint_model, None, config, gestures, &scene, GraspParams::default()),
+                    Some(left) => ManipulationLoop::two_handed([(Arc::clone(left), mapper.clone()), (Arc::clone(&model), mapper)], joint_model, config, gestures, &scene, GraspParams::default()),
+                    None => ManipulationLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures, &scene, GraspParams::default()),
                 }
                 .map_err(js)?;
-                LiveInput::with_scene(manip, SOURCE, false)
+                LiveInput::with_scene(manip, source, false)
             }
         }
-        .map_err(|e| JsError::new(&e.to_string()))?;
-        let session = Session::new(model, left.map(|l| (l, Side::Left)), joint_model).map_err(|e| JsError::new(&e.to_string()))?;
+        .map_err(stream)?;
+        let session = Session::new(model, left.map(|l| (l, Side::Left)), joint_model).map_err(stream)?;
         let view = input.view();
         let record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
-        Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], texts: Vec::new(), record, rate: FrameRate::default(), clock: 0.0 })
+        let sensors = settings.sensors().map_err(stream)?;
+        Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], texts: Vec::new(), record, sensors, rate: FrameRate::default(), clock: 0.0 })
+    }
+
+    /// Recognises `gestures` (a gesture file's text) from now on: the set `dqhand demo` learned
+    /// a gesture into, sent by its relay.
+    ///
+    /// # Errors
+    /// Text that is not a gesture file, or one the input's commands do not fit.
+    #[wasm_bindgen(js_name = setGestures)]
+    pub fn set_gestures(&mut self, gestures: &str) -> Result<(), JsError> {
+        let set = GestureSet::from_json(gestures, "the relayed gestures").map_err(js)?;
+        self.input.set_gestures(set).map_err(|e| JsError::new(&e.to_string()))
     }
 
     /// The hello message (JSON text), as the server's first message.
@@ -129,7 +166,7 @@ impl LocalStream {
     /// A record that cannot be read or is refused; the input counts it and goes on.
     pub fn push(&mut self, line: &str) -> Result<(), JsError> {
         let input = &self.input;
-        if read(line, Side::Right, &mut self.record, |r| input.reject(r))? {
+        if read(line, Side::Right, &self.sensors, &mut self.record, |r| input.reject(r))? {
             input.push(&self.record, |_| {}).map_err(|r| JsError::new(&r.to_string()))?;
         }
         Ok(())

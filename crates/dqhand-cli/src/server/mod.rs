@@ -1,10 +1,12 @@
-//! The viewer's local server: static files of the built page and the engine stream, both on
-//! one port. One thread per connection: a slow or vanished browser only ever holds up its own
+//! The viewer's local server: static files of the built page, the engine stream, and the
+//! live input's relay to pages that run the engine themselves, all on one port. One thread per connection: a slow or vanished browser only ever holds up its own
 //! thread, never the engine of another viewer.
 
 mod assets;
 mod input_socket;
 mod messages;
+mod page_engine;
+mod relay_socket;
 mod request;
 mod socket;
 
@@ -19,6 +21,7 @@ use dqhand::hand::Side;
 use dqhand::model::Model;
 
 use crate::feed::Feed;
+pub use page_engine::PageEngine;
 
 /// Requests served at once (files, streams, input senders) once their heads are in; more are
 /// answered 503.
@@ -46,6 +49,8 @@ pub struct Shared {
     /// The live input every viewer follows once it has records (the `/input` WebSocket
     /// feeds it, beside the demo's recording or UDP port); `None`: no input, no `/input`.
     pub feed: Option<Arc<Feed>>,
+    /// The engine a page runs itself, following the live input over `/relay`.
+    pub page: PageEngine,
 }
 
 /// One place of a bounded count, taken while it lives.
@@ -104,10 +109,6 @@ fn log_error(peer: Option<SocketAddr>, e: &std::io::Error) {
     }
 }
 
-/// Where the page learns that `dqhand demo` runs its engine (and streams it on
-/// [`socket::PATH`]); a static host has no such file, and the page then runs the engine itself.
-pub const ENGINE_PATH: &str = "/engine.json";
-
 /// One connection: a request for a file, or the upgrade to the engine stream. `head` is this
 /// connection's place among the heads still arriving, kept until its request is accepted (a
 /// refusal lingers in it); a served place is taken only then.
@@ -120,7 +121,7 @@ fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place
         Ok(r) => r,
         Err(refusal) => return request::answer_refusal(&stream, &refusal),
     };
-    let feed = shared.feed.as_deref().filter(|_| request.path == input_socket::PATH);
+    let feed = shared.feed.as_ref().filter(|_| [input_socket::PATH, relay_socket::PATH].contains(&request.path.as_str()));
     let accept = if request.path == socket::PATH || feed.is_some() {
         match request.websocket_accept() {
             Ok(accept) => Some(accept),
@@ -134,13 +135,11 @@ fn connection(stream: TcpStream, shared: &Shared, bound: SocketAddr, head: Place
         return request::answer_refusal(&stream, &request::refuse(503, "too many connections"));
     };
     match (accept, feed) {
+        (Some(accept), Some(feed)) if request.path == relay_socket::PATH => relay_socket::run(stream, request, &accept, feed),
         (Some(accept), Some(feed)) => input_socket::run(stream, request, &accept, feed),
         (Some(accept), None) => socket::run(stream, request, &accept, shared),
-        // The page asks whether its engine runs here (else it runs its own: a static host).
-        (None, _) if request.path == ENGINE_PATH => match request.method.as_str() {
-            "GET" | "HEAD" => request::respond(&stream, 200, "application/json", br#"{"engine": "dqhand demo", "stream": "/stream"}"#, request.method == "HEAD"),
-            _ => request::respond(&stream, 405, "text/plain", b"only GET and HEAD\n", false),
-        },
+        // The page asks what runs here (a static host has no such file: it runs its own engine).
+        (None, _) if PageEngine::serves(&request.path) => shared.page.answer(&stream, &request, shared),
         (None, _) => match &shared.assets {
             Some(root) => assets::serve(&stream, &request, root),
             None => request::respond(&stream, 404, "text/plain", b"not found\n", false),

@@ -14,6 +14,7 @@ use tungstenite::{Message, WebSocket};
 use super::messages::{server_socket, Incoming, MAX_COMMAND_BYTES};
 use super::request::{linger, Request};
 use super::Shared;
+use crate::feed::Feed;
 use crate::live_learning;
 
 /// The path of the stream.
@@ -25,9 +26,9 @@ const WINDOW: u32 = 3;
 pub(super) const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
 /// A viewer that sends nothing this long while frames wait for its acknowledgement is pinged
 /// (a live page answers with a pong, or acknowledges)...
-const PING_AFTER: Duration = Duration::from_secs(5);
+pub(super) const PING_AFTER: Duration = Duration::from_secs(5);
 /// ...and one silent this long is closed: it would hold one of the server's places for ever.
-const SILENT_LIMIT: Duration = Duration::from_secs(15);
+pub(super) const SILENT_LIMIT: Duration = Duration::from_secs(15);
 
 /// Completes the WebSocket handshake (the server's answer to a checked upgrade request).
 pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> std::io::Result<WebSocket<TcpStream>> {
@@ -91,7 +92,7 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
                     Ok(Applied::Frame) => {}
                     Ok(Applied::Hello) => ws.send(Message::text(session.hello(MAX_COMMAND_BYTES, input))).map_err(io)?,
                     Ok(Applied::Record(on)) => {
-                        if let Err(e) = record(shared, on) {
+                        if let Err(e) = record(shared.feed.as_deref(), on) {
                             send_error(&mut ws, &format!("{e:#}")).map_err(io)?;
                         }
                     }
@@ -155,8 +156,8 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, shared: &Shared) -
 
 /// Starts (`on`) or stops the viewers' recording of the live input; every viewer then sends
 /// the new state ([`crate::live::LiveRecords::recording_message`]).
-fn record(shared: &Shared, on: bool) -> anyhow::Result<()> {
-    let Some(feed) = shared.feed.as_deref() else { anyhow::bail!("record: this server has no live input") };
+pub(super) fn record(feed: Option<&Feed>, on: bool) -> anyhow::Result<()> {
+    let Some(feed) = feed else { anyhow::bail!("record: this server has no live input") };
     if on {
         feed.records.start()
     } else {
@@ -186,7 +187,7 @@ pub(super) fn read_failure(ws: &mut WebSocket<TcpStream>, e: tungstenite::Error)
 
 /// Sends `message` as an error, closes (with `frame`, if any) and lingers: the end of a
 /// connection whose client broke the protocol.
-fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<CloseFrame>) -> std::io::Result<()> {
+pub(super) fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<CloseFrame>) -> std::io::Result<()> {
     let _ = send_error(ws, message);
     let _ = ws.close(frame);
     let _ = ws.flush();
@@ -200,7 +201,7 @@ pub(super) fn send_error(ws: &mut WebSocket<TcpStream>, message: &str) -> tungst
 
 /// A failed send as an I/O error; one that timed out says what happened (reads that time out
 /// never get here: [`read_failure`] reads on).
-fn io(e: tungstenite::Error) -> std::io::Error {
+pub(super) fn io(e: tungstenite::Error) -> std::io::Error {
     match e {
         tungstenite::Error::Io(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
             std::io::Error::new(ErrorKind::TimedOut, format!("the client stopped reading: nothing could be sent for {} s; closed", WRITE_TIMEOUT.as_secs()))

@@ -113,6 +113,12 @@ fn skin_material() -> Value {
 /// # Errors
 /// [`crate::Error::Io`] if the file cannot be written.
 pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
+    write_bytes(path, &skinned_glb(model))
+}
+
+/// The GLB [`write_skinned_glb`] writes, in memory (a server hands it to a page).
+#[must_use]
+pub fn skinned_glb(model: &Model) -> Vec<u8> {
     let mesh = &model.mesh;
     let skeleton = &model.skeleton;
     let mut glb = Glb::default();
@@ -184,7 +190,7 @@ pub fn write_skinned_glb(model: &Model, path: &Path) -> Result<()> {
         "materials": skin_material(),
         "skins": [{ "name": "hand", "inverseBindMatrices": ibm, "joints": (0..joints.len()).collect::<Vec<_>>(), "skeleton": roots[0] }],
     });
-    write_bytes(path, &glb.finish(doc))
+    glb.finish(doc)
 }
 
 #[cfg(feature = "interaction")]
