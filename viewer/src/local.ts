@@ -8,19 +8,31 @@ import { LocalStream, wasmMemory } from '../../packages/dqhand/wasm/dqhand_wasm.
 import { fetchModel, loadEngine } from '../../packages/dqhand/src/engine';
 import { decodeFrame, decodeTopology, encodeCommand, type Command } from './protocol';
 import { dispatchText, type ConnectionEvents } from './connection';
+import { Relay } from './relay';
 import type { RecordSink } from './sender';
+
+/** `dqhand demo`'s engine, as its `engine.json` gives it: the page runs it and follows the relay. */
+export interface RelaySetup {
+  /** The relay's WebSocket URL. */
+  url: string;
+  /** The engine's settings (JSON text: crates/dqhand-stream/src/engine_settings.rs). */
+  settings: string;
+  /** The hands' files, right first. */
+  hands: string[];
+}
 
 /** The engine's step rate (Hz): a timer's, which runs during an XR session too (the window's animation frames stop then). */
 const RATE_HZ = 60;
 
 /**
- * The built-in hand of `side` as `make viewer` writes it beside the page (`hands/<side>.glb`,
- * from `dqhand hand --out`): loading it takes milliseconds where generating it takes seconds in
- * WebAssembly. Without the file (a build that left it out, or a host that answers with something
- * else), undefined: the engine generates the same hand itself.
+ * A hand as a skinned glTF file: the built-in one as `make viewer` writes it beside the page
+ * (`hands/<side>.glb`, from `dqhand hand --out`), or `dqhand demo`'s. Loading it takes
+ * milliseconds where generating it takes seconds in WebAssembly. Without the file (a build that
+ * left it out, or a host that answers with something else), undefined: the engine generates the
+ * built-in hand itself.
  */
-async function handFile(side: 'right' | 'left'): Promise<Uint8Array | undefined> {
-  const bytes = await fetchModel(`./hands/${side}.glb`).catch(() => undefined);
+async function handFile(url: string): Promise<Uint8Array | undefined> {
+  const bytes = await fetchModel(url).catch(() => undefined);
   // A host that answers every path with the page (a single-page app's rewrite) gives no GLB.
   return bytes && bytes.length >= 12 && new TextDecoder().decode(bytes.subarray(0, 4)) === 'glTF' ? bytes : undefined;
 }
@@ -38,21 +50,26 @@ export class LocalConnection {
   /** The records of a recording going on (JSON lines), or null. */
   private recorded: string[] | null = null;
   private saved: { path: string | null; records: number } = { path: null, records: 0 };
-  /** The page's live input (camera, WebXR) into this engine. */
-  readonly input: RecordSink = { send: (record) => this.push(record), close: () => {} };
+  /** The page's live input (camera, WebXR) into this engine (relayed: the server's `/input` instead). */
+  readonly input: RecordSink = { send: (record) => this.push(JSON.stringify(record)), close: () => {} };
+  /** `dqhand demo`'s relay this engine follows, or null (a static host). */
+  relay: Relay | null = null;
 
   /**
    * `scene`: a built-in scene's name or `''`; `twoHands`: a left hand too (a scene's); `config`:
-   * an input configuration's JSON text (docs/formats.md), or null for the defaults.
+   * an input configuration's JSON text (docs/formats.md), or null for the defaults. With
+   * `relayed`, those are the server's instead, and its live input drives the engine.
    */
-  constructor(private readonly events: ConnectionEvents, scene: string, twoHands: boolean, config: string | null) {
+  constructor(private readonly events: ConnectionEvents, scene: string, twoHands: boolean, config: string | null, readonly relayed: RelaySetup | null = null) {
     void this.start(scene, twoHands, config);
   }
 
   private async start(scene: string, twoHands: boolean, config: string | null): Promise<void> {
+    const relayed = this.relayed;
     try {
-      const [, right, left] = await Promise.all([loadEngine(), handFile('right'), twoHands ? handFile('left') : undefined]);
-      this.stream = new LocalStream(scene, twoHands, right, left, config ?? undefined);
+      const urls = relayed?.hands ?? ['./hands/right.glb', ...(twoHands ? ['./hands/left.glb'] : [])];
+      const [, right, left] = await Promise.all([loadEngine(), handFile(urls[0]), urls[1] ? handFile(urls[1]) : undefined]);
+      this.stream = relayed ? LocalStream.fromSettings(relayed.settings, right, left) : new LocalStream(scene, twoHands, right, left, config ?? undefined);
     } catch (e) {
       this.events.error(`the page's engine: ${(e as Error).message}`);
       return;
@@ -62,6 +79,7 @@ export class LocalConnection {
     this.events.status(true);
     this.text(this.stream.hello());
     for (let k = 0; k < this.stream.handCount; k++) this.events.topology(decodeTopology(this.stream.topology(k).slice().buffer as ArrayBuffer));
+    if (relayed) this.follow(relayed.url);
     this.last = performance.now();
     const timer = setInterval(() => {
       try {
@@ -104,9 +122,37 @@ export class LocalConnection {
     }
   }
 
-  /** Applies a command now (dropped before the engine has loaded). */
+  /** Follows the server's relay: its records into the engine, its state messages to the page. */
+  private follow(url: string): void {
+    let opened = false;
+    this.relay = new Relay(url, {
+      record: (line) => this.push(line),
+      gestures: (text) => {
+        try {
+          this.stream!.setGestures(text);
+        } catch (e) {
+          this.events.error(`the relayed gestures: ${(e as Error).message}`);
+        }
+      },
+      text: (text) => this.text(text),
+      status: (open) => {
+        this.connected = open;
+        // The engine's status was said when it loaded; a relay lost and found again is said too,
+        // and the found one retold the engine's hello (the panel starts over on a status).
+        if (opened || !open) this.events.status(open);
+        if (opened && open) this.text(this.stream!.hello());
+        opened ||= open;
+      },
+    });
+  }
+
+  /** Applies a command now (dropped before the engine has loaded); relayed, `record` and `learn` go to the server. */
   send(command: Command): void {
     if (!this.stream) return;
+    if (this.relay && (command.type === 'record' || command.type === 'learn')) {
+      this.relay.send(command);
+      return;
+    }
     try {
       const todo = this.stream.command(encodeCommand(command));
       if (todo === 'record') this.record(true);
@@ -123,10 +169,9 @@ export class LocalConnection {
 
   remember(): void {}
 
-  /** One record of the page's live input into the engine (and the recording going on). */
-  private push(record: object): boolean {
+  /** One record (a JSON line) of the live input into the engine (and the recording going on). */
+  private push(line: string): boolean {
     if (!this.stream) return false;
-    const line = JSON.stringify(record);
     try {
       this.stream.push(line);
       this.sent++;

@@ -7,7 +7,7 @@ import { Connection, type ConnectionEvents } from './connection';
 import { heldText, InputPanel } from './input';
 import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
-import { LocalConnection } from './local';
+import { LocalConnection, type RelaySetup } from './local';
 import { InputSender } from './sender';
 import { Webcam } from './webcam';
 import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
@@ -35,20 +35,25 @@ const status = (text: string, kind: '' | 'ok' | 'error') => {
 };
 
 /**
- * Whether the engine runs in this page: asked (`?engine=page` or `?engine=server`), else
- * wherever `dqhand demo` does not serve the page (it answers `engine.json`; a static host has
- * no such file).
+ * Where the engine runs: asked (`?engine=page`: the page's own, on its own input;
+ * `?engine=server`: `dqhand demo`'s, streamed), else as `engine.json` says: `dqhand demo`
+ * answers it with its engine's settings, which the page runs following the live input the
+ * server relays (or, where the page cannot rebuild that engine, `relay` is null and the page
+ * shows the server's stream); a static host has no such file, and the page runs its own.
  */
-async function engineInPage(): Promise<boolean> {
+async function engineSetup(): Promise<'page' | 'server' | RelaySetup> {
   const asked = params.get('engine');
-  if (asked === 'page' || asked === 'server') return asked === 'page';
+  if (asked === 'page' || asked === 'server') return asked;
   try {
     const answer = await fetch('./engine.json', { cache: 'no-store', signal: AbortSignal.timeout(3000) });
-    if (!answer.ok) return true;
-    return (await answer.json()).engine !== 'dqhand demo';
+    if (!answer.ok) return 'page';
+    const engine = await answer.json();
+    if (engine.engine !== 'dqhand demo') return 'page';
+    if (typeof engine.relay !== 'string' || !engine.settings) return 'server';
+    return { url: `${wsOrigin}${engine.relay}`, settings: JSON.stringify(engine.settings), hands: engine.hands };
   } catch {
     // No answer in 3 s, or one that is not JSON (a host that answers every path with a page).
-    return true;
+    return 'page';
   }
 }
 
@@ -118,7 +123,7 @@ const events: ConnectionEvents = {
     $<HTMLButtonElement>('record').disabled = !connected;
     showRecording(false); // a recording going on is announced by the new session
     sceneSet = false;
-    status(connected ? (local ? 'engine in this page' : 'connected') : 'disconnected — reconnecting…', connected ? 'ok' : '');
+    status(connected ? (local ? (local.relayed ? 'engine in this page, following dqhand demo' : 'engine in this page') : 'connected') : 'disconnected — reconnecting…', connected ? 'ok' : '');
   },
 };
 
@@ -126,10 +131,11 @@ const events: ConnectionEvents = {
  * In the page: `?scene=NAME` puts the hand in a built-in scene, `&hands=2` both hands in it;
  * `&config=JSON` is the input configuration (as `dqhand demo --config` reads from a file).
  */
-const local = (await engineInPage()) ? new LocalConnection(events, params.get('scene') ?? '', params.get('hands') === '2', params.get('config')) : null;
+const setup = await engineSetup();
+const local = setup === 'server' ? null : new LocalConnection(events, params.get('scene') ?? '', params.get('hands') === '2', params.get('config'), setup === 'page' ? null : setup);
 const connection = local ?? new Connection(`${wsOrigin}/stream`, events);
-/** The page's own live input to the engine: the camera's hand or an XR session's. */
-const sender = local?.input ?? new InputSender(`${wsOrigin}/input`);
+/** The page's own live input to the engine: the camera's hand or an XR session's (with a server, to its input, which relays it back). */
+const sender = local && !local.relayed ? local.input : new InputSender(`${wsOrigin}/input`);
 const xr = new XRInput(scene.renderer, sender, $, {
   changed: () => {
     if (xr.active && webcam.state.on) webcam.stop('stopped for the VR or AR session');
@@ -384,6 +390,8 @@ window.dqhand = {
   state: () => ({
     /** Where the engine runs: `'page'` (WebAssembly, here) or `'server'` (dqhand demo). */
     engine: local ? 'page' : 'server',
+    /** The page's engine following `dqhand demo`'s relay: whether it is open, records received; null otherwise. */
+    relay: local?.relay ? { open: local.relay.open, received: local.relay.received } : null,
     firstFrameMs,
     connected: connection.connected,
     framesReceived: connection.framesReceived,

@@ -191,7 +191,6 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         config.actions.retain(|a| gestures.gestures().iter().any(|g| g.name() == a.gesture));
     }
     let mapper = Some(args.common.mapper(args.joint_model)?);
-    let settings = page_settings(args, &config, &gestures)?;
     let scene = args.scene_name().map(|name| Scene::named(name).map(|s| (name, s))).transpose()?;
     let played = match (&args.input, &scene, args.udp) {
         (Some(path), _, _) => Some(Played::File(path.clone())),
@@ -218,6 +217,7 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         (None, None) => "WebSocket /input".to_owned(),
     };
     let announce = played.is_some() || udp.is_some();
+    let settings = page_settings(args, &config, &gestures)?.map(|s| EngineSettings { source: source.clone(), announce, ..s });
     let input = match scene {
         None => LiveInput::new(GestureLoop::new(Arc::clone(model), args.joint_model, mapper, config, Some(gestures))?, source.clone(), announce)?,
         Some((name, scene)) => {
@@ -292,7 +292,7 @@ fn page_settings(args: &Args, config: &InputConfig, gestures: &GestureSet) -> an
         None => Calibration::default_for(&table),
     };
     let (hands, joint_model) = (1 + u8::from(args.two_hands()), args.joint_model.as_str().to_owned());
-    Ok(Ok(EngineSettings { hands, scene, joint_model, config: config.clone(), gestures: gestures.to_json(), glove, calibration }))
+    Ok(Ok(EngineSettings { hands, scene, joint_model, config: config.clone(), gestures: gestures.to_json(), glove, calibration, ..EngineSettings::default() }))
 }
 
 /// The built page: `--viewer`, else the first of these with an `index.html`: `viewer/dist`

@@ -920,6 +920,7 @@ fn the_relay_gives_a_page_the_engine_and_every_record_taken() {
     let settings = dqhand_stream::EngineSettings::from_json(&engine["settings"].to_string()).unwrap();
     assert_eq!((settings.hands, settings.scene.as_deref(), settings.glove.as_str(), settings.joint_model.as_str()), (1, None, "5dt-5", "paper"));
     assert_eq!((settings.config.grace_s, settings.config.max_latency_s), (5.0, 5.0), "the configuration given");
+    assert_eq!((settings.source.as_str(), settings.announce), ("WebSocket /input", false), "told of the input with its first record");
     assert_eq!(settings.sensors().unwrap().len(), 5, "the 5DT 5-sensor glove's");
     assert!(settings.gesture_set().unwrap().gestures().len() >= 12);
     let (status, glb) = get_bytes(&server.address, "/engine/hands/right.glb");

@@ -7,7 +7,8 @@
 //!
 //! ```json
 //! {"hands": 1, "scene": null, "joint_model": "full", "config": {"filter": true, ...},
-//!  "gestures": "{\"gestures\": [...]}", "glove": "5dt-14", "calibration": {...}}
+//!  "gestures": "{\"gestures\": [...]}", "glove": "5dt-14", "calibration": {...},
+//!  "source": "udp 127.0.0.1:9000", "announce": true}
 //! ```
 //!
 //! `gestures` is a gesture file's text ([`GestureSet::to_json`]), `glove` a built-in table's
@@ -39,6 +40,11 @@ pub struct EngineSettings {
     pub glove: String,
     /// The glove's calibration.
     pub calibration: Calibration,
+    /// The live input, as the server's hello names it (`udp 127.0.0.1:9000`, a recording's path).
+    pub source: String,
+    /// Whether viewers are told of the input from the start (a recording played, a UDP port)
+    /// rather than with its first record.
+    pub announce: bool,
 }
 
 impl Default for EngineSettings {
@@ -56,6 +62,8 @@ impl Default for EngineSettings {
             gestures: GestureSet::builtin().to_json(),
             glove: glove.to_owned(),
             calibration: Calibration::default_for(&table),
+            source: "this page (camera or WebXR)".to_owned(),
+            announce: false,
         }
     }
 }

@@ -21,10 +21,6 @@ use crate::{js, load_model, read};
 
 /// Longest step of the engine's clock, s: after a stall (a hidden tab) it resumes, not races.
 const MAX_STEP_S: f32 = 0.1;
-/// What the hello names as the live input.
-const SOURCE: &str = "this page (camera or WebXR)";
-/// ... and as the input `dqhand demo` relays.
-const RELAYED: &str = "dqhand demo's live input, relayed";
 
 /// One viewer's engine and the live input it follows, in the page.
 #[wasm_bindgen]
@@ -63,7 +59,7 @@ impl LocalStream {
             Some(text) => InputConfig::from_json(text).map_err(js)?,
         };
         let scene = (!scene.is_empty()).then(|| scene.to_owned());
-        Self::build(&EngineSettings { hands: 1 + u8::from(two_hands), scene, config, ..EngineSettings::default() }, right, left, SOURCE)
+        Self::build(&EngineSettings { hands: 1 + u8::from(two_hands), scene, config, ..EngineSettings::default() }, right, left)
     }
 
     /// The engine `dqhand demo` runs, from the settings it gives in `engine.json` (JSON text,
@@ -76,10 +72,12 @@ impl LocalStream {
     #[wasm_bindgen(js_name = fromSettings)]
     pub fn from_settings(settings: &str, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<LocalStream, JsError> {
         let settings = EngineSettings::from_json(settings).map_err(|e| JsError::new(&e.to_string()))?;
-        Self::build(&settings, right, left, RELAYED)
+        let source = format!("{}, relayed by dqhand demo", settings.source);
+        Self::build(&EngineSettings { source, ..settings }, right, left)
     }
 
-    fn build(settings: &EngineSettings, right: Option<Vec<u8>>, left: Option<Vec<u8>>, source: &str) -> Result<LocalStream, JsError> {
+    fn build(settings: &EngineSettings, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<LocalStream, JsError> {
+        let (source, announce) = (settings.source.as_str(), settings.announce);
         let stream = |e: dqhand_stream::Error| JsError::new(&e.to_string());
         let hand = |side: Side, bytes: Option<Vec<u8>>| match bytes {
             Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name()), side),
@@ -91,7 +89,7 @@ impl LocalStream {
         let (mapper, gestures) = (Some(settings.mapper().map_err(stream)?), Some(settings.gesture_set().map_err(stream)?));
         let config = settings.config.clone();
         let input = match (settings.scene.as_deref(), &left) {
-            (None, None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, false),
+            (None, None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, announce),
             (None, Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),
             (Some(name), left) => {
                 let scene = Scene::named(name).map_err(js)?;
@@ -100,7 +98,7 @@ impl LocalStream {
                     None => ManipulationLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures, &scene, GraspParams::default()),
                 }
                 .map_err(js)?;
-                LiveInput::with_scene(manip, source, false)
+                LiveInput::with_scene(manip, source, announce)
             }
         }
         .map_err(stream)?;
