@@ -1,6 +1,8 @@
-// The real page in headless Chromium against a real `dqhand demo`: it loads and draws, the
-// controls reach the engine and come back as the right change on screen, and it survives a
-// server restart; and, with a recorded live input, that the Input panel follows it.
+// The real page in headless Chromium against a real `dqhand demo` (the demo's engine run by the
+// page, following the demo's relay): it loads and draws, the controls reach the engine and come
+// back as the right change on screen, and it survives a server restart; with a recorded live
+// input, the Input panel follows it, and a gesture learned on the demo is recognised by the
+// page's engine; the Input panel's messages are checked on the demo's own stream.
 
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -265,7 +267,8 @@ describe('the Input panel, on input messages put into the real stream', () => {
       ws.onMessage((m) => engine.send(m));
       toPage = (m) => ws.send(m);
     });
-    await p.goto(server.url);
+    // The server's stream, whose messages this test stands between.
+    await p.goto(`${server.url}?engine=server`);
     await waitState(p, 's.connected && s.framesReceived > 3 && s.input !== null');
   });
 

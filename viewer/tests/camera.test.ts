@@ -119,8 +119,9 @@ function watchFrames([marker, size]: [typeof MARKER, [number, number]]): void {
 
 /**
  * A browser whose camera plays `video` (in `dir`, of `size`), and a page of it, connected: on
- * `dqhand demo`, or on a plain static server (no dqhand process: the engine in the page, given
- * the tests' input configuration in its URL; Record downloads the file).
+ * `dqhand demo` (the demo's engine in the page, the camera's records relayed back by the demo,
+ * which records them), or on a plain static server (no dqhand process: the page's own engine,
+ * given the tests' input configuration in its URL; Record downloads the file).
  */
 async function cameraPage(video: string, size: [number, number], host: 'server' | 'static' = 'server'): Promise<{ browser: Browser; page: Page }> {
   const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
@@ -128,7 +129,8 @@ async function cameraPage(video: string, size: [number, number], host: 'server' 
   await p.addInitScript(watchFrames, [MARKER, size] as [typeof MARKER, [number, number]]);
   await p.goto(host === 'server' ? server.url : `${staticServer.url}?config=${encodeURIComponent(JSON.stringify(CONFIG))}`);
   await waitState(p, 's.connected && s.frame !== null');
-  expect((await read<{ engine: string }>(p)).engine).toBe(host === 'server' ? 'server' : 'page');
+  const s = await read<{ engine: string; relay: object | null }>(p);
+  expect([s.engine, s.relay !== null]).toEqual(['page', host === 'server']);
   return { browser: b, page: p };
 }
 
@@ -324,7 +326,7 @@ describe('the Camera button on a video of our own hand', () => {
     expect(state.camera.status).toBe('running');
     // The video shows a right hand's palm: MediaPipe calls it "Left" (its labels assume a mirrored image).
     expect(state.camera.hands[0]).toBe(labels.side);
-    expect(state.input.source).toBe('WebSocket /input');
+    expect(state.input.source).toBe('WebSocket /input, relayed by dqhand demo');
     expect(await page.locator('#camera-preview').isVisible()).toBe(true);
 
     const loop = labels.frames / labels.fps;

@@ -11,6 +11,9 @@
 //!   closes them: how many were open and unanswered when the page was asked for, the page's
 //!   and a new viewer's time to be served meanwhile, what each dripping socket was answered
 //!   and how long after it opened the server closed it, a streaming viewer's frame rate;
+//! * **relay** — 1, 10 and 60 pages following the live input on `/relay` while a sender gives
+//!   `/input` 120 records a second: the share of the records each page received, and the time
+//!   from a record's send to its arrival at a page (median, 99th percentile), the server's CPU;
 //! * **slow reader** — a viewer that never reads: when the server closes it (its end of the
 //!   connection, watched in the system's socket table, stops being established; the server's
 //!   limits: 5 s for a blocked send, 15 s without a sign of life), and another viewer's frame
@@ -46,6 +49,10 @@ pub struct Args {
 
 /// Viewer counts streamed at once (64: every place the server has).
 const VIEWER_COUNTS: [usize; 3] = [1, 10, 64];
+/// Pages following the relay at once (60: with the sender, within the server's 64 places).
+const RELAY_COUNTS: [usize; 3] = [1, 10, 60];
+/// Records a second the relay stage sends to `/input` (a headset's hand-tracking rate).
+const RELAY_RATE_HZ: f64 = 120.0;
 /// Sockets dripping a request head during the slowloris stage.
 const DRIPPERS: usize = 200;
 /// How long the dripping sockets are given to be answered and closed by the server (its
@@ -76,6 +83,27 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         stop(viewers);
     }
     report.insert("viewers".into(), rows.into());
+
+    // Relay: pages following the live input, a sender on /input at a headset's rate. Each
+    // record's `t` is when it was sent (s since `clock`), so a page's receipt gives its latency.
+    let clock = Instant::now();
+    let mut rows = Vec::new();
+    for n in RELAY_COUNTS {
+        let pages: Vec<RelayPage> = (0..n).map(|_| RelayPage::start(a, clock)).collect::<anyhow::Result<_>>()?;
+        std::thread::sleep(Duration::from_millis(500));
+        let cpu = server.cpu_ns();
+        let t = Instant::now();
+        let sent = send_records(a, clock, period)?;
+        let cpu_share = (server.cpu_ns() - cpu) as f64 / t.elapsed().as_nanos() as f64;
+        std::thread::sleep(Duration::from_millis(500)); // the last records' way to the pages
+        let (received, latencies) = RelayPage::stop(pages);
+        let share = received.iter().map(|&r| r as f64 / sent.max(1) as f64).collect::<Vec<_>>();
+        rows.push(json!({
+            "pages": n, "sent": sent, "received_min": received.iter().min(), "share_min": quantile(&share, 0.0),
+            "latency_ms_median": quantile(&latencies, 0.5) * 1e3, "latency_ms_p99": quantile(&latencies, 0.99) * 1e3, "server_cpu": cpu_share,
+        }));
+    }
+    report.insert("relay".into(), rows.into());
 
     // Malformed flood: bad commands as fast as they go, a watcher streaming beside them; then
     // the errors still owed are waited for.
@@ -207,6 +235,18 @@ fn print_table(r: &Value, seconds: f64) {
         f(&s["closed_after_s"]["min"]),
         f(&s["closed_after_s"]["max"])
     );
+    println!("{:>8} {:>14} {:>16} {:>14} {:>14} {:>14}", "relay", "records sent", "fewest received", "median ms", "p99 ms", "server CPU %");
+    for row in r["relay"].as_array().into_iter().flatten() {
+        let cpu = row["server_cpu"].as_f64().map_or("—".to_owned(), |c| format!("{:.0}", 100.0 * c));
+        println!(
+            "{:>8} {:>14} {:>16} {:>14} {:>14} {cpu:>14}",
+            format!("{} pages", row["pages"]),
+            row["sent"].to_string(),
+            row["received_min"].to_string(),
+            format!("{:.2}", row["latency_ms_median"].as_f64().unwrap_or(f64::NAN)),
+            format!("{:.2}", row["latency_ms_p99"].as_f64().unwrap_or(f64::NAN))
+        );
+    }
     let w = &r["slow_reader"];
     println!(
         "slow reader (never reads): closed by the server: {}, after {} s; a viewer beside it {} fps (longest wait for a frame {})",
@@ -215,6 +255,66 @@ fn print_table(r: &Value, seconds: f64) {
         f(&w["watcher_fps"]),
         ms(&w["watcher_longest_gap_s"])
     );
+}
+
+/// A page following the relay: a thread reading the records, each one's latency kept.
+struct RelayPage {
+    running: Arc<AtomicBool>,
+    thread: JoinHandle<Vec<f64>>,
+}
+
+impl RelayPage {
+    /// Connects to `/relay`; a record's latency is its receipt's time since `clock` less its `t`.
+    fn start(a: SocketAddr, clock: Instant) -> anyhow::Result<Self> {
+        let (mut ws, _) = tungstenite::connect(format!("ws://{a}/relay")).context("a relay page's connection")?;
+        if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_mut() {
+            s.set_read_timeout(Some(Duration::from_millis(100)))?;
+        }
+        let running = Arc::new(AtomicBool::new(true));
+        let run = Arc::clone(&running);
+        let thread = std::thread::spawn(move || {
+            let mut latencies = Vec::new();
+            while run.load(Ordering::Relaxed) {
+                match ws.read() {
+                    Ok(Message::Binary(b)) => {
+                        let now = clock.elapsed().as_secs_f64();
+                        if let Some(t) = serde_json::from_slice::<Value>(&b).ok().and_then(|v| v["t"].as_f64()) {
+                            latencies.push(now - t);
+                        }
+                    }
+                    Ok(_) => {}
+                    Err(tungstenite::Error::Io(e)) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                    Err(_) => break,
+                }
+            }
+            latencies
+        });
+        Ok(Self { running, thread })
+    }
+
+    /// Stops the pages: the records each received, and every latency (s).
+    fn stop(pages: Vec<Self>) -> (Vec<usize>, Vec<f64>) {
+        pages.iter().for_each(|p| p.running.store(false, Ordering::Relaxed));
+        let each: Vec<Vec<f64>> = pages.into_iter().map(|p| p.thread.join().unwrap_or_default()).collect();
+        (each.iter().map(Vec::len).collect(), each.into_iter().flatten().collect())
+    }
+}
+
+/// Sends `/input` tracker records at [`RELAY_RATE_HZ`] for `period`, each stamped with its send
+/// time since `clock`; the number sent.
+fn send_records(a: SocketAddr, clock: Instant, period: Duration) -> anyhow::Result<u64> {
+    let (mut input, _) = tungstenite::connect(format!("ws://{a}/input")).context("the relay's sender")?;
+    let (start, step) = (Instant::now(), Duration::from_secs_f64(1.0 / RELAY_RATE_HZ));
+    let mut sent = 0u64;
+    while start.elapsed() < period {
+        let t = clock.elapsed().as_secs_f64();
+        let record = json!({ "t": t, "hand": "right", "tracker": { "p": [0.0, 1.2, -0.3], "q": [0.0, 0.0, 0.0, 1.0] } });
+        input.send(Message::text(record.to_string())).context("the relay's sender")?;
+        sent += 1;
+        std::thread::sleep((start + step * u32::try_from(sent).unwrap_or(u32::MAX)).saturating_duration_since(Instant::now()));
+    }
+    input.close(None).ok();
+    Ok(sent)
 }
 
 /// The server under test: this binary's `demo`, a page of one file, a port of its own.

@@ -32,9 +32,11 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, feed: &Arc<Feed>) 
     // Reads only look whether the page said something; the waiting is for records.
     ws.get_ref().set_read_timeout(Some(Duration::from_millis(1)))?;
     let mut seen = feed.relay.published();
-    // The versions of the recording and learning this page was last told of.
-    let (mut recording_seen, mut learning_seen) = (u64::MAX, u64::MAX);
+    // The versions of the recording and learning this page was last told of (as the stream's
+    // viewers, it is told of them once they have changed).
+    let (mut recording_seen, mut learning_seen) = (0, 0);
     let mut gestures_sent = String::new();
+    send_gestures(&mut ws, feed, &mut gestures_sent)?;
     let mut lines = Vec::new();
     let (mut heard, mut pinged) = (Instant::now(), false);
     loop {
