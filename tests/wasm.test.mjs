@@ -332,3 +332,35 @@ test('hands loaded from skinned glTF: the native command\'s file is the hand the
   assert.throws(() => new LocalStream('', false, new Uint8Array(12), undefined, undefined), oneLine('hands/right.glb: '));
   assert.throws(() => new LocalStream('two-hands', true, files.left, files.right, undefined), oneLine('hands/right.glb: the file holds a left hand'));
 });
+
+test('the viewer\'s engine from dqhand demo\'s settings: its glove, joint model, input and gestures; bad settings are one line', () => {
+  const oneLine = (start) => (e) => e instanceof Error && e.message.startsWith(start) && !e.message.includes('\n');
+  const defaults = JSON.parse(LocalStream.defaultSettings());
+  assert.deepEqual([defaults.hands, defaults.scene, defaults.glove, defaults.joint_model, defaults.calibration], [1, null, '5dt-14', 'full', null]);
+  // A glove table given as a file's text (here the 5-sensor 5DT's), as `demo --glove FILE` sends it.
+  const table = JSON.parse(readFileSync(path.join(root, 'crates', 'dqhand', 'data', 'gloves', '5dt-5.json'), 'utf8'));
+  const sensors = table.sensors.map((s) => s.name);
+  const settings = { ...defaults, glove: JSON.stringify(table), joint_model: 'paper', source: 'udp 127.0.0.1:9000', announce: true };
+  const page = LocalStream.fromSettings(JSON.stringify(settings), undefined, undefined);
+  const hello = JSON.parse(page.hello());
+  assert.equal(hello.joint_model, 'paper');
+  assert.equal(hello.input.source, 'udp 127.0.0.1:9000, relayed by dqhand demo', 'announced from the start, named as the demo names it');
+  // A fist on the glove, its values named by the table's sensors, is taken and bends the fingers.
+  const glove = (value) => Object.fromEntries(sensors.map((s) => [s, value]));
+  page.push(JSON.stringify({ t: 0, hand: 'right', glove: glove(0) }));
+  page.push(JSON.stringify({ t: 0.01, hand: 'right', glove: glove(4095) }));
+  for (let k = 0; k < 30; k++) page.step(1 / 60);
+  const inputs = page.takeTexts().map((t) => JSON.parse(t)).filter((m) => m.type === 'input');
+  assert.equal(inputs.at(-1).accepted, 2);
+  assert.ok(inputs.some((m) => m.gesture === 'fist'), `the glove's fist is named: ${JSON.stringify(inputs.map((m) => m.gesture))}`);
+  assert.throws(() => page.push(JSON.stringify({ t: 0.02, hand: 'right', glove: { thumb_far: 1 } })), oneLine('record'));
+  // The gestures the demo relays after it learns one.
+  page.setGestures(defaults.gestures);
+  assert.throws(() => page.setGestures('{'), oneLine('the relayed gestures'));
+  page.free();
+  assert.throws(() => LocalStream.fromSettings('{"hands": 1}', undefined, undefined), oneLine('engine settings: missing field'));
+  assert.throws(() => LocalStream.fromSettings(JSON.stringify({ ...defaults, hands: 3 }), undefined, undefined), oneLine('engine settings: hands: 3 is neither 1 nor 2'));
+  assert.throws(() => LocalStream.fromSettings(JSON.stringify({ ...defaults, joint_model: 'elbow' }), undefined, undefined), oneLine('engine settings: joint_model: '));
+  assert.throws(() => LocalStream.fromSettings(JSON.stringify({ ...defaults, glove: 'mitten-3' }), undefined, undefined), (e) => e instanceof Error && e.message.includes('mitten-3') && !e.message.includes('\n'));
+  assert.throws(() => LocalStream.fromSettings(JSON.stringify({ ...defaults, hands: 2 }), undefined, undefined), oneLine('two hands: only a scene drives two'));
+});

@@ -286,11 +286,7 @@ fn page_settings(args: &Args, config: &InputConfig, gestures: &GestureSet) -> an
         name if MappingTable::BUILTIN.contains(&name) => name.to_owned(),
         path => std::fs::read_to_string(path).with_context(|| format!("--glove {path}"))?,
     };
-    let table = args.common.table()?;
-    let calibration = match &args.common.calib {
-        Some(path) => Calibration::load(path)?,
-        None => Calibration::default_for(&table),
-    };
+    let calibration = args.common.calib.as_deref().map(Calibration::load).transpose()?;
     let (hands, joint_model) = (1 + u8::from(args.two_hands()), args.joint_model.as_str().to_owned());
     Ok(Ok(EngineSettings { hands, scene, joint_model, config: config.clone(), gestures: gestures.to_json(), glove, calibration, ..EngineSettings::default() }))
 }

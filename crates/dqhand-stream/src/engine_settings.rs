@@ -7,12 +7,13 @@
 //!
 //! ```json
 //! {"hands": 1, "scene": null, "joint_model": "full", "config": {"filter": true, ...},
-//!  "gestures": "{\"gestures\": [...]}", "glove": "5dt-14", "calibration": {...},
+//!  "gestures": "{\"gestures\": [...]}", "glove": "5dt-14", "calibration": null,
 //!  "source": "udp 127.0.0.1:9000", "announce": true}
 //! ```
 //!
 //! `gestures` is a gesture file's text ([`GestureSet::to_json`]), `glove` a built-in table's
-//! name or a table file's text, `calibration` as `dqhand calibrate` writes it; `scene` names a
+//! name or a table file's text, `calibration` as `dqhand calibrate` writes it (null: the
+//! table's default); `scene` names a
 //! built-in scene (a scene file's meshes are the server's files, which a page cannot read).
 
 use dqhand::gesture::GestureSet;
@@ -38,8 +39,9 @@ pub struct EngineSettings {
     pub gestures: String,
     /// The glove's mapping table: a built-in name or a table file's text.
     pub glove: String,
-    /// The glove's calibration.
-    pub calibration: Calibration,
+    /// The glove's calibration; none: the table's default (raw 0 flat, 4095 fist).
+    #[serde(default)]
+    pub calibration: Option<Calibration>,
     /// The live input, as the server's hello names it (`udp 127.0.0.1:9000`, a recording's path).
     pub source: String,
     /// Whether viewers are told of the input from the start (a recording played, a UDP port)
@@ -53,7 +55,6 @@ impl Default for EngineSettings {
     /// demo` with no options.
     fn default() -> Self {
         let glove = MappingTable::BUILTIN[0];
-        let table = MappingTable::builtin(glove).expect("the built-in tables are valid");
         Self {
             hands: 1,
             scene: None,
@@ -61,7 +62,7 @@ impl Default for EngineSettings {
             config: InputConfig::default(),
             gestures: GestureSet::builtin().to_json(),
             glove: glove.to_owned(),
-            calibration: Calibration::default_for(&table),
+            calibration: None,
             source: "this page (camera or WebXR)".to_owned(),
             announce: false,
         }
@@ -110,7 +111,9 @@ impl EngineSettings {
     /// # Errors
     /// The table's, or a calibration of another glove.
     pub fn mapper(&self) -> Result<GloveMapper> {
-        Ok(GloveMapper::new(&self.table()?, &self.calibration, self.joint_model()?)?)
+        let table = self.table()?;
+        let calibration = self.calibration.clone().unwrap_or_else(|| Calibration::default_for(&table));
+        Ok(GloveMapper::new(&table, &calibration, self.joint_model()?)?)
     }
 
     /// The glove's sensor names, in the order of its records' values.

@@ -77,6 +77,8 @@ pub struct LiveInput {
     /// The hello's `scene` (built once: a mesh's triangles are many).
     scene: Option<Value>,
     start: Instant,
+    /// Records keep the arrival times another input gave them ([`Self::following_arrivals`]).
+    follows: bool,
     state: Mutex<State>,
 }
 
@@ -97,6 +99,9 @@ struct State {
     gesture_changes: u64,
     /// The hand's features being recorded for learning a gesture ([`LiveInput::capture`]).
     capture: Option<Capture>,
+    /// Following another input's arrival clock ([`LiveInput::following_arrivals`]): this
+    /// clock less that one's at the first record; `None` until then, and for an input of its own.
+    arrival_shift: Option<f64>,
 }
 
 /// The virtual hand's features over a stretch of live input, with their record times.
@@ -336,8 +341,20 @@ impl LiveInput {
         };
         let joint_model = gesture_loop.pipeline().retargeter().rig().model();
         let log = Log { entries: VecDeque::with_capacity(LOG_CAPACITY), logged: 0 };
-        let state = State { driver, actions, posed: 0, log, gestures, two_hand, last_time: 0.0, gesture_changes: 0, capture: None };
-        Ok(Self { source, announce, joint_model, scene, start: Instant::now(), state: Mutex::new(state) })
+        let state = State { driver, actions, posed: 0, log, gestures, two_hand, last_time: 0.0, gesture_changes: 0, capture: None, arrival_shift: None };
+        Ok(Self { source, announce, joint_model, scene, start: Instant::now(), follows: false, state: Mutex::new(state) })
+    }
+
+    /// This input as a replica of another live input whose records it is relayed (a page's
+    /// engine following `dqhand demo`): a record keeps the arrival time that input gave it,
+    /// shifted onto this input's clock at the first record, so lateness, dropouts and the
+    /// gesture events are judged as that input judged them, not on when the relay delivered
+    /// the record (a page's main thread busy with a camera frame delivers them in bursts).
+    /// Records with no arrival time arrive now, as always.
+    #[must_use]
+    pub fn following_arrivals(mut self) -> Self {
+        self.follows = true;
+        self
     }
 
     /// The gestures recognised now (`None`: recognition is off).
@@ -439,7 +456,11 @@ impl LiveInput {
     pub fn push(&self, record: &Record, taken: impl FnOnce(&Record)) -> Result<(), Rejection> {
         let mut guard = self.lock();
         // Read under the lock, so that the records taken have increasing arrival times.
-        let arrival = self.clock();
+        let now = self.clock();
+        let arrival = match record.arrival.filter(|_| self.follows) {
+            Some(given) => given + *guard.arrival_shift.get_or_insert(now - given),
+            None => now,
+        };
         let record = &Record { arrival: Some(arrival), ..*record };
         let State { driver, actions, posed, log, capture, last_time, .. } = &mut *guard;
         let hand = driver.shown_of(record.side);

@@ -73,7 +73,16 @@ impl LocalStream {
     pub fn from_settings(settings: &str, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<LocalStream, JsError> {
         let settings = EngineSettings::from_json(settings).map_err(|e| JsError::new(&e.to_string()))?;
         let source = format!("{}, relayed by dqhand demo", settings.source);
-        Self::build(&EngineSettings { source, ..settings }, right, left)
+        let mut stream = Self::build(&EngineSettings { source, ..settings }, right, left)?;
+        stream.input = stream.input.following_arrivals();
+        Ok(stream)
+    }
+
+    /// The settings [`Self::new`] runs with when given nothing (JSON text): `dqhand demo`'s
+    /// defaults, a start for [`Self::from_settings`].
+    #[wasm_bindgen(js_name = defaultSettings)]
+    pub fn default_settings() -> String {
+        EngineSettings::default().to_json()
     }
 
     fn build(settings: &EngineSettings, right: Option<Vec<u8>>, left: Option<Vec<u8>>) -> Result<LocalStream, JsError> {
