@@ -92,14 +92,17 @@ impl LocalStream {
             Some(bytes) => load_model(&bytes, &format!("hands/{}.glb", side.name()), side),
             None => build(&HandParams { side, ..HandParams::default() }).map(Arc::new).map_err(js),
         };
-        let model = hand(Side::Right, right)?;
-        let left = if settings.hands == 2 { Some(hand(Side::Left, left)?) } else { None };
+        // The settings' own faults first: the hands take seconds to generate.
+        if settings.hands == 2 && settings.scene.is_none() {
+            return Err(JsError::new("two hands: only a scene drives two (give a scene)"));
+        }
         let joint_model = settings.joint_model().map_err(stream)?;
         let (mapper, gestures) = (Some(settings.mapper().map_err(stream)?), Some(settings.gesture_set().map_err(stream)?));
+        let model = hand(Side::Right, right)?;
+        let left = if settings.hands == 2 { Some(hand(Side::Left, left)?) } else { None };
         let config = settings.config.clone();
         let input = match (settings.scene.as_deref(), &left) {
-            (None, None) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, announce),
-            (None, Some(_)) => return Err(JsError::new("two hands: only a scene drives two (give a scene)")),
+            (None, _) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, announce),
             (Some(name), left) => {
                 let scene = Scene::named(name).map_err(js)?;
                 let manip = match left {
