@@ -69,6 +69,8 @@ export class LocalConnection {
     try {
       const urls = relayed?.hands ?? ['./hands/right.glb', ...(twoHands ? ['./hands/left.glb'] : [])];
       const [, right, left] = await Promise.all([loadEngine(), handFile(urls[0]), urls[1] ? handFile(urls[1]) : undefined]);
+      // The demo's hand may be its --model: the built-in one generated instead would be another.
+      if (relayed && (!right || (urls[1] && !left))) throw new Error(`${urls[right ? 1 : 0]}: the demo's hand could not be loaded`);
       this.stream = relayed ? LocalStream.fromSettings(relayed.settings, right, left) : new LocalStream(scene, twoHands, right, left, config ?? undefined);
     } catch (e) {
       this.events.error(`the page's engine: ${(e as Error).message}`);
@@ -79,7 +81,7 @@ export class LocalConnection {
     this.events.status(true);
     this.text(this.stream.hello());
     for (let k = 0; k < this.stream.handCount; k++) this.events.topology(decodeTopology(this.stream.topology(k).slice().buffer as ArrayBuffer));
-    if (relayed) this.follow(relayed.url);
+    if (relayed) this.follow(relayed);
     this.last = performance.now();
     const timer = setInterval(() => {
       try {
@@ -123,27 +125,46 @@ export class LocalConnection {
   }
 
   /** Follows the server's relay: its records into the engine, its state messages to the page. */
-  private follow(url: string): void {
+  private follow(relayed: RelaySetup): void {
     let opened = false;
-    this.relay = new Relay(url, {
+    // The gestures the engine has (the relay sends them on every connection).
+    let gestures = (JSON.parse(relayed.settings) as { gestures: string }).gestures;
+    this.relay = new Relay(relayed.url, {
       record: (line) => this.push(line),
       gestures: (text) => {
+        if (text === gestures) return;
         try {
           this.stream!.setGestures(text);
+          gestures = text;
         } catch (e) {
           this.events.error(`the relayed gestures: ${(e as Error).message}`);
         }
       },
+      resetScene: () => this.stream!.resetScene(),
       text: (text) => this.text(text),
       status: (open) => {
         this.connected = open;
         // The engine's status was said when it loaded; a relay lost and found again is said too,
         // and the found one retold the engine's hello (the panel starts over on a status).
         if (opened || !open) this.events.status(open);
-        if (opened && open) this.text(this.stream!.hello());
+        if (opened && open) {
+          this.text(this.stream!.hello());
+          void this.reloadIfChanged(relayed.settings);
+        }
         opened ||= open;
       },
     });
+  }
+
+  /** A demo restarted with other settings (glove, scene, hands): the page starts over on its engine. */
+  private async reloadIfChanged(settings: string): Promise<void> {
+    const setup = (text: string) => JSON.stringify({ ...(JSON.parse(text) as object), gestures: null });
+    try {
+      const engine = (await (await fetch('./engine.json', { cache: 'no-store' })).json()) as { settings: object | null };
+      if (setup(JSON.stringify(engine.settings)) !== setup(settings)) location.reload();
+    } catch {
+      // No answer (the demo gone again): the relay reconnects, and this is asked again.
+    }
   }
 
   /** Applies a command now (dropped before the engine has loaded); relayed, `record` and `learn` go to the server. */

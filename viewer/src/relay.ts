@@ -1,8 +1,9 @@
 // `dqhand demo`'s live input for the engine in this page (crates/dqhand-cli/src/server/
 // relay_socket.rs): every record the server's input takes (a glove, a recording played,
 // another device's `/input`, this page's camera or headset) as a binary message holding its
-// JSON line; the gestures recognised as `{"type": "gestures", "gestures": "<file text>"}`; the
-// `recording` and `learning` messages of the stream. The page sends it `record` and `learn`
+// JSON line; `{"type": "reset_scene"}` where the scene starts over among them; the gestures
+// recognised as `{"type": "gestures", "gestures": "<file text>"}`; the `recording` and
+// `learning` messages of the stream. The page sends it `record` and `learn`
 // only, what needs the server's disk and its learner. Reopened when the server goes away.
 
 import { encodeCommand, type Command } from './protocol';
@@ -12,6 +13,8 @@ export interface RelayEvents {
   record(line: string): void;
   /** The gestures recognised now (a gesture file's text). */
   gestures(text: string): void;
+  /** The scene started over (a recording played again), in its place among the records. */
+  resetScene(): void;
   /** Any other message (`recording`, `learning`, `error`): JSON text. */
   text(text: string): void;
   status(open: boolean): void;
@@ -45,13 +48,13 @@ export class Relay {
         this.events.record(this.decoder.decode(data));
         return;
       }
-      // Rare (a state change), so read whole here: a `gestures` message is the relay's own.
+      // Rare (a state change), so read whole here: `gestures` and `reset_scene` are the relay's own.
       const message = JSON.parse(data) as { type?: string; gestures?: string };
       if (message.type === 'gestures' && typeof message.gestures === 'string') this.events.gestures(message.gestures);
+      else if (message.type === 'reset_scene') this.events.resetScene();
       else this.events.text(data);
     };
     socket.onclose = () => {
-      if (this.socket !== socket) return;
       this.open = false;
       this.events.status(false);
       setTimeout(() => this.connect(), RETRY_MS);

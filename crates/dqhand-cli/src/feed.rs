@@ -81,6 +81,7 @@ impl Feed {
         loop {
             if pass > 0 {
                 self.input.reset_scene();
+                self.relay.reset_scene();
             }
             let mut reader = open()?;
             let (mut first, mut last, mut interval, mut played) = (None::<f64>, None::<f64>, FIRST_INTERVAL, 0.0);

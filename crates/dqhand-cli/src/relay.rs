@@ -2,7 +2,8 @@
 //! input takes (a glove's or tracker's datagram, a recording played, a device's `/input`
 //! message) as the JSON line a recording holds, for each `/relay` connection to send on.
 //! The log is bounded: a page further behind than [`CAPACITY`] records misses the oldest (its
-//! engine sees a gap, as after a lost datagram), and the server never grows.
+//! engine sees a gap, as after a lost datagram), and the server never grows. A scene started
+//! over (a recording played again) is an entry of the log too, in its place among the records.
 
 use std::collections::VecDeque;
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
@@ -10,9 +11,12 @@ use std::time::Duration;
 
 use dqhand::input::json_record::write_record;
 use dqhand::input::Record;
+use tungstenite::Bytes;
 
 /// Records kept for connections that have not sent them yet (seconds of a 120 Hz glove).
 pub const CAPACITY: usize = 1024;
+/// The entry of a scene started over: empty (a record never is).
+pub const RESET: &[u8] = b"";
 
 /// The records taken, for every page that follows them.
 pub struct RecordRelay {
@@ -22,10 +26,10 @@ pub struct RecordRelay {
     arrived: Condvar,
 }
 
-/// The latest records, as JSON lines without their newline.
+/// The latest records, as JSON lines without their newline ([`RESET`] for a scene started over).
 #[derive(Default)]
 struct Log {
-    lines: VecDeque<Vec<u8>>,
+    lines: VecDeque<Bytes>,
     /// Records published so far: the next one's number.
     next: u64,
 }
@@ -36,20 +40,30 @@ impl RecordRelay {
         Self { sensors, log: Mutex::default(), arrived: Condvar::new() }
     }
 
-    /// Adds a record the input took; the oldest goes when the log is full (its line buffer
-    /// is reused).
+    /// Adds a record the input took; the oldest goes when the log is full.
     pub fn publish(&self, record: &Record) {
-        let mut log = lock(&self.log);
-        let mut line = if log.lines.len() == CAPACITY { log.lines.pop_front().unwrap_or_default() } else { Vec::with_capacity(256) };
-        line.clear();
+        let mut line = Vec::with_capacity(256);
         // A taken record is finite, and a Vec takes every write.
         if write_record(&mut line, record, &self.sensors).is_ok() {
             line.pop(); // the newline: one record is one message
-            log.lines.push_back(line);
-            log.next += 1;
-            drop(log);
-            self.arrived.notify_all();
+            self.add(Bytes::from(line));
         }
+    }
+
+    /// Adds that the input's scene started over ([`RESET`]).
+    pub fn reset_scene(&self) {
+        self.add(Bytes::new());
+    }
+
+    fn add(&self, line: Bytes) {
+        let mut log = lock(&self.log);
+        if log.lines.len() == CAPACITY {
+            log.lines.pop_front();
+        }
+        log.lines.push_back(line);
+        log.next += 1;
+        drop(log);
+        self.arrived.notify_all();
     }
 
     /// The number of records published so far: where a new page starts (it follows the
@@ -58,9 +72,10 @@ impl RecordRelay {
         lock(&self.log).next
     }
 
-    /// Copies into `out` the records after the first `seen` (those still kept), waiting up to
-    /// `wait` for one if there is none yet; `seen` moves past them.
-    pub fn after(&self, seen: &mut u64, wait: Duration, out: &mut Vec<Vec<u8>>) {
+    /// Puts into `out` the entries after the first `seen` (those still kept; a clone is a
+    /// count, not a copy), waiting up to `wait` for one if there is none yet; `seen` moves past
+    /// them.
+    pub fn after(&self, seen: &mut u64, wait: Duration, out: &mut Vec<Bytes>) {
         let mut log = lock(&self.log);
         if log.next == *seen {
             log = self.arrived.wait_timeout(log, wait).unwrap_or_else(PoisonError::into_inner).0;
@@ -94,9 +109,11 @@ mod tests {
         relay.after(&mut seen, Duration::ZERO, &mut out);
         assert!(out.is_empty(), "the backlog is not sent to a new page");
         relay.publish(&record(1.0));
+        relay.reset_scene();
         relay.publish(&record(2.0));
         relay.after(&mut seen, Duration::ZERO, &mut out);
-        let times = |out: &[Vec<u8>]| out.iter().map(|l| serde_json::from_slice::<serde_json::Value>(l).unwrap()["t"].as_f64().unwrap()).collect::<Vec<_>>();
+        assert_eq!(&out.remove(1)[..], RESET, "the reset in its place");
+        let times = |out: &[Bytes]| out.iter().map(|l| serde_json::from_slice::<serde_json::Value>(l).unwrap()["t"].as_f64().unwrap()).collect::<Vec<_>>();
         assert_eq!(times(&out), [1.0, 2.0]);
         assert!(out.iter().all(|l| !l.ends_with(b"\n")), "one record per message, no newline");
         out.clear();

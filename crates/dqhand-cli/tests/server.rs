@@ -986,6 +986,27 @@ fn the_relay_gives_a_page_the_engine_and_every_record_taken() {
     let path = PathBuf::from(stopped["path"].as_str().unwrap());
     assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 100);
 
+    // A scene played from a recording starts over with each pass: the relay says so, in its
+    // place among the records (the page's engine puts the objects back then).
+    let short = dir.join("short.jsonl");
+    std::fs::write(&short, lines[..30].join("\n") + "\n").unwrap();
+    let server = start("relay-scene", &["--scene", "grasp", "--input", short.to_str().unwrap()]);
+    let (mut page, _) = tungstenite::connect(format!("ws://{}/relay", server.address)).unwrap();
+    if let MaybeTlsStream::Plain(s) = page.get_mut() {
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    }
+    let (mut records, mut resets) = (0, 0);
+    while resets < 2 {
+        match page.read().unwrap() {
+            Message::Binary(_) => records += 1,
+            Message::Text(t) if t.contains("reset_scene") => {
+                assert!(resets == 0 || records >= 30, "a whole pass of 30 records between two resets ({records})");
+                (resets, records) = (resets + 1, 0);
+            }
+            _ => {}
+        }
+    }
+
     let scene = dir.join("scene.json");
     std::fs::write(&scene, r#"{"objects": [{"name": "ball", "shape": "sphere", "radius": 0.04, "position": [0, 0.05, 0], "mass": 0.15}]}"#).unwrap();
     let server = start("relay-scene-file", &["--scene", scene.to_str().unwrap()]);

@@ -18,7 +18,7 @@
 
 use dqhand::gesture::GestureSet;
 use dqhand::input::{Calibration, GloveMapper, InputConfig, MappingTable};
-use dqhand::kinematics::{JointModel, Side};
+use dqhand::kinematics::JointModel;
 use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
@@ -130,11 +130,5 @@ impl EngineSettings {
     /// The gesture file's.
     pub fn gesture_set(&self) -> Result<GestureSet> {
         Ok(GestureSet::from_json(&self.gestures, "settings' gestures")?)
-    }
-
-    /// The sides of the hands driven, right first: the right one, and the left one of two.
-    #[must_use]
-    pub fn sides(&self) -> &'static [Side] {
-        if self.hands == 2 { &[Side::Right, Side::Left] } else { &[Side::Right] }
     }
 }

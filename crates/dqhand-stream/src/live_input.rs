@@ -100,8 +100,9 @@ struct State {
     /// The hand's features being recorded for learning a gesture ([`LiveInput::capture`]).
     capture: Option<Capture>,
     /// Following another input's arrival clock ([`LiveInput::following_arrivals`]): this
-    /// clock less that one's at the first record; `None` until then, and for an input of its own.
-    arrival_shift: Option<f64>,
+    /// clock less that one's at the first record, and that clock's last arrival; `None` until
+    /// then, and for an input of its own.
+    arrival_shift: Option<(f64, f64)>,
 }
 
 /// The virtual hand's features over a stretch of live input, with their record times.
@@ -350,7 +351,8 @@ impl LiveInput {
     /// shifted onto this input's clock at the first record, so lateness, dropouts and the
     /// gesture events are judged as that input judged them, not on when the relay delivered
     /// the record (a page's main thread busy with a camera frame delivers them in bursts).
-    /// Records with no arrival time arrive now, as always.
+    /// Records with no arrival time arrive now, as always. (A first record delivered late by
+    /// D shifts the rest by D: the hand is judged lost D later than the other input judged it.)
     #[must_use]
     pub fn following_arrivals(mut self) -> Self {
         self.follows = true;
@@ -458,7 +460,16 @@ impl LiveInput {
         // Read under the lock, so that the records taken have increasing arrival times.
         let now = self.clock();
         let arrival = match record.arrival.filter(|_| self.follows) {
-            Some(given) => given + *guard.arrival_shift.get_or_insert(now - given),
+            Some(given) => {
+                // Anchored at the first record, and again when the other clock starts over
+                // (its input restarted).
+                let (shift, last) = guard.arrival_shift.get_or_insert((now - given, given));
+                if given < *last {
+                    *shift = now - given;
+                }
+                *last = given;
+                given + *shift
+            }
             None => now,
         };
         let record = &Record { arrival: Some(arrival), ..*record };

@@ -98,13 +98,13 @@ impl LocalStream {
         }
         let joint_model = settings.joint_model().map_err(stream)?;
         let (mapper, gestures) = (Some(settings.mapper().map_err(stream)?), Some(settings.gesture_set().map_err(stream)?));
+        let scene = settings.scene.as_deref().map(Scene::named).transpose().map_err(js)?;
         let model = hand(Side::Right, right)?;
         let left = if settings.hands == 2 { Some(hand(Side::Left, left)?) } else { None };
         let config = settings.config.clone();
-        let input = match (settings.scene.as_deref(), &left) {
+        let input = match (scene, &left) {
             (None, _) => LiveInput::new(GestureLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures).map_err(js)?, source, announce),
-            (Some(name), left) => {
-                let scene = Scene::named(name).map_err(js)?;
+            (Some(scene), left) => {
                 let manip = match left {
                     Some(left) => ManipulationLoop::two_handed([(Arc::clone(left), mapper.clone()), (Arc::clone(&model), mapper)], joint_model, config, gestures, &scene, GraspParams::default()),
                     None => ManipulationLoop::new(Arc::clone(&model), joint_model, mapper, config, gestures, &scene, GraspParams::default()),
@@ -119,6 +119,13 @@ impl LocalStream {
         let record = Record { time: 0.0, side: Side::Right, hand: None, tracker: None, arrival: None };
         let sensors = settings.sensors().map_err(stream)?;
         Ok(LocalStream { session, input, view, frames: [Vec::new(), Vec::new()], texts: Vec::new(), record, sensors, rate: FrameRate::default(), clock: 0.0 })
+    }
+
+    /// Puts the scene's objects back where the scene has them: `dqhand demo`'s played
+    /// recording started over (its relay says so in its place among the records).
+    #[wasm_bindgen(js_name = resetScene)]
+    pub fn reset_scene(&self) {
+        self.input.reset_scene();
     }
 
     /// Recognises `gestures` (a gesture file's text) from now on: the set `dqhand demo` learned

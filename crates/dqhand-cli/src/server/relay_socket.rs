@@ -1,8 +1,9 @@
 //! The `/relay` WebSocket: the demo's live input for a page that runs the engine itself
 //! ([`super::page_engine`]). The server sends each record its input takes as a binary message
-//! (one JSON record, as a recording's line), the gestures recognised (`{"type": "gestures",
-//! "gestures": "<gesture file text>"}`: at once, and again after one is learned), and the
-//! `recording` and `learning` messages of the stream. The page sends only what needs this
+//! (one JSON record, as a recording's line), `{"type": "reset_scene"}` in its place among them
+//! when the scene starts over (a recording played again), the gestures recognised
+//! (`{"type": "gestures", "gestures": "<gesture file text>"}`: at once, and again after one is
+//! learned), and the `recording` and `learning` messages of the stream. The page sends only what needs this
 //! machine: `record` (to disk, [`crate::live::LiveRecords`]) and `learn`; anything else is
 //! answered with an error, since the page's own engine does the rest. The page's camera or
 //! headset input goes to `/input` as before and comes back here like any other record.
@@ -20,6 +21,7 @@ use super::request::Request;
 use super::socket::{read_failure, refuse_and_close, send_error, upgrade, PING_AFTER, SILENT_LIMIT};
 use crate::feed::Feed;
 use crate::live_learning;
+use crate::relay::RESET;
 
 /// The path of the relay.
 pub const PATH: &str = "/relay";
@@ -78,7 +80,8 @@ pub fn run(stream: TcpStream, request: Request, accept: &str, feed: &Arc<Feed>) 
         }
         feed.relay.after(&mut seen, WAIT, &mut lines);
         for line in lines.drain(..) {
-            ws.send(Message::binary(line)).map_err(super::socket::io)?;
+            let message = if line == RESET { Message::text(r#"{"type": "reset_scene"}"#) } else { Message::binary(line) };
+            ws.send(message).map_err(super::socket::io)?;
         }
     }
 }
