@@ -66,9 +66,9 @@ const LOG_CAPACITY: usize = 256;
 const COUNTER_PERIOD: Duration = Duration::from_millis(250);
 /// A scene's loop steps at least this often (s) while viewers watch, records or not.
 pub const STEP_PERIOD: f64 = 1.0 / 60.0;
-/// How far behind its clock a replica ([`LiveInput::following_arrivals`]) judges its hand
-/// and steps its scene between records (s): a relayed record later than the fastest by more
-/// than this is stepped at the time already reached.
+/// How far behind its clock a replica's scene ([`LiveInput::following_arrivals`]) steps
+/// between records (s): a relayed record delivered later than the first one by more than this
+/// is stepped at the time already reached.
 const RELAY_SLACK_S: f64 = 0.25;
 /// A moving scene is reported at most this often (s); a grasp or release at once.
 pub const SCENE_PERIOD: f64 = 1.0 / 30.0;
@@ -357,9 +357,10 @@ impl LiveInput {
     /// shifted onto this input's clock at the first record, so lateness, dropouts and the
     /// gesture events are judged as that input judged them, not on when the relay delivered
     /// the record (a page's main thread busy with a camera frame delivers them in bursts).
-    /// Records with no arrival time arrive now, as always. Between records the replica judges
-    /// and steps [`RELAY_SLACK_S`] behind its clock, so a hand is judged lost that much later
-    /// than the other input judged it.
+    /// Records with no arrival time arrive now, as always. (A first record delivered late by D
+    /// shifts the rest by D: between records the hand is judged lost D later than the other
+    /// input judged it. A scene steps [`RELAY_SLACK_S`] behind this clock between records, and
+    /// never back in time.)
     #[must_use]
     pub fn following_arrivals(mut self) -> Self {
         self.follows = true;
@@ -468,10 +469,10 @@ impl LiveInput {
         let now = self.clock();
         let arrival = match record.arrival.filter(|_| self.follows) {
             Some(given) => {
-                // Anchored at the fastest delivery so far, so that no arrival is ahead of this
-                // clock (re-anchored when the other clock starts over: its input restarted).
+                // Anchored at the first record, and again when the other clock starts over
+                // (its input restarted): one shift keeps that clock's intervals exactly.
                 let (shift, last) = guard.arrival_shift.get_or_insert((now - given, given));
-                if given < *last || now - given < *shift {
+                if given < *last {
                     *shift = now - given;
                 }
                 *last = given;
@@ -551,10 +552,11 @@ impl LiveInput {
     /// gesture commands since its last update, and says what to send.
     pub fn update(&self, session: &mut Session, view: &mut InputView) -> InputUpdate {
         let mut guard = self.lock();
-        // A replica judges now a slack behind its clock: records delivered that much later
-        // than the fastest still arrive after the time it has stepped to.
-        let arrival = self.clock() - if self.follows { RELAY_SLACK_S } else { 0.0 };
         let state = &mut *guard;
+        // A replica's scene steps a slack behind its clock between records, so that records
+        // the relay delivers late still come after the time it has stepped to.
+        let slack = if self.follows && matches!(state.driver, Driver::Scene(_)) { RELAY_SLACK_S } else { 0.0 };
+        let arrival = self.clock() - slack;
         match &mut state.driver {
             Driver::Gestures(g) => {
                 if g.advance(arrival) {
