@@ -28,7 +28,7 @@ pub(super) const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
 /// (a live page answers with a pong, or acknowledges)...
 pub(super) const PING_AFTER: Duration = Duration::from_secs(5);
 /// ...and one silent this long is closed: it would hold one of the server's places for ever.
-pub(super) const SILENT_LIMIT: Duration = Duration::from_secs(15);
+const SILENT_LIMIT: Duration = Duration::from_secs(15);
 
 /// Completes the WebSocket handshake (the server's answer to a checked upgrade request).
 pub(super) fn upgrade(mut stream: TcpStream, request: Request, accept: &str) -> std::io::Result<WebSocket<TcpStream>> {
@@ -187,7 +187,7 @@ pub(super) fn read_failure(ws: &mut WebSocket<TcpStream>, e: tungstenite::Error)
 
 /// Sends `message` as an error, closes (with `frame`, if any) and lingers: the end of a
 /// connection whose client broke the protocol.
-pub(super) fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<CloseFrame>) -> std::io::Result<()> {
+fn refuse_and_close(ws: &mut WebSocket<TcpStream>, message: &str, frame: Option<CloseFrame>) -> std::io::Result<()> {
     let _ = send_error(ws, message);
     let _ = ws.close(frame);
     let _ = ws.flush();
