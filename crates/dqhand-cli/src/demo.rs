@@ -229,7 +229,7 @@ fn live_input(args: &Args, model: &Arc<Model>, left: Option<&Arc<Model>>, host: 
         }
     };
     let learning = LiveLearning::new(Arc::clone(model), args.common.config()?, Some(args.recordings.clone()));
-    let relay = RecordRelay::new(args.common.table()?.layout().sensors().iter().map(|s| s.name.clone()).collect());
+    let relay = RecordRelay::new(records.sensors().to_vec());
     let feed = Arc::new(Feed { input, records, learning, relay, clients: AtomicUsize::new(0) });
     let reporter = Arc::clone(&feed);
     std::thread::spawn(move || reporter.report());

@@ -47,6 +47,11 @@ impl LiveRecords {
         Ok(Self { side: args.hand, sensors, fixed, viewers: Mutex::default(), version: AtomicU64::new(0), directory })
     }
 
+    /// The glove's sensor names, in the order of a glove record's values.
+    pub fn sensors(&self) -> &[String] {
+        &self.sensors
+    }
+
     /// A blank record to decode into.
     pub fn blank(&self) -> Record {
         Record { time: 0.0, side: self.side, hand: None, tracker: None, arrival: None }
