@@ -10,6 +10,7 @@
 
 mod contact_constraint;
 mod hand_proxies;
+mod hull_support;
 mod object_colliders;
 mod proxy;
 mod proxy_mesh_query;

@@ -29,9 +29,11 @@ use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
 use parry3d::partitioning::BvhLeafCost;
 use parry3d::query::{self, NonlinearRigidMotion};
-use parry3d::shape::{Shape, TriMesh, Triangle};
+use parry3d::query::details::contact_support_map_support_map;
+use parry3d::shape::{Shape, SupportMap, TriMesh, Triangle};
 use std::sync::Arc;
 
+use super::hull_support::HullSupport;
 use super::HandProxies;
 use crate::math::{segment_distance, segment_triangle_closest};
 
@@ -107,7 +109,26 @@ enum QueryShape {
     Capsule { a: Vec3, b: Vec3, radius: f32 },
     /// Any other convex shape, scaled to [`UNIT`]s for parry's GJK, and its box in the joint's
     /// frame (m) for a cheap bound.
-    Scaled(Arc<dyn Shape>, Aabb),
+    Scaled(Convex, Aabb),
+}
+
+/// A convex shape's support function, in [`UNIT`]s.
+#[derive(Clone)]
+enum Convex {
+    /// A hull's, by hill climbing ([`HullSupport`]).
+    Hull(HullSupport),
+    /// Any other's, parry's own.
+    Other(Arc<dyn Shape>),
+}
+
+impl Convex {
+    /// The support function GJK asks.
+    fn support(&self) -> &dyn SupportMap {
+        match self {
+            Self::Hull(hull) => hull,
+            Self::Other(shape) => shape.as_support_map().expect("checked when made"),
+        }
+    }
 }
 
 /// The unit normal of `tri`'s plane (by its winding).
@@ -127,7 +148,11 @@ impl QueryShape {
         if let Some(c) = shape.as_capsule() {
             return Some(Self::Capsule { a: c.segment.a, b: c.segment.b, radius: c.radius });
         }
-        shape.scale_dyn(Vec3::splat(UNIT), 16).map(|scaled| Self::Scaled(Arc::from(scaled), shape.compute_local_aabb()))
+        let convex = match shape.as_convex_polyhedron() {
+            Some(hull) => Convex::Hull(HullSupport::new(hull, UNIT)),
+            None => Convex::Other(Arc::from(shape.scale_dyn(Vec3::splat(UNIT), 16).filter(|s| s.as_support_map().is_some())?)),
+        };
+        Some(Self::Scaled(convex, shape.compute_local_aabb()))
     }
 
     /// The box holding the proxy at `pose` (the mesh's frame).
@@ -202,15 +227,20 @@ impl QueryShape {
                 };
                 (length - radius, normal, p - normal * *radius)
             }
-            Self::Scaled(shape, _) => {
+            Self::Scaled(convex, _) => {
                 let pose = Pose::from_parts(pose.translation * UNIT, pose.rotation);
                 let tri = Triangle::new(tri.a * UNIT, tri.b * UNIT, tri.c * UNIT);
-                match query::contact(&pose, &**shape, &Pose::identity(), &tri, f32::MAX) {
+                // As parry's `query::contact` between two support maps, with the hull's own.
+                let contact = contact_support_map_support_map(&pose.inverse(), convex.support(), &tri, f32::MAX).map(|mut c| {
+                    c.transform_by_mut(&pose, &Pose::identity());
+                    c
+                });
+                match contact {
                     // parry gives no normal where the shapes touch exactly.
-                    Ok(Some(c)) if c.normal1 != Vec3::ZERO => (c.dist / UNIT - GJK_ERROR, -c.normal1, c.point1 / UNIT),
-                    Ok(Some(c)) => (c.dist / UNIT - GJK_ERROR, face_normal_towards(&tri, pose.translation), c.point1 / UNIT),
+                    Some(c) if c.normal1 != Vec3::ZERO => (c.dist / UNIT - GJK_ERROR, -c.normal1, c.point1 / UNIT),
+                    Some(c) => (c.dist / UNIT - GJK_ERROR, face_normal_towards(&tri, pose.translation), c.point1 / UNIT),
                     // No answer: touching, and not leaving (it stops the proxy, never lets it in).
-                    _ => (0.0, Vec3::ZERO, pose.translation / UNIT),
+                    None => (0.0, Vec3::ZERO, pose.translation / UNIT),
                 }
             }
         }
@@ -522,7 +552,7 @@ mod tests {
     #[test]
     fn parry_distance_to_small_triangles_needs_a_larger_unit() {
         let capsule = SharedShape::capsule(Vec3::new(0.0, -0.015, 0.0), Vec3::new(0.0, 0.015, 0.0), 0.008);
-        let scaled = QueryShape::Scaled(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales")), capsule.compute_local_aabb());
+        let scaled = QueryShape::Scaled(Convex::Other(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales"))), capsule.compute_local_aabb());
         let exact = QueryShape::of(&*capsule).expect("a capsule");
         let (mut in_metres, mut in_units) = (0.0f32, 0.0f32);
         for (k, tri) in teapot_triangles().into_iter().enumerate().step_by(7) {
