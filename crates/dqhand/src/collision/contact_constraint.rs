@@ -408,6 +408,11 @@ impl ContactConstraint {
                 }
                 let hit = match mesh {
                     Some(mesh) => self.mesh_query.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
+                    // A proxy touching a primitive stops the wrist unless its touching point
+                    // moves off the surface: parry's directional cast read a thumb 0.2 mm off
+                    // a bar as overlapping it, judged the overlap a leaving one, and let the
+                    // hand 5 mm into the bar (the headset-tracked hand-over).
+                    None if gap <= 2.0 * STOP_DISTANCE && approaching(&from, &*p.shape, o, linvel, angvel, t0) => Some(0.0),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };
                 if let Some(hit) = hit {
@@ -672,5 +677,14 @@ impl ContactConstraint {
     #[must_use]
     pub fn closure(&self) -> &[Closure; 5] {
         &self.closure
+    }
+}
+
+/// Whether the point where `shape` (at `pose`) is nearest the object `o`, moving with the wrist
+/// (`linvel`, `angvel` about `pivot`), closes on the surface there.
+fn approaching(pose: &parry3d::math::Pose, shape: &dyn parry3d::shape::Shape, o: &super::ObjectCollider, linvel: Vec3, angvel: Vec3, pivot: Vec3) -> bool {
+    match query::contact(pose, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
+        Ok(Some(c)) => (linvel + angvel.cross(c.point1 - pivot)).dot(c.normal1) > 0.0,
+        _ => false,
     }
 }

@@ -6,7 +6,8 @@
 //! * [`ContactConstraint`] — continuous collision detection of the hand's motion against the
 //!   objects, which gives the rendered hand (it never sinks in) and its contacts;
 //! * [`ProxyMeshQuery`] — a proxy against a triangle mesh (the nearest triangle, the time of
-//!   impact), its own rather than parry's, whose GJK in metres is centimetres off there.
+//!   impact), its own rather than parry's, whose GJK in metres is centimetres off there;
+//!   a hull proxy's support points by hill climbing (`hull_support`).
 
 mod contact_constraint;
 mod hand_proxies;
