@@ -37,7 +37,7 @@ use parry3d::query::{self, NonlinearRigidMotion};
 
 use super::proxy_mesh_query::ProxyMeshQuery;
 use super::hand_proxies::pose_of;
-use super::{HandPart, HandProxies, ObjectColliders, FINGERS};
+use super::{HandPart, HandProxies, ObjectCollider, ObjectColliders, FINGERS};
 use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
 use crate::math::DualQuat;
 
@@ -412,7 +412,7 @@ impl ContactConstraint {
                     // moves off the surface: parry's directional cast read a thumb 0.2 mm off
                     // a bar as overlapping it, judged the overlap a leaving one, and let the
                     // hand 5 mm into the bar (the headset-tracked hand-over).
-                    None if gap <= 2.0 * STOP_DISTANCE && approaching(&from, &*p.shape, o, linvel, angvel, t0) => Some(0.0),
+                    None if gap <= 2.0 * STOP_DISTANCE && approaching(&motion, &*p.shape, o) => Some(0.0),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };
                 if let Some(hit) = hit {
@@ -680,11 +680,13 @@ impl ContactConstraint {
     }
 }
 
-/// Whether the point where `shape` (at `pose`) is nearest the object `o`, moving with the wrist
-/// (`linvel`, `angvel` about `pivot`), closes on the surface there.
-fn approaching(pose: &parry3d::math::Pose, shape: &dyn parry3d::shape::Shape, o: &super::ObjectCollider, linvel: Vec3, angvel: Vec3, pivot: Vec3) -> bool {
-    match query::contact(pose, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
-        Ok(Some(c)) => (linvel + angvel.cross(c.point1 - pivot)).dot(c.normal1) > 0.0,
+/// Whether the point where `shape`, at the start of `motion`, is nearest the object `o` closes
+/// on the surface there as it moves (as [`ProxyMeshQuery::time_of_impact`] judges a touching
+/// triangle).
+fn approaching(motion: &NonlinearRigidMotion, shape: &dyn parry3d::shape::Shape, o: &ObjectCollider) -> bool {
+    let pivot = motion.start * motion.local_center;
+    match query::contact(&motion.start, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
+        Ok(Some(c)) => (motion.linvel + motion.angvel.cross(c.point1 - pivot)).dot(c.normal1) > 0.0,
         _ => false,
     }
 }

@@ -5,8 +5,8 @@
 //! manipulation frame's time went there while the hand rested on a mesh. On a convex
 //! polyhedron a vertex no neighbour beats is the farthest of all along a direction (the
 //! simplex method's argument), so the search walks from the nearest of a few precomputed
-//! extremes to a better neighbour until none is better: the same point, some 30 dot products
-//! instead of 957.
+//! extremes to a better neighbour until none is better: the same point, about 20 dot products
+//! on the wrist's hull (10–15 on the metacarpals') instead of 957.
 
 use glam::Vec3;
 use parry3d::shape::{ConvexPolyhedron, SupportMap};
