@@ -329,8 +329,9 @@ describe('the viewer page with a recorded input', () => {
     await waitState(p, 's.connected && s.framesReceived > 3 && s.input !== null');
     expect(await p.locator('#input-panel').isVisible()).toBe(true);
     expect(await p.locator('#input-source').textContent()).toContain('gestures-joints.jsonl');
-    await waitState(p, 's.input.tracking === "tracking"', 30_000);
-    expect(await p.locator('#tracking').textContent()).toBe('tracking');
+    // The state and the panel read together: the recording loses tracking now and then, and a
+    // loaded machine may render the next frame between two separate reads.
+    await waitState(p, 's.input.tracking === "tracking" && document.getElementById("tracking").textContent === "tracking"', 30_000);
     // A gesture of the library recognised (shown in the panel as it is in the state) and its start logged.
     await waitState(
       p,
