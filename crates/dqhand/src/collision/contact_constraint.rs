@@ -157,6 +157,8 @@ pub struct ContactConstraint {
     closure: [Closure; 5],
     near: Vec<usize>,
     mesh_query: ProxyMeshQuery,
+    /// The proxy (index in [`HandProxies::colliders`]) that last stopped the wrist: cast first.
+    first_stop: usize,
 }
 
 impl ContactConstraint {
@@ -233,6 +235,7 @@ impl ContactConstraint {
         let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
         Self {
             mesh_query: ProxyMeshQuery::new(&proxies),
+            first_stop: 0,
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
@@ -374,7 +377,15 @@ impl ContactConstraint {
         }
         self.uncast = 0.0;
         let mut toi: f32 = 1.0;
-        for (i, p) in self.proxies.colliders().iter().enumerate() {
+        // The proxy that stopped the wrist last frame first: a hand held back on an object is
+        // stopped at once, and no other proxy can stop it sooner.
+        let colliders = self.proxies.colliders();
+        let first = self.first_stop.min(colliders.len() - 1);
+        for i in core::iter::once(first).chain((0..colliders.len()).filter(|&i| i != first)) {
+            if toi <= 0.0 {
+                break;
+            }
+            let p = &colliders[i];
             let offset = to_wrist * world[p.joint];
             let from = pose_of(&(start_affine * offset));
             let to = pose_of(&(Affine3A::from_rotation_translation(r1, t1) * offset));
@@ -392,20 +403,17 @@ impl ContactConstraint {
                 let mesh = o.surface.as_trimesh();
                 // A mesh's own advancement starts with its distance: the hull's is enough here.
                 let (gap, slack) = match mesh {
-                    Some(_) => (o.hull_distance(&from, &*p.shape).unwrap_or(0.0), MESH_DISTANCE_SLACK),
-                    None => (o.distance_at_least(&from, &*p.shape, reach), 0.0),
+                    Some(_) => (o.hull_distance(&from, p).unwrap_or(0.0), MESH_DISTANCE_SLACK),
+                    None => (o.distance_at_least(&from, p, reach), 0.0),
                 };
                 // (A query parry cannot answer reads as infinitely far: then cast.)
                 if gap > reach + slack && gap.is_finite() {
                     continue;
                 }
-                let still = NonlinearRigidMotion::constant_position(o.pose);
-                // Nothing that misses the hull can hit the surface inside it (a proxy that
-                // starts inside the hull counts as a hit: the surface decides).
-                let misses_hull = o.hull().is_some_and(|h| matches!(query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &**h, 0.0, toi, true), Ok(None)));
-                if misses_hull {
+                if o.misses_hull(&motion, p, toi) {
                     continue;
                 }
+                let still = NonlinearRigidMotion::constant_position(o.pose);
                 let hit = match mesh {
                     Some(mesh) => self.mesh_query.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
                     // A proxy touching a primitive stops the wrist unless its touching point
@@ -415,8 +423,8 @@ impl ContactConstraint {
                     None if gap <= 2.0 * STOP_DISTANCE && approaching(&motion, &*p.shape, o) => Some(0.0),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };
-                if let Some(hit) = hit {
-                    toi = toi.min(hit);
+                if let Some(hit) = hit.filter(|&hit| hit < toi) {
+                    (toi, self.first_stop) = (hit, i);
                 }
             }
         }
@@ -541,7 +549,7 @@ impl ContactConstraint {
                             let c = objects.collider(o);
                             let here = match c.surface.as_trimesh() {
                                 Some(mesh) => self.mesh_query.distance_at_least(*p, &*proxy.shape, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
-                                None => c.distance_at_least(&pose, &*proxy.shape, STOP_DISTANCE),
+                                None => c.distance_at_least(&pose, proxy, STOP_DISTANCE),
                             };
                             if here < d {
                                 (d, to) = (here, o);
@@ -631,7 +639,7 @@ impl ContactConstraint {
                     }
                     continue;
                 }
-                if o.distance_at_least(&pose, &*p.shape, CONTACT_DISTANCE) > CONTACT_DISTANCE {
+                if o.distance_at_least(&pose, p, CONTACT_DISTANCE) > CONTACT_DISTANCE {
                     continue;
                 }
                 if let Ok(Some(c)) = query::contact(&pose, &*p.shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {

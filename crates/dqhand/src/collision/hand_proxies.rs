@@ -4,8 +4,9 @@
 
 use glam::{Affine3A, Quat, Vec3};
 use parry3d::math::Pose;
-use parry3d::shape::SharedShape;
+use parry3d::shape::{SharedShape, SupportMap};
 
+use super::hull_support::HullSupport;
 use super::{Proxy, ProxyShape};
 use crate::kinematics::Skeleton;
 
@@ -47,6 +48,20 @@ pub struct ProxyCollider {
     /// The largest distance of a point of the shape from the joint's origin (m): bounds how
     /// fast the shape moves when the joint turns.
     pub extent: f32,
+    /// A hull's support function by hill climbing (parry's tries every vertex: 957 on the
+    /// wrist's).
+    hull: Option<HullSupport>,
+}
+
+impl ProxyCollider {
+    /// The shape's support function, as GJK between two convex shapes asks it.
+    #[must_use]
+    pub fn support(&self) -> &dyn SupportMap {
+        match &self.hull {
+            Some(hull) => hull,
+            None => self.shape.as_support_map().expect("a capsule"),
+        }
+    }
 }
 
 /// A rigid affine transform as a parry pose.
@@ -70,16 +85,18 @@ impl HandProxies {
         let colliders = proxies
             .iter()
             .filter_map(|p| {
-                let (shape, extent) = match &p.shape {
+                let (shape, extent, hull) = match &p.shape {
                     ProxyShape::Capsule { start, end, radius } => {
-                        (SharedShape::capsule(*start, *end, *radius), start.length().max(end.length()) + radius)
+                        (SharedShape::capsule(*start, *end, *radius), start.length().max(end.length()) + radius, None)
                     }
                     ProxyShape::ConvexHull { points, triangles } => {
                         let extent = points.iter().map(|q| q.length()).fold(0.0, f32::max);
-                        (SharedShape::convex_mesh(points.clone(), triangles)?, extent)
+                        let shape = SharedShape::convex_mesh(points.clone(), triangles)?;
+                        let hull = shape.as_convex_polyhedron().map(|h| HullSupport::new(h, 1.0));
+                        (shape, extent, hull)
                     }
                 };
-                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent })
+                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent, hull })
             })
             .collect();
         Self { colliders }

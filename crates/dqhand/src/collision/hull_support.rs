@@ -78,13 +78,17 @@ mod tests {
 
     /// Every direction's walk ends at a point as far along it as the farthest of all the
     /// vertices (tried one by one): on a rounded, flattened hull of 1,500 vertices like the
-    /// wrist's, and on a cube, whose faces tie.
+    /// wrist's, on a cube, whose faces tie, and on the Utah teapot's hull.
     #[test]
     fn the_walk_finds_the_farthest_vertex() {
         let mut rng = Rng::new(11);
         let blob: Vec<Vec3> = (0..3000).map(|_| rng.unit() * Vec3::new(0.045, 0.04, 0.015)).collect();
         let cube: Vec<Vec3> = (0..8).map(|k| Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, (k >> 2) as f32) - 0.5).collect();
-        for points in [blob, cube] {
+        // The Utah teapot's vertices (Newell's patches, as the scene's teapot is made).
+        let scene = crate::scene::Scene::named("objects").expect("built in");
+        let colliders = super::super::ObjectColliders::new(&scene).expect("its shapes");
+        let teapot = colliders.objects().iter().find(|o| o.name == "teapot").and_then(|o| o.mesh.as_ref()).expect("the teapot");
+        for points in [blob, cube, teapot.vertices.clone()] {
             let (points, triangles) = parry3d::transformation::try_convex_hull(&points).expect("a hull");
             let hull = ConvexPolyhedron::from_convex_mesh(points.clone(), &triangles).expect("a polyhedron");
             let support = HullSupport::new(&hull, 2.0);

@@ -13,10 +13,12 @@
 use glam::{Affine3A, Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query;
-use parry3d::shape::{Shape, SharedShape, TriMeshFlags};
+use parry3d::query::details::NonlinearShapeCastMode;
+use parry3d::query::{self, DefaultQueryDispatcher, NonlinearRigidMotion};
+use parry3d::shape::{SharedShape, SupportMap, TriMeshFlags};
 
-use super::hand_proxies::pose_of;
+use super::hand_proxies::{pose_of, ProxyCollider};
+use super::hull_support::HullSupport;
 use super::HandProxies;
 use crate::Warning;
 use crate::scene::{ObjectMesh, ObjectShape, Scene};
@@ -37,6 +39,8 @@ pub struct ObjectCollider {
     /// The object's current world pose.
     pub pose: Pose,
     aabb: Aabb,
+    /// The hull's support function by hill climbing, where the hull is a convex polyhedron.
+    hull_support: Option<HullSupport>,
 }
 
 impl ObjectCollider {
@@ -54,20 +58,57 @@ impl ObjectCollider {
         self.mesh.as_ref().map(|_| &self.solid)
     }
 
-    /// The distance from `shape` at `pose` to the [`Self::hull`], if there is one: a lower
-    /// bound of the distance to the surface.
-    #[must_use]
-    pub fn hull_distance(&self, pose: &Pose, shape: &dyn Shape) -> Option<f32> {
-        self.hull().and_then(|hull| query::distance(pose, shape, &self.pose, &**hull).ok()).map(|x| x.distance)
+    /// The [`Self::hull`]'s support function, where it has one (a flat mesh's box is a compound).
+    fn hull_support(&self) -> Option<&dyn SupportMap> {
+        match &self.hull_support {
+            Some(hull) => Some(hull),
+            None => self.hull()?.as_support_map(),
+        }
     }
 
-    /// The distance from `shape` at `pose` to the surface, or a lower bound of it above
+    /// The distance from `proxy` at `pose` to the [`Self::hull`], if there is one: a lower
+    /// bound of the distance to the surface.
+    #[must_use]
+    pub fn hull_distance(&self, pose: &Pose, proxy: &ProxyCollider) -> Option<f32> {
+        let hull = self.hull()?;
+        match self.hull_support() {
+            Some(support) => Some(query::details::distance_support_map_support_map(&pose.inv_mul(&self.pose), proxy.support(), support)),
+            None => query::distance(pose, &*proxy.shape, &self.pose, &**hull).ok().map(|x| x.distance),
+        }
+    }
+
+    /// Whether `proxy`, moving by `motion` until time `end`, stays clear of the [`Self::hull`]
+    /// (starting inside it is a hit): nothing that misses the hull can touch the surface.
+    /// `false` where there is no hull.
+    #[must_use]
+    pub fn misses_hull(&self, motion: &NonlinearRigidMotion, proxy: &ProxyCollider, end: f32) -> bool {
+        let Some(hull) = self.hull() else { return false };
+        let still = NonlinearRigidMotion::constant_position(self.pose);
+        let hit = match self.hull_support() {
+            Some(support) => Ok(query::details::cast_shapes_nonlinear_support_map_support_map(
+                &DefaultQueryDispatcher,
+                motion,
+                proxy.support(),
+                &*proxy.shape,
+                &still,
+                support,
+                &**hull,
+                0.0,
+                end,
+                NonlinearShapeCastMode::StopAtPenetration,
+            )),
+            None => query::cast_shapes_nonlinear(motion, &*proxy.shape, &still, &**hull, 0.0, end, true),
+        };
+        matches!(hit, Ok(None))
+    }
+
+    /// The distance from `proxy` at `pose` to the surface, or a lower bound of it above
     /// `enough` (m): the distance to the [`Self::hull`] when that is larger.
     #[must_use]
-    pub fn distance_at_least(&self, pose: &Pose, shape: &dyn Shape, enough: f32) -> f32 {
-        match self.hull_distance(pose, shape) {
+    pub fn distance_at_least(&self, pose: &Pose, proxy: &ProxyCollider, enough: f32) -> f32 {
+        match self.hull_distance(pose, proxy) {
             Some(d) if d > enough => d,
-            _ => query::distance(pose, shape, &self.pose, &*self.surface).map_or(f32::INFINITY, |x| x.distance),
+            _ => query::distance(pose, &*proxy.shape, &self.pose, &*self.surface).map_or(f32::INFINITY, |x| x.distance),
         }
     }
 }
@@ -137,7 +178,8 @@ impl ObjectColliders {
             };
             let pose = Pose::from_parts(o.position, o.rotation);
             let aabb = surface.compute_aabb(&pose);
-            objects.push(ObjectCollider { name: o.name.clone(), surface, solid, mesh, pose, aabb });
+            let hull_support = mesh.as_ref().and(solid.as_convex_polyhedron()).map(|h| HullSupport::new(h, 1.0));
+            objects.push(ObjectCollider { name: o.name.clone(), surface, solid, mesh, pose, aabb, hull_support });
         }
         let count = objects.len();
         let table = scene.table.map(|t| table_top(t.height, &objects));
@@ -145,7 +187,7 @@ impl ObjectColliders {
             let surface = SharedShape::cuboid(t.half[0], TABLE_HALF_THICKNESS, t.half[1]);
             let pose = Pose::from_translation(Vec3::new(t.centre[0], t.height - TABLE_HALF_THICKNESS, t.centre[1]));
             let aabb = surface.compute_aabb(&pose);
-            objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb });
+            objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb, hull_support: None });
         }
         Ok(Self { all: objects, count, hands: Vec::new(), solving: None, table, warnings })
     }
@@ -239,7 +281,7 @@ impl ObjectColliders {
         for p in proxies.colliders() {
             let pose = Pose::IDENTITY;
             let aabb = p.shape.compute_aabb(&pose);
-            self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb });
+            self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb, hull_support: None });
         }
         self.hands.push((start..self.all.len(), proxies.colliders().iter().map(|p| p.joint).collect(), false));
         self.hands.len() - 1

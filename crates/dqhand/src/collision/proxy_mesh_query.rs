@@ -37,6 +37,9 @@ use super::hull_support::HullSupport;
 use super::HandProxies;
 use crate::math::{segment_distance, segment_triangle_closest};
 
+/// How far short of its distance to a mesh a proxy's lower bound may fall, as a share of what
+/// the distance exceeds the exactness asked for by ([`ProxyMeshQuery::distance_at_least`]).
+const SHORT_ABOVE: f32 = 0.1;
 /// A distance this small is contact (m): where the advancement stops.
 pub const TOLERANCE: f32 = 2e-5;
 /// How far a proxy must get from a triangle it started touching and left before the triangle
@@ -166,6 +169,23 @@ impl QueryShape {
         }
     }
 
+    /// A lower bound of the distance to anything in the tree's node `node` (the mesh's frame),
+    /// the proxy at `pose` (`to_local` its inverse) and within `aabb`: the gap between the
+    /// boxes, or where larger (a slanted finger's box holds much that the finger is far from)
+    /// the proxy's distance to the node's centre less the node's half diagonal.
+    fn node_gap(&self, pose: &Pose, to_local: &Pose, aabb: &Aabb, node: &Aabb) -> f32 {
+        let boxes = box_gap(node, aabb);
+        let (centre, half) = (node.center(), node.half_extents().length());
+        let centre_gap = match self {
+            Self::Capsule { a, b, radius } => segment_distance(centre, *pose * *a, *pose * *b) - radius,
+            Self::Scaled(_, local) => {
+                let c = to_local * centre;
+                (local.mins - c).max(c - local.maxs).max(Vec3::ZERO).length()
+            }
+        } - half;
+        if boxes > 0.0 || centre_gap > 0.0 { boxes.max(centre_gap) } else { self.deepest() }
+    }
+
     /// The least signed distance it can have to anything: a node of the tree whose box meets
     /// the proxy's may hold a triangle this deep in it.
     fn deepest(&self) -> f32 {
@@ -263,7 +283,7 @@ impl ProxyMeshQuery {
             return Some(MeshNearest { distance: c.dist, normal: (-c.normal1).normalize_or_zero(), point: c.point2 });
         };
         let local = mesh_pose.inv_mul(pose);
-        let near = Self::search(query, &local, mesh, limit, f32::INFINITY)?;
+        let near = Self::search(query, &local, mesh, limit, f32::INFINITY, 0.0)?;
         Some(MeshNearest { distance: near.distance, normal: mesh_pose.rotation * near.normal, point: *mesh_pose * near.point })
     }
 
@@ -271,29 +291,39 @@ impl ProxyMeshQuery {
     /// `mesh_pose`), exact where it is under `exact_below`, and at most `limit` (m): what
     /// conservative advancement needs, where a triangle whose cheap bound is enough is never
     /// measured (a finger a centimetre off a mesh has dozens of triangles about as near).
+    /// Above `exact_below` the search also passes over what is within [`SHORT_ABOVE`] of the
+    /// excess of being the nearest: a finger lying a centimetre along a curved mesh has
+    /// hundreds of triangles within a millimetre of its distance, which it need not tell apart.
     #[allow(clippy::too_many_arguments)]
     #[must_use]
     pub fn distance_at_least(&self, proxy: usize, shape: &dyn Shape, pose: &Pose, mesh: &TriMesh, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
         let Some(query) = &self.shapes[proxy] else {
             return query::distance(pose, shape, mesh_pose, mesh).map_or(0.0, |d| d.distance.min(limit));
         };
-        Self::search(query, &mesh_pose.inv_mul(pose), mesh, limit, exact_below).map_or(limit, |n| n.distance)
+        // Nothing found within the limit: what was passed over may be a little nearer.
+        let passed_over = limit - SHORT_ABOVE * (limit - exact_below).max(0.0);
+        Self::search(query, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
     }
 
     /// The best-first search of the mesh's tree for the triangle nearest `query` at `pose` (the
-    /// mesh's frame) within `limit` (the deepest, where it overlaps several); a triangle whose cheap bound is above `exact_below` counts
-    /// as that far (with no normal or point).
-    fn search(query: &QueryShape, pose: &Pose, mesh: &TriMesh, limit: f32, exact_below: f32) -> Option<MeshNearest> {
-        let (aabb, deepest, to_local) = (query.aabb(pose), query.deepest(), pose.inverse());
+    /// mesh's frame) within `limit` (the deepest, where it overlaps several); a triangle whose
+    /// cheap bound is above `exact_below` counts as that far (with no normal or point). With
+    /// `short` above 0, the distance found may be short of the true one by that share of its
+    /// excess over `exact_below`: what is no nearer than that is not looked at.
+    fn search(query: &QueryShape, pose: &Pose, mesh: &TriMesh, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
+        let (aabb, to_local) = (query.aabb(pose), pose.inverse());
+        // What can still count, with `best` found: rising with `best`, so that it holds for
+        // everything passed over on the way to the final `best`.
+        let worth = |best: f32| best - short * (best - exact_below).max(0.0);
         mesh.bvh()
             .find_best(
                 limit,
-                |node, _| Some(box_gap(&node.aabb(), &aabb)).filter(|&gap| gap > 0.0).unwrap_or(deepest),
+                |node, best| Some(query.node_gap(pose, &to_local, &aabb, &node.aabb())).filter(|&gap| gap < worth(best)).unwrap_or(f32::MAX),
                 |triangle, best| {
                     let triangle = mesh.triangle(triangle);
                     // The cheap bound first: most triangles near the proxy are not the nearest.
                     let bound = query.bound(pose, &to_local, &triangle);
-                    if bound >= best {
+                    if bound >= worth(best) {
                         return None;
                     }
                     if bound > exact_below {
@@ -303,7 +333,7 @@ impl ProxyMeshQuery {
                     Some(MeshNearest { distance, normal, point: point - normal * distance })
                 },
             )
-            .map(|(_, near)| near)
+            .map(|(_, near)| MeshNearest { distance: worth(near.distance), ..near })
     }
 
     /// The first time in `[0, end)` at which proxy `proxy` (`shape`), moving by `motion`, comes
