@@ -71,7 +71,10 @@ fn a_baton_is_handed_from_the_right_hand_to_the_left() {
 
 /// Tracked as a headset tracks it (grasp-bench's seed), the left hand comes down on the bar the
 /// right one holds with its thumb touching it: parry's directional cast read the touch as an
-/// overlap being left and let the hand 26 mm into the bar, through its surface.
+/// overlap being left and let the hand 26 mm into the bar, through its surface; then, with the
+/// thumb's metacarpal 0.04 mm off the bar, parry's contact gave no answer and the wrist went on
+/// 5.4 mm into it; and the right hand's jitter carried the bar 2.9 mm into the left fingers
+/// closing on it. The skin stays within the benchmark's 1 mm, and the bar is handed over.
 #[test]
 fn a_headset_tracked_hand_over_keeps_the_left_hand_out_of_the_bar() {
     let scene = Scene::named("two-hands").unwrap();
@@ -81,7 +84,7 @@ fn a_headset_tracked_hand_over_keeps_the_left_hand_out_of_the_bar() {
     let mut manip = two_handed(&scene);
     let i = manip.names().iter().position(|n| n == "baton").unwrap();
     let score = benchmark::score(&mut manip, &script, i, scene.objects[i].position + Vec3::new(0.0, 0.0, 0.24));
-    assert!(!score.tunnelled && score.max_penetration_m < 0.005, "{:?}", RunScore { step_s: Vec::new(), ..score });
+    assert!(score.success && !score.tunnelled && score.max_penetration_m <= 0.001, "{:?}", RunScore { step_s: Vec::new(), ..score });
 }
 
 #[test]

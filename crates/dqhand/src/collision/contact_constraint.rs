@@ -35,7 +35,7 @@ use glam::{Affine3A, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{self, NonlinearRigidMotion};
 
-use super::proxy_mesh_query::ProxyMeshQuery;
+use super::proxy_mesh_query::{ProxyMeshQuery, TOLERANCE};
 use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectCollider, ObjectColliders, FINGERS};
 use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
@@ -410,17 +410,19 @@ impl ContactConstraint {
                 if gap > reach + slack && gap.is_finite() {
                     continue;
                 }
-                if o.misses_hull(&motion, p, toi) {
+                // (One in the hull from the start, as a finger round the teapot's handle, meets
+                // it at once: no cast needed to know.)
+                if gap > 0.0 && o.misses_hull(&motion, p, toi) {
                     continue;
                 }
                 let still = NonlinearRigidMotion::constant_position(o.pose);
                 let hit = match mesh {
                     Some(mesh) => self.mesh_query.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
-                    // A proxy touching a primitive stops the wrist unless its touching point
-                    // moves off the surface: parry's directional cast read a thumb 0.2 mm off
-                    // a bar as overlapping it, judged the overlap a leaving one, and let the
-                    // hand 5 mm into the bar (the headset-tracked hand-over).
-                    None if gap <= 2.0 * STOP_DISTANCE && approaching(&motion, &*p.shape, o) => Some(0.0),
+                    // A proxy touching a primitive stops the wrist unless it moves off the
+                    // surface: parry's directional cast read a thumb 0.2 mm off a bar as
+                    // overlapping it, judged the overlap a leaving one, and let the hand 5 mm
+                    // into the bar (the headset-tracked hand-over).
+                    None if gap <= 2.0 * STOP_DISTANCE && !moves_off(&motion, &*p.shape, o, toi) => Some(0.0),
                     None => query::cast_shapes_nonlinear(&motion, &*p.shape, &still, &*o.surface, 0.0, toi, false).ok().flatten().map(|hit| hit.time_of_impact),
                 };
                 if let Some(hit) = hit.filter(|&hit| hit < toi) {
@@ -688,13 +690,15 @@ impl ContactConstraint {
     }
 }
 
-/// Whether the point where `shape`, at the start of `motion`, is nearest the object `o` closes
-/// on the surface there as it moves (as [`ProxyMeshQuery::time_of_impact`] judges a touching
-/// triangle).
-fn approaching(motion: &NonlinearRigidMotion, shape: &dyn parry3d::shape::Shape, o: &ObjectCollider) -> bool {
+/// Whether a proxy touching primitive `o` at the start of `motion` moves off it: its touching
+/// point does not close on the surface there (as [`ProxyMeshQuery::time_of_impact`] judges a
+/// touching triangle), and halfway to `end` and at `end` it is no deeper in than it started: a
+/// turn can lift the touching point and sink another end of the proxy (a left thumb's
+/// metacarpal, touching a bar, rolled 5.4 mm into it where parry's directional cast saw no hit).
+fn moves_off(motion: &NonlinearRigidMotion, shape: &dyn parry3d::shape::Shape, o: &ObjectCollider, end: f32) -> bool {
     let pivot = motion.start * motion.local_center;
-    match query::contact(&motion.start, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) {
-        Ok(Some(c)) => (motion.linvel + motion.angvel.cross(c.point1 - pivot)).dot(c.normal1) > 0.0,
-        _ => false,
-    }
+    // parry's contact has no answer for some shapes touching exactly: then it does not.
+    let Ok(Some(c)) = query::contact(&motion.start, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) else { return false };
+    let deeper = |t: f32| query::contact(&motion.position_at_time(t), shape, &o.pose, &*o.surface, CONTACT_DISTANCE).is_ok_and(|e| e.is_some_and(|e| e.dist < c.dist.min(0.0) - TOLERANCE));
+    (motion.linvel + motion.angvel.cross(c.point1 - pivot)).dot(c.normal1) <= 0.0 && !deeper(end / 2.0) && !deeper(end)
 }

@@ -23,7 +23,7 @@ pub struct ManipulatingHand {
     pub(super) constraint: ContactConstraint,
     pub(super) grasp: Grasp,
     /// The hand's index among the physics' hands.
-    physics: usize,
+    pub(super) physics: usize,
     was_tracking: bool,
 }
 

@@ -231,6 +231,15 @@ impl ManipulationLoop {
         for hand in &self.hands {
             if let (Some(held), Some((q, t))) = (hand.grasp.held(), hand.grasp.target()) {
                 let t = self.objects.above_table(held, q, t);
+                // It stops at a hand that does not hold it (and is not handing it over).
+                let to = parry3d::math::Pose::from_parts(t, q);
+                let share = self.hands.iter().filter(|other| other.grasp.held() != Some(held)).map(|other| self.objects.free_share(held, other.physics, &to)).fold(1.0, f32::min);
+                let (q, t) = if share < 1.0 {
+                    let (q0, t0) = self.poses[held];
+                    (q0.slerp(q, share).normalize(), t0.lerp(t, share))
+                } else {
+                    (q, t)
+                };
                 self.objects.set_pose(held, q, t);
                 self.poses[held] = (q, t);
             }
