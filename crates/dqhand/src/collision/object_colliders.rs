@@ -15,7 +15,7 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query::details::NonlinearShapeCastMode;
 use parry3d::query::{self, DefaultQueryDispatcher, NonlinearRigidMotion};
-use parry3d::shape::{Shape, SharedShape, SupportMap, TriMeshFlags};
+use parry3d::shape::{SharedShape, SupportMap, TriMeshFlags};
 
 use super::hand_proxies::{pose_of, ProxyCollider};
 use super::hull_support::HullSupport;
@@ -374,6 +374,7 @@ fn mesh_shapes(mesh: &ObjectMesh) -> std::result::Result<(SharedShape, SharedSha
 #[cfg(test)]
 mod tests {
     use super::*;
+    use parry3d::shape::Shape;
 
     /// A ball carried towards the other hand's index fingertip, along the finger, stops where it touches the hand
     /// (checked against the distances there), goes freely the other way, and passes where the
