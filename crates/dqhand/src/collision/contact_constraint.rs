@@ -380,8 +380,8 @@ impl ContactConstraint {
         // The proxy that stopped the wrist last frame first: a hand held back on an object is
         // stopped at once, and no other proxy can stop it sooner.
         let colliders = self.proxies.colliders();
-        let first = self.first_stop.min(colliders.len() - 1);
-        for i in core::iter::once(first).chain((0..colliders.len()).filter(|&i| i != first)) {
+        let first = self.first_stop.min(colliders.len().saturating_sub(1));
+        for i in core::iter::once(first).filter(|&i| i < colliders.len()).chain((0..colliders.len()).filter(|&i| i != first)) {
             if toi <= 0.0 {
                 break;
             }

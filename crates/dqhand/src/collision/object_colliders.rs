@@ -300,30 +300,37 @@ impl ObjectColliders {
     }
 
     /// The share of object `i`'s motion from where it is to `to` (0 to 1) it may make before
-    /// it meets hand `hand`'s proxies, where that hand is placed and does not hold it: a held
-    /// object moves kinematically with the hand holding it, and the other hand, stopped on it,
-    /// cannot move out of its way (headset-tracked jitter turned a bar handed over 3 mm into
-    /// the fingers closing on it). A proxy it overlaps already stops it only going deeper.
+    /// it comes within `stop` (m) of hand `hand`'s proxies, where that hand is placed
+    /// and does not hold it: a held object moves kinematically with the hand holding it, and
+    /// the other hand, stopped on it, cannot move out of its way (headset-tracked jitter
+    /// carried a bar handed over 2.9 mm into the fingers closing on it). A proxy it overlaps
+    /// already stops it only going deeper (parry's directional cast). A mesh is not stopped:
+    /// parry's cast of a triangle mesh cost 4–60 ms frames ([`super::ProxyMeshQuery`]).
     #[must_use]
-    pub fn free_share(&self, i: usize, hand: usize, to: &Pose) -> f32 {
+    pub fn free_share(&self, i: usize, hand: usize, to: &Pose, stop: f32) -> f32 {
         let (range, _, there) = &self.hands[hand];
         let o = &self.all[i];
-        if !*there || range.is_empty() {
+        if !*there || range.is_empty() || o.mesh.is_some() {
             return 1.0;
         }
         let from = o.pose;
         let swept = o.surface.compute_swept_aabb(&from, to);
-        let turn = (to.rotation * from.rotation.inverse()).to_scaled_axis();
-        let motion = NonlinearRigidMotion::new(from, Vec3::ZERO, to.translation - from.translation, turn);
-        let reach = swept.half_extents().length() * turn.length().min(core::f32::consts::PI) / 2.0;
-        let swept = swept.loosened(reach);
-        self.all[range.clone()].iter().filter(|p| p.aabb.intersects(&swept)).fold(1.0, |share, p| {
+        // The short way round, as the object is then turned (slerp).
+        let relative = to.rotation * from.rotation.inverse();
+        let turn = if relative.w < 0.0 { -relative } else { relative }.to_scaled_axis();
+        let linvel = to.translation - from.translation;
+        let motion = NonlinearRigidMotion::new(from, Vec3::ZERO, linvel, turn);
+        let radius = swept.half_extents().length();
+        let swept = swept.loosened(radius * turn.length() / 2.0 + stop);
+        let hit = self.all[range.clone()].iter().filter(|p| p.aabb.intersects(&swept)).fold(1.0, |share, p| {
             let still = NonlinearRigidMotion::constant_position(p.pose);
             match query::cast_shapes_nonlinear(&motion, &*o.surface, &still, &*p.surface, 0.0, share, false) {
                 Ok(Some(hit)) => share.min(hit.time_of_impact),
                 _ => share,
             }
-        })
+        });
+        // Stopped short of it, as the wrist is: not touching next frame.
+        if hit < 1.0 { (hit - stop / (linvel.length() + turn.length() * radius)).max(0.0) } else { 1.0 }
     }
 
     /// The hand whose rendered pose is solved next: the other hands' proxies are obstacles
@@ -396,7 +403,7 @@ mod tests {
         let start = b + along * 0.06;
         colliders.set_pose(ball, Quat::IDENTITY, start);
         let towards = Pose::from_translation(start - along * 0.04);
-        let share = colliders.free_share(ball, hand, &towards);
+        let share = colliders.free_share(ball, hand, &towards, 0.0004);
         assert!(share > 0.0 && share < 1.0, "{share}");
         colliders.set_pose(ball, Quat::IDENTITY, start.lerp(towards.translation, share));
         let o = &colliders.objects()[ball];
@@ -404,13 +411,13 @@ mod tests {
         // Signed distances (negative where they overlap).
         let signed = |pose: &Pose, shape: &dyn Shape| query::contact(&o.pose, &*o.surface, pose, shape, 0.01).unwrap().map_or(0.01, |c| c.dist);
         let nearest = colliders.all[colliders.hands[hand].0.clone()].iter().map(|q| signed(&q.pose, &*q.surface)).fold(f32::INFINITY, f32::min);
-        assert!(nearest > -1e-4 && nearest < 1e-3, "stopped {nearest} m from the hand");
+        assert!(nearest > 0.0 && nearest < 1e-3, "stopped {nearest} m from the hand");
         assert!(signed(&tip_pose, &*p.shape) < 0.005, "not at the fingertip");
         // Away from the hand, or with the hand not placed, it goes all the way.
         colliders.set_pose(ball, Quat::IDENTITY, start);
-        assert_eq!(colliders.free_share(ball, hand, &Pose::from_translation(start + along * 0.04)), 1.0);
+        assert_eq!(colliders.free_share(ball, hand, &Pose::from_translation(start + along * 0.04), 0.0004), 1.0);
         colliders.move_hand(hand, None);
-        assert_eq!(colliders.free_share(ball, hand, &towards), 1.0);
+        assert_eq!(colliders.free_share(ball, hand, &towards, 0.0004), 1.0);
     }
 
     #[test]

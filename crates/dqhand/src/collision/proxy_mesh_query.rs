@@ -3,9 +3,11 @@
 //! first time of impact of a proxy moving rigidly with the wrist (its wrist stage).
 //!
 //! The nearest triangle is a best-first search of the mesh's tree, each node bounded by the gap
-//! between its box and the proxy's, each triangle measured exactly (a capsule) or in
-//! centimetres (a hull, [`UNIT`]): parry's own distance to a mesh runs GJK in metres, too long
-//! by up to 17 mm against millimetre triangles.
+//! between its box and the proxy's or the proxy's distance to the node's centre, each triangle
+//! first by a cheap bound, then measured exactly (a capsule) or in centimetres (a hull,
+//! [`UNIT`]): parry's own distance to a mesh runs GJK in metres, too long by up to 17 mm
+//! against millimetre triangles. Where only a lower bound is asked above some distance, what
+//! is nearly as near as the best found is passed over ([`SHORT_ABOVE`]).
 //!
 //! The time of impact is conservative advancement (Mirtich 1996) over the triangles the proxy's sweep meets, each
 //! with its own lower bound of the distance: measured exactly at some time, it falls no faster

@@ -19,7 +19,7 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::ManipulatingHand;
-use crate::collision::ObjectColliders;
+use crate::collision::{ObjectColliders, STOP_DISTANCE};
 use crate::gesture::{Events, GestureSet, TwoHandEvent, TwoHandRecognizer};
 use crate::grasp::{Grasp, GraspEvent, GraspParams};
 use crate::input::{GloveMapper, InputConfig, Record, Rejection};
@@ -233,7 +233,7 @@ impl ManipulationLoop {
                 let t = self.objects.above_table(held, q, t);
                 // It stops at a hand that does not hold it (and is not handing it over).
                 let to = parry3d::math::Pose::from_parts(t, q);
-                let share = self.hands.iter().filter(|other| other.grasp.held() != Some(held)).map(|other| self.objects.free_share(held, other.physics, &to)).fold(1.0, f32::min);
+                let share = self.hands.iter().filter(|other| other.grasp.held() != Some(held)).map(|other| self.objects.free_share(held, other.physics, &to, STOP_DISTANCE)).fold(1.0, f32::min);
                 let (q, t) = if share < 1.0 {
                     let (q0, t0) = self.poses[held];
                     (q0.slerp(q, share).normalize(), t0.lerp(t, share))
