@@ -222,6 +222,45 @@ fn glove_and_tracker_records_pose_the_hand() {
     let paper = GloveMapper::new(&table, &calibration, JointModel::Paper).unwrap();
     assert!(InputPipeline::new(&rig(), Some(paper), unfiltered()).is_err());
 }
+/// A stream slower than the grace time (a camera inferring at 1.25 frames a second): with
+/// the grace fixed, every record found the hand lost and blended back from the held pose, so
+/// the hand never moved. The grace follows the stream's rate, and the hand follows it; when
+/// the stream stops, it is lost after that longer grace, and a fast stream's grace is
+/// `grace_s` again.
+#[test]
+fn a_slow_stream_keeps_tracking_and_drives_the_hand() {
+    let config = unfiltered();
+    let mut p = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+    let fist = gesture("fist").unwrap().pose(JointModel::Full);
+    let open = gesture("open_palm").unwrap().pose(JointModel::Full);
+    let interval = 0.8;
+    let (mut now, mut lost_between) = (0.0, 0);
+    for k in 0..12 {
+        let t = f64::from(k) * interval;
+        // The engine's frames advance the hand at 60 Hz between records.
+        while now < t {
+            p.advance(now);
+            lost_between += usize::from(k >= 6 && p.tracking() == Tracking::Lost);
+            now += 1.0 / 60.0;
+        }
+        p.push(&arriving(joints_record(t, if k < 8 { &fist } else { &open }), t)).unwrap();
+    }
+    assert_eq!(lost_between, 0, "tracking lost between the records of a steady slow stream");
+    assert!((p.grace() - 2.5 * interval).abs() < 1e-9, "grace {}", p.grace());
+    assert!(max_diff_deg(p.pose(), &open) < 0.5, "the slow stream drives the hand ({}° off)", max_diff_deg(p.pose(), &open));
+    let last = 11.0 * interval;
+    p.advance(last + p.grace() - 0.01);
+    assert_eq!(p.tracking(), Tracking::Tracking);
+    p.advance(last + p.grace() + 0.01);
+    assert_eq!(p.tracking(), Tracking::Lost);
+    // A stream at 60 Hz: the grace is `grace_s`.
+    let mut fast = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+    for k in 0..20 {
+        let t = f64::from(k) / 60.0;
+        fast.push(&arriving(joints_record(t, &fist), t)).unwrap();
+    }
+    assert_eq!(fast.grace(), config.grace_s);
+}
 
 /// A live sender whose clock jumps ahead is refused; "lost" follows the arrival clock, so no
 /// capture time holds the hand in "tracking"; once lost, a sender that restarted its clock at

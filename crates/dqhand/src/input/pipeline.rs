@@ -13,6 +13,13 @@
 //! not fit the old stream (out of order, late, ahead) starts a new one: a sender that
 //! restarted with its clock at zero, or another sender, is taken after `grace_s`.
 //!
+//! The grace time is at least `grace_s`, and grows with a stream that is slower than it: a
+//! camera inferring at 3 frames a second, or a headset emulated in software, would otherwise
+//! be lost before every record and each record would blend back from the held pose, leaving
+//! the hand frozen. [`GRACE_INTERVALS`] times the median of the last [`INTERVALS`] intervals
+//! between records, once there are [`MIN_INTERVALS`] of them, up to [`MAX_GRACE_S`]: the
+//! median passes over a dropout, so a fast stream that stops is lost after `grace_s` as before.
+//!
 //! Every per-record buffer is made up front: [`InputPipeline::push`] allocates nothing.
 
 use glam::Vec3;
@@ -26,6 +33,15 @@ use crate::math::DualQuat;
 /// How far ahead of the stream's clock a live record may claim to be, seconds: beyond it the
 /// sender's clock jumped (a faster delivery gains milliseconds, not a second).
 pub const MAX_LEAD_S: f64 = 1.0;
+
+/// A stream's grace time is at least this many of its typical intervals between records.
+pub const GRACE_INTERVALS: f64 = 2.5;
+/// How many of the last intervals between records the typical one is the median of.
+pub const INTERVALS: usize = 8;
+/// Intervals measured before the grace time follows the stream's rate.
+pub const MIN_INTERVALS: usize = 4;
+/// The longest grace time a slow stream earns, seconds (a longer `grace_s` is kept).
+pub const MAX_GRACE_S: f64 = 2.0;
 
 /// Whether the hand follows the user.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,6 +97,10 @@ pub struct InputPipeline {
     kept: f32,
     /// When the hand was marked lost (its clock: arrival when live).
     lost_at: f64,
+    /// The last intervals between records of the stream (its clock), a ring, and how many
+    /// were measured.
+    intervals: [f64; INTERVALS],
+    measured: usize,
 }
 
 impl InputPipeline {
@@ -118,6 +138,8 @@ impl InputPipeline {
             side: None,
             kept: 1.0,
             lost_at: 0.0,
+            intervals: [0.0; INTERVALS],
+            measured: 0,
             config,
         })
     }
@@ -132,6 +154,21 @@ impl InputPipeline {
     #[must_use]
     pub fn tracking(&self) -> Tracking {
         self.state
+    }
+
+    /// Seconds without a good record before the hand is lost: `grace_s`, or longer for a slow
+    /// stream (see the module docs).
+    #[must_use]
+    pub fn grace(&self) -> f64 {
+        if self.measured < MIN_INTERVALS {
+            return self.config.grace_s;
+        }
+        let n = self.measured.min(INTERVALS);
+        let mut sorted = self.intervals;
+        let sorted = &mut sorted[..n];
+        sorted.sort_unstable_by(f64::total_cmp);
+        let median = if n % 2 == 1 { sorted[n / 2] } else { (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0 };
+        self.config.grace_s.max((GRACE_INTERVALS * median).min(MAX_GRACE_S))
     }
 
     /// The refused records so far, by kind.
@@ -176,17 +213,18 @@ impl InputPipeline {
         self.rejections.add(rejection);
     }
 
-    /// Marks the hand lost if no good record came for the grace time before `now` (the local
+    /// Marks the hand lost if no good record came for the [`Self::grace`] time before `now` (the local
     /// arrival clock of [`Self::push`] on a live stream, the records' clock for a file), and
     /// relaxes a hand lost for `rest_after_s` more: its angles ease to rest over `recover_s`,
     /// its wrist stays. Returns whether the pose to show changed. Allocates nothing.
     pub fn advance(&mut self, now: f64) -> bool {
         if self.state == Tracking::Tracking {
             let Some(last) = self.last_arrival.or(self.last_time) else { return false };
-            if now - last <= self.config.grace_s {
+            let grace = self.grace();
+            if now - last <= grace {
                 return false;
             }
-            (self.state, self.lost_at, self.kept) = (Tracking::Lost, last + self.config.grace_s, 1.0);
+            (self.state, self.lost_at, self.kept) = (Tracking::Lost, last + grace, 1.0);
             self.held.clone_from(&self.output);
         }
         // Timed from the loss itself: a record refused meanwhile may have cleared the clocks.
@@ -227,10 +265,20 @@ impl InputPipeline {
     fn take(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
         let t = record.time;
         if arrival.is_some() && self.state == Tracking::Lost && self.fit(t, arrival).is_err() {
-            (self.last_time, self.last_arrival, self.clock_offset) = (None, None, None); // a new stream
+            // A new stream, at a rate of its own.
+            (self.last_time, self.last_arrival, self.clock_offset, self.measured) = (None, None, None, 0);
         }
         let fastest = self.fit(t, arrival)?;
         self.solve(record)?;
+        // The interval on the clock loss is judged on: arrival when live, capture from a file.
+        let since = match arrival {
+            Some(a) => self.last_arrival.map(|last| a - last),
+            None => self.last_time.filter(|_| self.last_arrival.is_none()).map(|last| t - last),
+        };
+        if let Some(interval) = since {
+            self.intervals[self.measured % INTERVALS] = interval;
+            self.measured += 1;
+        }
         self.clock_offset = fastest;
         self.last_arrival = arrival;
         let dt = self.last_time.map_or(0.0, |last| (t - last) as f32);
