@@ -55,3 +55,42 @@ export function stampFrame(rgba, w, k) {
     for (let y = 0; y < bh; y++) for (let x = b * bw; x < (b + 1) * bw; x++) rgba.fill(v, 4 * (y * w + x), 4 * (y * w + x) + 3);
   }
 }
+
+/**
+ * A video of both of a user's hands from one of the right hand (`C420jpeg`, even width): each
+ * frame beside its mirror image, twice as wide. A camera facing the user sees their right hand
+ * on its left, so the frame stays on the left (its number stays readable in the top-left
+ * corner) and the mirrored one, their left hand, goes on the right. Returns the new size.
+ * @param {Buffer} y4m - the right hand's video, a whole YUV4MPEG2 file
+ * @returns {{ y4m: Buffer, size: [number, number] }}
+ */
+export function besideItsMirror(y4m) {
+  const headerEnd = y4m.indexOf(0x0a);
+  const header = y4m.subarray(0, headerEnd).toString('latin1');
+  const w = Number(/ W(\d+)/.exec(header)?.[1]);
+  const h = Number(/ H(\d+)/.exec(header)?.[1]);
+  if (!header.startsWith('YUV4MPEG2') || !header.includes('C420jpeg') || !(w > 0 && h > 0) || w % 2 || h % 2) throw new Error(`not a 4:2:0 YUV4MPEG2 video of even size: ${header}`);
+  const planes = [[w, h], [w / 2, h / 2], [w / 2, h / 2]];
+  const frameBytes = (w * h * 3) / 2;
+  const out = [Buffer.from(header.replace(` W${w}`, ` W${2 * w}`) + '\n', 'latin1')];
+  let at = headerEnd + 1;
+  while (at < y4m.length) {
+    const line = y4m.indexOf(0x0a, at);
+    if (y4m.subarray(at, line).toString('latin1') !== 'FRAME') throw new Error(`no FRAME at byte ${at}`);
+    out.push(Buffer.from('FRAME\n', 'latin1'));
+    let from = line + 1;
+    if (from + frameBytes > y4m.length) throw new Error(`a frame cut short at byte ${from}`);
+    for (const [pw, ph] of planes) {
+      const plane = Buffer.alloc(2 * pw * ph);
+      for (let y = 0; y < ph; y++) {
+        const row = y4m.subarray(from + y * pw, from + (y + 1) * pw);
+        row.copy(plane, 2 * pw * y);
+        for (let x = 0; x < pw; x++) plane[2 * pw * y + 2 * pw - 1 - x] = row[x];
+      }
+      out.push(plane);
+      from += pw * ph;
+    }
+    at = from;
+  }
+  return { y4m: Buffer.concat(out), size: [2 * w, h] };
+}

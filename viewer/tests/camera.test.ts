@@ -20,7 +20,7 @@ import path from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
 import { dqhandBin, launchBrowser, newPage, root, serveStatic, startServer, waitState } from '../scripts/harness.mjs';
-import { MARKER } from '../scripts/y4m.mjs';
+import { MARKER, besideItsMirror } from '../scripts/y4m.mjs';
 
 type Server = Awaited<ReturnType<typeof startServer>>;
 let staticServer: Awaited<ReturnType<typeof serveStatic>>;
@@ -33,7 +33,7 @@ interface Labels {
   fps: number;
   frames: number;
   size: [number, number];
-  side: 'left' | 'right';
+  side: 'left' | 'right' | 'both';
   gestures: Hold[];
 }
 interface Sample {
@@ -45,6 +45,8 @@ interface Sample {
   tracking: string;
   side: string | null;
   anglesDeg: number[];
+  /** Each engine hand's state (two hands in a scene: the right one first). */
+  hands: { side: string; tracking: string; gesture: string | null }[] | null;
 }
 
 /**
@@ -123,11 +125,11 @@ function watchFrames([marker, size]: [typeof MARKER, [number, number]]): void {
  * which records them), or on a plain static server (no dqhand process: the page's own engine,
  * given the tests' input configuration in its URL; Record downloads the file).
  */
-async function cameraPage(video: string, size: [number, number], host: 'server' | 'static' = 'server'): Promise<{ browser: Browser; page: Page }> {
+async function cameraPage(video: string, size: [number, number], host: 'server' | 'static' = 'server', query = ''): Promise<{ browser: Browser; page: Page }> {
   const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
   const p = await newPage(b, { width: 1100, height: 700 });
   await p.addInitScript(watchFrames, [MARKER, size] as [typeof MARKER, [number, number]]);
-  await p.goto(host === 'server' ? server.url : `${staticServer.url}?config=${encodeURIComponent(JSON.stringify(CONFIG))}`);
+  await p.goto(host === 'server' ? server.url : `${staticServer.url}?config=${encodeURIComponent(JSON.stringify(CONFIG))}${query}`);
   await waitState(p, 's.connected && s.frame !== null');
   const s = await read<{ engine: string; relay: object | null }>(p);
   expect([s.engine, s.relay !== null]).toEqual(['page', host === 'server']);
@@ -210,11 +212,11 @@ async function sample(p: Page, seconds: number, v: Labels): Promise<Sample[]> {
   const raw = await p.evaluate(
     (seconds) =>
       new Promise<(Omit<Sample, 'video'> & { pageAt: number })[]>((done) => {
-        const w = window as unknown as { dqhand: { state(): { input: { gesture: string | null; tracking: string; side: string | null } | null; frame: { anglesDeg: number[] } | null } } };
+        const w = window as unknown as { dqhand: { state(): { input: { gesture: string | null; tracking: string; side: string | null; hands: Sample['hands'] } | null; frame: { anglesDeg: number[] } | null } } };
         const samples: (Omit<Sample, 'video'> & { pageAt: number })[] = [];
         const timer = setInterval(() => {
           const s = w.dqhand.state();
-          samples.push({ at: Date.now(), pageAt: performance.now(), gesture: s.input?.gesture ?? null, tracking: s.input?.tracking ?? 'none', side: s.input?.side ?? null, anglesDeg: s.frame?.anglesDeg ?? [] });
+          samples.push({ at: Date.now(), pageAt: performance.now(), gesture: s.input?.gesture ?? null, tracking: s.input?.tracking ?? 'none', side: s.input?.side ?? null, anglesDeg: s.frame?.anglesDeg ?? [], hands: s.input?.hands ?? null });
         }, 100);
         setTimeout(() => {
           clearInterval(timer);
@@ -458,6 +460,50 @@ describe('the Camera button on a video of our own hand, mirrored: a left hand', 
       expect((counts.fist ?? 0) / n, `${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
     }
     await leftPage.click('#camera');
+  });
+});
+
+describe('the Camera button on a video of both hands: each drives the engine hand of its side', () => {
+  let bothLabels: Labels;
+  let bothBrowser: Browser;
+  let bothPage: Page;
+
+  beforeAll(async () => {
+    // Our hand's video beside its mirror image: the user's right hand and their left, in the
+    // same gestures at once.
+    const { y4m, size } = besideItsMirror(readFileSync(path.join(dir, 'hand.y4m')));
+    writeFileSync(path.join(dir, 'hands-both.y4m'), y4m);
+    bothLabels = { ...labels, size, side: 'both' };
+    ({ browser: bothBrowser, page: bothPage } = await cameraPage('hands-both.y4m', size, 'static', '&scene=two-hands&hands=2'));
+  });
+
+  afterAll(async () => {
+    await bothBrowser?.close();
+  });
+
+  test('MediaPipe finds both hands, the engine\'s right hand follows the user\'s right and its left the left, and each names the open palm and the fist', async () => {
+    await bothPage.click('#camera');
+    await waitState(bothPage, 's.camera.detected > 3 && s.input !== null && s.input.hands !== null && s.input.hands.length === 2 && s.input.hands.every((h) => h.tracking === "tracking")', 90_000);
+    const samples = await sample(bothPage, (2 * bothLabels.frames) / bothLabels.fps, bothLabels);
+    const s = await read<{ camera: { hands: string[] }; frame: { wrist: number[] }; secondHand: { side: string; wrist: number[] } }>(bothPage);
+    expect([...s.camera.hands].sort()).toEqual(['left', 'right']);
+    // Each engine hand where the user's hand of its side is: the right one to the right (+x).
+    expect(s.secondHand.side).toBe('left');
+    expect(s.frame.wrist[0] - s.secondHand.wrist[0], `right hand at x ${s.frame.wrist[0]}, left at ${s.secondHand.wrist[0]}`).toBeGreaterThan(0.05);
+    const bySide = (side: string) => samples.map((x) => ({ ...x, gesture: x.hands?.find((h) => h.side === side)?.gesture ?? null, tracking: x.hands?.find((h) => h.side === side)?.tracking ?? 'none' }));
+    const report = Object.fromEntries(['right', 'left'].map((side) => [side, bothLabels.gestures.map((hold) => ({ ...hold, shown: shown(inHold(bySide(side), hold)) }))]));
+    console.log(`camera, both hands: shown in each hold: ${JSON.stringify(report)}`);
+    for (const side of ['right', 'left']) {
+      const tracked = bySide(side).filter((x) => x.tracking === 'tracking');
+      expect(tracked.length / samples.length, side).toBeGreaterThan(0.8);
+      // The open palm and the fist named on NAMED_SHARE of each of their holds' samples, by each hand.
+      for (const { gesture, shown: counts } of report[side].filter((r) => r.gesture === 'fist' || r.gesture === 'open_palm')) {
+        const n = Object.values(counts).reduce((a, b) => a + b, 0);
+        expect(n, `${side} ${gesture}`).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
+        expect((counts[gesture] ?? 0) / n, `${side} ${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
+      }
+    }
+    await bothPage.click('#camera');
   });
 });
 
