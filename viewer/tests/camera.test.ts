@@ -50,8 +50,10 @@ interface Sample {
 }
 
 /**
- * The input configuration of these tests: a longer grace time than the default 0.25 s, since
- * MediaPipe in software WebGL on a small CI machine gives ~5 frames a second, not a webcam's 30.
+ * The input configuration of these tests: a grace time of 1.5 s. MediaPipe in software WebGL on
+ * a small CI machine gives 2-6 frames a second, not a webcam's 30, with longer stalls now and
+ * then; the engine's own grace follows a slow stream's rate (2.5 of its intervals) but these
+ * tests' waits were measured with this one, and the XR test's two hands run on the default.
  */
 const CONFIG = { grace_s: 1.5 };
 /**
@@ -126,6 +128,7 @@ function watchFrames([marker, size]: [typeof MARKER, [number, number]]): void {
  * given the tests' input configuration in its URL; Record downloads the file).
  */
 async function cameraPage(video: string, size: [number, number], host: 'server' | 'static' = 'server', query = ''): Promise<{ browser: Browser; page: Page }> {
+  if (query && host === 'server') throw new Error('a page on dqhand demo takes the demo\'s settings, not a query');
   const b = await launchBrowser(['--use-fake-device-for-media-stream', '--use-fake-ui-for-media-stream', `--use-file-for-fake-video-capture=${path.join(dir, video)}`]);
   const p = await newPage(b, { width: 1100, height: 700 });
   await p.addInitScript(watchFrames, [MARKER, size] as [typeof MARKER, [number, number]]);
@@ -420,6 +423,11 @@ describe('the Camera button on a video of our own hand', () => {
     // The engine blends to rest: every angle back to zero.
     await waitState(page, 's.frame.anglesDeg.every((a) => Math.abs(a) < 0.5)', 10_000);
   });
+
+  // Done with this page: the next describes' pages run MediaPipe and draw alone (software WebGL).
+  afterAll(async () => {
+    await page?.close();
+  });
 });
 
 describe('the Camera button on a video of our own hand, mirrored: a left hand', () => {
@@ -485,11 +493,12 @@ describe('the Camera button on a video of both hands: each drives the engine han
     await bothPage.click('#camera');
     await waitState(bothPage, 's.camera.detected > 3 && s.input !== null && s.input.hands !== null && s.input.hands.length === 2 && s.input.hands.every((h) => h.tracking === "tracking")', 90_000);
     const samples = await sample(bothPage, (2 * bothLabels.frames) / bothLabels.fps, bothLabels);
-    const s = await read<{ camera: { hands: string[] }; frame: { wrist: number[] }; secondHand: { side: string; wrist: number[] } }>(bothPage);
+    const s = await read<{ camera: { hands: string[] }; frame: { wrist: number[] } | null; secondHand: { side: string; wrist: number[] | null } | null }>(bothPage);
     expect([...s.camera.hands].sort()).toEqual(['left', 'right']);
     // Each engine hand where the user's hand of its side is: the right one to the right (+x).
-    expect(s.secondHand.side).toBe('left');
-    expect(s.frame.wrist[0] - s.secondHand.wrist[0], `right hand at x ${s.frame.wrist[0]}, left at ${s.secondHand.wrist[0]}`).toBeGreaterThan(0.05);
+    expect(s.secondHand!.side).toBe('left');
+    const [right, left] = [s.frame!.wrist[0], s.secondHand!.wrist![0]];
+    expect(right - left, `right hand at x ${right}, left at ${left}`).toBeGreaterThan(0.05);
     const bySide = (side: string) => samples.map((x) => ({ ...x, gesture: x.hands?.find((h) => h.side === side)?.gesture ?? null, tracking: x.hands?.find((h) => h.side === side)?.tracking ?? 'none' }));
     const report = Object.fromEntries(['right', 'left'].map((side) => [side, bothLabels.gestures.map((hold) => ({ ...hold, shown: shown(inHold(bySide(side), hold)) }))]));
     console.log(`camera, both hands: shown in each hold: ${JSON.stringify(report)}`);

@@ -253,13 +253,48 @@ fn a_slow_stream_keeps_tracking_and_drives_the_hand() {
     assert_eq!(p.tracking(), Tracking::Tracking);
     p.advance(last + p.grace() + 0.01);
     assert_eq!(p.tracking(), Tracking::Lost);
-    // A stream at 60 Hz: the grace is `grace_s`.
-    let mut fast = InputPipeline::new(&rig(), None, config.clone()).unwrap();
-    for k in 0..20 {
-        let t = f64::from(k) / 60.0;
-        fast.push(&arriving(joints_record(t, &fist), t)).unwrap();
+    // The sender restarts its clock: a new stream, `grace_s` until its rate is known again.
+    p.push(&arriving(joints_record(0.0, &fist), 100.0)).unwrap();
+    assert_eq!(p.grace(), config.grace_s, "a new stream's grace");
+}
+
+/// The grace time of a stream: `grace_s` until 4 intervals are known, then 2.5 times their
+/// median (capped at 2 s), on the arrival clock live and the capture clock from a file; a fast
+/// stream's dropout does not lengthen it.
+#[test]
+fn the_grace_time_follows_the_streams_rate() {
+    let config = unfiltered();
+    let fist = gesture("fist").unwrap().pose(JointModel::Full);
+    // `interval` apart, live (arriving 50 ms after capture) or from a file; the grace after each.
+    let graces = |interval: f64, live: bool, records: usize| {
+        let mut p = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+        (0..records)
+            .map(|k| {
+                let t = k as f64 * interval;
+                let record = joints_record(t, &fist);
+                p.push(&if live { arriving(record, t + 0.05) } else { record }).unwrap();
+                p.grace()
+            })
+            .collect::<Vec<_>>()
+    };
+    for live in [true, false] {
+        let g = graces(0.4, live, 8);
+        assert!(g[..4].iter().all(|&x| x == config.grace_s), "live {live}: before 4 intervals {g:?}");
+        assert!(g[4..].iter().all(|&x| (x - 1.0).abs() < 1e-9), "live {live}: 2.5 × 0.4 s {g:?}");
+        assert_eq!(graces(1.5, live, 6)[5], 2.0, "live {live}: the cap");
+        assert_eq!(graces(1.0 / 60.0, live, 20)[19], config.grace_s, "live {live}: a fast stream");
     }
-    assert_eq!(fast.grace(), config.grace_s);
+    // A fast stream with one 3 s gap in its records (the hand lost and found) keeps `grace_s`,
+    // and is lost that long after its records stop.
+    let mut p = InputPipeline::new(&rig(), None, config.clone()).unwrap();
+    let times = (0..20).map(|k| f64::from(k) / 60.0).chain((0..20).map(|k| 3.5 + f64::from(k) / 60.0));
+    for t in times {
+        p.push(&arriving(joints_record(t, &fist), t)).unwrap();
+    }
+    assert_eq!(p.grace(), config.grace_s);
+    let last = 3.5 + 19.0 / 60.0;
+    p.advance(last + config.grace_s + 0.01);
+    assert_eq!(p.tracking(), Tracking::Lost);
 }
 
 /// A live sender whose clock jumps ahead is refused; "lost" follows the arrival clock, so no

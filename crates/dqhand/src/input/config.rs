@@ -29,8 +29,8 @@ pub struct InputConfig {
     /// One Euro filter on the wrist orientation (on the sphere, radians).
     pub rotation_filter: OneEuroParams,
     /// Seconds without a good record before the hand is marked "tracking lost" (it holds its
-    /// last good pose meanwhile); a stream slower than this earns a longer grace, 2.5 of its
-    /// intervals up to 2 s ([`super::InputPipeline::grace`]).
+    /// last good pose meanwhile); a slow stream (records more than `grace_s` / 2.5 apart) earns
+    /// a longer grace, 2.5 of its intervals up to 2 s ([`super::InputPipeline::grace`]).
     pub grace_s: f64,
     /// Seconds over which the hand blends from the held pose back to the tracked one (and,
     /// lost, to rest).

@@ -11,14 +11,15 @@
 //! jump of the sender's clock and out of range. "Tracking lost" is judged on the arrival
 //! clock, so no capture time can hold the hand in "tracking". Once lost, a record that does
 //! not fit the old stream (out of order, late, ahead) starts a new one: a sender that
-//! restarted with its clock at zero, or another sender, is taken after `grace_s`.
+//! restarted with its clock at zero, or another sender, is taken after the grace time.
 //!
-//! The grace time is at least `grace_s`, and grows with a stream that is slower than it: a
-//! camera inferring at 3 frames a second, or a headset emulated in software, would otherwise
-//! be lost before every record and each record would blend back from the held pose, leaving
-//! the hand frozen. [`GRACE_INTERVALS`] times the median of the last [`INTERVALS`] intervals
-//! between records, once there are [`MIN_INTERVALS`] of them, up to [`MAX_GRACE_S`]: the
-//! median passes over a dropout, so a fast stream that stops is lost after `grace_s` as before.
+//! The grace time is at least `grace_s`, and grows with a slow stream (records more than
+//! `grace_s` / [`GRACE_INTERVALS`] apart): a camera inferring at 3 frames a second, or a
+//! headset emulated in software, would otherwise be lost before every record and each record
+//! would blend back from the held pose, leaving the hand frozen. [`GRACE_INTERVALS`] times
+//! the median of the last [`INTERVALS`] intervals between records, once there are
+//! [`MIN_INTERVALS`] of them, up to [`MAX_GRACE_S`]: the median passes over a dropout, so a
+//! fast stream that stops is lost after `grace_s` as before.
 //!
 //! Every per-record buffer is made up front: [`InputPipeline::push`] allocates nothing.
 
@@ -264,12 +265,18 @@ impl InputPipeline {
 
     fn take(&mut self, record: &Record, arrival: Option<f64>) -> Result<(), Rejection> {
         let t = record.time;
-        if arrival.is_some() && self.state == Tracking::Lost && self.fit(t, arrival).is_err() {
-            // A new stream, at a rate of its own.
-            (self.last_time, self.last_arrival, self.clock_offset, self.measured) = (None, None, None, 0);
-        }
-        let fastest = self.fit(t, arrival)?;
+        // A lost hand's record that does not fit the old stream starts a new one, at a rate of
+        // its own; its clocks are reset only once it is taken (a live recording keeps only the
+        // records taken: a refused one must leave nothing that a replay would not).
+        let new_stream = arrival.filter(|_| self.state == Tracking::Lost && self.fit(t, arrival).is_err());
+        let fastest = match new_stream {
+            Some(a) => Some(a - t),
+            None => self.fit(t, arrival)?,
+        };
         self.solve(record)?;
+        if new_stream.is_some() {
+            (self.last_time, self.last_arrival, self.measured) = (None, None, 0);
+        }
         // The interval on the clock loss is judged on: arrival when live, capture from a file.
         let since = match arrival {
             Some(a) => self.last_arrival.map(|last| a - last),
