@@ -124,8 +124,8 @@ fn a_hand_lost_for_good_relaxes_its_fingers_where_it_was() {
     p.advance(0.1 + grace + rest_after - 0.01);
     assert_eq!(p.tracking(), Tracking::Lost);
     assert!(max_diff_deg(p.pose(), &fist) < 0.5, "a short dropout holds the pose");
-    // A record of another stream (its clock restarted) that is refused leaves no clock of a
-    // last record: the relax is timed from the loss all the same.
+    // A record of another stream (its clock restarted) that is refused changes nothing: the
+    // relax is timed from the loss all the same.
     let mut unusable = joints_record(0.0, &fist);
     let Some(HandData::Joints(set)) = &mut unusable.hand else { unreachable!() };
     for i in 0..25 {

@@ -228,7 +228,7 @@ impl InputPipeline {
             (self.state, self.lost_at, self.kept) = (Tracking::Lost, last + grace, 1.0);
             self.held.clone_from(&self.output);
         }
-        // Timed from the loss itself: a record refused meanwhile may have cleared the clocks.
+        // Timed from the loss itself, not from the clocks of the records since.
         let relaxing = now - self.lost_at - self.config.rest_after_s;
         if self.state != Tracking::Lost || relaxing <= 0.0 {
             return false;
