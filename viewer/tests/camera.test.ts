@@ -242,6 +242,18 @@ function shown(samples: Sample[]): Record<string, number> {
   return counts;
 }
 
+/**
+ * Asserts that each hold of `report` showing one of `gestures` has MIN_HOLD_SAMPLES samples or
+ * more, and shows its gesture on NAMED_SHARE of them (`label` names the hand in a failure).
+ */
+function expectNamed(report: (Hold & { shown: Record<string, number> })[], gestures: string[], label = ''): void {
+  for (const { gesture, shown: counts } of report.filter((r) => gestures.includes(r.gesture))) {
+    const n = Object.values(counts).reduce((a, b) => a + b, 0);
+    expect(n, `${label}${gesture}`).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
+    expect((counts[gesture] ?? 0) / n, `${label}${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
+  }
+}
+
 /** Mean difference of two poses' angles (degrees) under which a pose has reached the other. */
 const REACHED_DEG = 10;
 
@@ -462,11 +474,7 @@ describe('the Camera button on a video of our own hand, mirrored: a left hand', 
     const report = leftLabels.gestures.map((hold) => ({ ...hold, shown: shown(inHold(samples, hold)) }));
     console.log(`camera, left: shown in each hold: ${JSON.stringify(report)}`);
     expect(samples.some((s) => s.gesture === 'open_palm'), JSON.stringify(report)).toBe(true);
-    for (const { gesture, shown: counts } of report.filter((r) => r.gesture === 'fist')) {
-      const n = Object.values(counts).reduce((a, b) => a + b, 0);
-      expect(n, gesture).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
-      expect((counts.fist ?? 0) / n, `${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
-    }
+    expectNamed(report, ['fist']);
     await leftPage.click('#camera');
   });
 });
@@ -499,18 +507,18 @@ describe('the Camera button on a video of both hands: each drives the engine han
     expect(s.secondHand!.side).toBe('left');
     const [right, left] = [s.frame!.wrist[0], s.secondHand!.wrist![0]];
     expect(right - left, `right hand at x ${right}, left at ${left}`).toBeGreaterThan(0.05);
-    const bySide = (side: string) => samples.map((x) => ({ ...x, gesture: x.hands?.find((h) => h.side === side)?.gesture ?? null, tracking: x.hands?.find((h) => h.side === side)?.tracking ?? 'none' }));
+    const bySide = (side: string) =>
+      samples.map((x) => {
+        const hand = x.hands?.find((h) => h.side === side);
+        return { ...x, gesture: hand?.gesture ?? null, tracking: hand?.tracking ?? 'none' };
+      });
     const report = Object.fromEntries(['right', 'left'].map((side) => [side, bothLabels.gestures.map((hold) => ({ ...hold, shown: shown(inHold(bySide(side), hold)) }))]));
     console.log(`camera, both hands: shown in each hold: ${JSON.stringify(report)}`);
     for (const side of ['right', 'left']) {
       const tracked = bySide(side).filter((x) => x.tracking === 'tracking');
       expect(tracked.length / samples.length, side).toBeGreaterThan(0.8);
       // The open palm and the fist named on NAMED_SHARE of each of their holds' samples, by each hand.
-      for (const { gesture, shown: counts } of report[side].filter((r) => r.gesture === 'fist' || r.gesture === 'open_palm')) {
-        const n = Object.values(counts).reduce((a, b) => a + b, 0);
-        expect(n, `${side} ${gesture}`).toBeGreaterThanOrEqual(MIN_HOLD_SAMPLES);
-        expect((counts[gesture] ?? 0) / n, `${side} ${gesture}: ${JSON.stringify(counts)}`).toBeGreaterThanOrEqual(NAMED_SHARE);
-      }
+      expectNamed(report[side], ['fist', 'open_palm'], `${side} `);
     }
     await bothPage.click('#camera');
   });
