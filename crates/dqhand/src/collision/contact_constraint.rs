@@ -393,7 +393,7 @@ impl ContactConstraint {
             // The arc a turning point sweeps bulges out of the two end boxes by at most
             // radius · angle / 2.
             let bulge = radius * angvel.length().min(core::f32::consts::PI) / 2.0;
-            let swept = p.shape.compute_swept_aabb(&from, &to).loosened(bulge);
+            let swept = p.swept_aabb(&from, &to).loosened(bulge);
             let motion = NonlinearRigidMotion::new(from, offset.inverse().transform_point3(Vec3::ZERO), linvel, angvel);
             // How far any of its points can move before `toi`: a surface farther than that
             // from where it starts cannot be reached (one distance query, where the cast
@@ -449,7 +449,7 @@ impl ContactConstraint {
         let at = Affine3A::from_rotation_translation(r, t) * self.tracked_world[self.kinematics.rig().wrist()].inverse();
         self.proxies.colliders().iter().all(|p| {
             let pose = pose_of(&(at * self.tracked_world[p.joint]));
-            let aabb = p.shape.compute_aabb(&pose);
+            let aabb = p.aabb(&pose);
             objects.near(&aabb, 0.0, held).all(|(_, o)| !query::intersection_test(&pose, &*p.shape, &o.pose, &*o.surface).is_ok_and(|x| x.intersecting))
         })
     }
@@ -632,7 +632,7 @@ impl ContactConstraint {
         }
         for (k, p) in self.proxies.colliders().iter().enumerate() {
             let pose = pose_of(&self.kinematics.world()[p.joint]);
-            let aabb = p.shape.compute_aabb(&pose);
+            let aabb = p.aabb(&pose);
             let skip = still_on.map(|(o, _)| o).filter(|_| unmoved(p.joint));
             for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, skip).filter(|(i, _)| *i < objects.objects().len()) {
                 if let Some(mesh) = o.surface.as_trimesh() {

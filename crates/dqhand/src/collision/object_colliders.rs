@@ -138,8 +138,9 @@ pub struct ObjectColliders {
     /// The objects, then the table's slab when there is one, then each hand's proxies.
     all: Vec<ObjectCollider>,
     count: usize,
-    /// Per hand: where its proxies are in `all`, their joints, and whether it is there.
-    hands: Vec<(core::ops::Range<usize>, Vec<usize>, bool)>,
+    /// Per hand: where its proxies are in `all`, their joints and boxes in the joints'
+    /// frames, and whether it is there.
+    hands: Vec<(core::ops::Range<usize>, Vec<(usize, Aabb)>, bool)>,
     /// The hand being solved: its own proxies are no obstacle to it.
     solving: Option<usize>,
     table: Option<TableTop>,
@@ -280,10 +281,10 @@ impl ObjectColliders {
         let start = self.all.len();
         for p in proxies.colliders() {
             let pose = Pose::IDENTITY;
-            let aabb = p.shape.compute_aabb(&pose);
+            let aabb = p.aabb(&pose);
             self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb, hull_support: None });
         }
-        self.hands.push((start..self.all.len(), proxies.colliders().iter().map(|p| p.joint).collect(), false));
+        self.hands.push((start..self.all.len(), proxies.colliders().iter().map(|p| (p.joint, p.aabb(&Pose::IDENTITY))).collect(), false));
         self.hands.len() - 1
     }
 
@@ -293,9 +294,10 @@ impl ObjectColliders {
         let (range, joints, there) = &mut self.hands[hand];
         *there = world.is_some();
         let Some(world) = world else { return };
-        for (o, &j) in self.all[range.clone()].iter_mut().zip(joints.iter()) {
-            o.pose = pose_of(&world[j]);
-            o.aabb = o.surface.compute_aabb(&o.pose);
+        for (o, (j, local)) in self.all[range.clone()].iter_mut().zip(joints.iter()) {
+            o.pose = pose_of(&world[*j]);
+            // (A hull's box turned: parry's transforms each of its vertices.)
+            o.aabb = local.transform_by(&o.pose);
         }
     }
 
