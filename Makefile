@@ -15,7 +15,7 @@ HAND_FILES := viewer/public/hands/right.glb viewer/public/hands/left.glb
 # The engine's web builds as the npm package and the page load them (make package-wasm).
 PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
-.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package
+.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -147,11 +147,18 @@ package: package-wasm
 	mkdir -p target/npm
 	cd packages/dqhand && $(NPM) ci --no-audit --no-fund && rm -rf dist && npx tsc -p tsconfig.json && npm pack --pack-destination ../../target/npm
 
+# The npm package `three-dqs` (packages/three-dqs): dual quaternion skinning for any three.js
+# SkinnedMesh, its TypeScript compiled and packed into target/npm/three-dqs-<version>.tgz; its
+# conformance page and example are built by the browser tests (viewer/tests/dqs.test.ts).
+dqs-package:
+	mkdir -p target/npm
+	cd packages/three-dqs && $(NPM) ci --no-audit --no-fund && npx tsc -p tsconfig.test.json && rm -rf dist && npx tsc -p tsconfig.json && npm pack --pack-destination ../../target/npm
+
 # Rust tests (unit, property, golden, CLI, server, doctests; their temporary files, the
 # doctests' binaries among them, under target/ rather than a small /tmp), the features alone and the
 # examples, the Khronos glTF validator on what we write, then the page: protocol unit tests and
 # browser tests against a real `dqhand demo`.
-test: assets viewer chromium recordings package
+test: assets viewer chromium recordings package dqs-package
 	mkdir -p target/tmp
 	DQHAND_REQUIRE_KERNELS=$(DQHAND_REQUIRE_KERNELS) TMPDIR=$(CURDIR)/target/tmp $(CARGO) test --locked --workspace
 	$(MAKE) features examples
@@ -193,6 +200,11 @@ fuzz: assets
 bench: build
 	./target/release/dqhand bench
 	./target/release/dqhand bench --stream 3
+
+# three-dqs beside three.js's own linear skinning in headless Chromium, 1, 10 and 100 hands
+# (docs/performance.md, "Dual quaternion skinning for three.js").
+bench-dqs: build chromium dqs-package
+	cd viewer && CHROMIUM=$(CHROMIUM) node scripts/dqs-bench.mjs
 
 # The engine in WebAssembly timed in headless Chromium beside the native kernels, in one run:
 # deformers of both builds, the page's interaction frame, load to the first drawn hand

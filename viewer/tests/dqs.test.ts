@@ -1,0 +1,161 @@
+// The three-dqs package (packages/three-dqs) on the GPU, in headless Chromium's software WebGL:
+// its conformance page (packages/three-dqs/test) reads back what the package's shader chunks
+// compute for every vertex of the built-in hand, from a float render target, and compares it
+// with dqhand's native DQB of the same frame (`dqhand export-skinning`) and, over random poses
+// (the whole hand turned up to 180°) and poses whose bones scale and shear, with a reference the
+// page writes from the definitions. The same page shows that a shader without the sign
+// alignment fails the comparison. Then the package as a user meets it: its example app,
+// installed from the tarball `make dqs-package` packed, built with Vite, draws a skinned glTF
+// made elsewhere (the WebXR generic hand) with its fingers bent.
+
+import { execFileSync } from 'node:child_process';
+import { copyFileSync, cpSync, mkdirSync, mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { afterAll, beforeAll, describe, expect, test } from 'vitest';
+import type { Browser } from 'playwright-core';
+import { canvasStats, countColour, dqhandBin, launchBrowser, newPage, root, serveStatic, thumbDifference } from '../scripts/harness.mjs';
+
+interface Conformance {
+  size: number;
+  vertices: number;
+  exported: { three: number; lbs: number; dqs: number; dqsNormals: number; cpu: number; blend: number };
+  random: { seed: number; dqs: number; dqsNormals: number; cpu: number; unaligned: number }[];
+  scaled: { seed: number; dqs: number; dqsNormals: number; cpu: number }[];
+}
+
+const PACKAGE = path.join(root, 'packages/three-dqs');
+let browser: Browser;
+let server: Awaited<ReturnType<typeof serveStatic>>;
+let result: Conformance;
+
+beforeAll(async () => {
+  const work = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'three-dqs-'));
+  const page = path.join(work, 'page');
+  execFileSync(path.join(PACKAGE, 'node_modules/.bin/vite'), ['build', '--config', 'test/vite.config.js', '--outDir', page, '--logLevel', 'warn'], { cwd: PACKAGE, stdio: 'inherit' });
+  execFileSync(dqhandBin(), ['export-skinning', '--out', path.join(work, 'rig'), '--frames', '10'], { stdio: 'inherit' });
+  for (const file of ['rig.json', 'rig.bin']) copyFileSync(path.join(work, 'rig', file), path.join(page, file));
+  server = await serveStatic(page);
+  browser = await launchBrowser();
+  const p = await newPage(browser);
+  await p.goto(server.url);
+  await p.waitForFunction(() => document.title === 'ready', null, { timeout: 60_000 });
+  result = await p.evaluate(() => (window as unknown as { conformance(): Promise<Conformance> }).conformance());
+}, 180_000);
+
+afterAll(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+describe('three-dqs on the GPU against dqhand and a reference from the definitions', () => {
+  /** Positions within 1e-4 of the mesh's size; normals within 1e-3 rad. */
+  const positions = () => 1e-4 * result.size;
+  const normals = 1e-3;
+  /** Each pose's GPU positions and normals, and CPU positions, within the bounds. */
+  const expectMatches = (poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[]) => {
+    for (const r of poses) {
+      expect(r.dqs, `seed ${r.seed}`).toBeLessThan(positions());
+      expect(r.dqsNormals, `seed ${r.seed}`).toBeLessThan(normals);
+      expect(r.cpu, `seed ${r.seed}`).toBeLessThan(positions());
+    }
+  };
+
+  test('the read-back itself reproduces three.js\'s own linear skinning and dqhand\'s LB', () => {
+    expect(result.vertices).toBeGreaterThan(8000);
+    expect(result.exported.three).toBeLessThan(positions());
+    expect(result.exported.lbs).toBeLessThan(positions());
+  });
+
+  test('the dual quaternion skin matches dqhand\'s native DQB of the exported frame, positions and normals, on the GPU and the CPU path', () => {
+    expect(result.exported.dqs).toBeLessThan(positions());
+    expect(result.exported.dqsNormals).toBeLessThan(normals);
+    expect(result.exported.cpu).toBeLessThan(positions());
+  });
+
+  test('mode blend follows its vertex attribute: linear where it is 0, dual quaternion where it is 1', () => {
+    expect(result.exported.blend).toBeLessThan(positions());
+  });
+
+  test('random poses turned up to 180° match the reference, GPU and CPU', () => {
+    expect(result.random.length).toBe(6);
+    expectMatches(result.random);
+  });
+
+  test('bones that scale and shear match the reference (scale blended before the rigid part)', () => {
+    expect(result.scaled.length).toBe(3);
+    expectMatches(result.scaled);
+  });
+
+  test('without the sign alignment the same comparison fails: the test can tell', () => {
+    const failing = result.random.filter((r) => r.unaligned > 100 * positions());
+    expect(failing.length, JSON.stringify(result.random.map((r) => r.unaligned))).toBeGreaterThanOrEqual(3);
+  });
+});
+
+interface Example {
+  mode: string;
+  meshes: number;
+  bones: number;
+  programs: string[];
+  box: [number, number, number];
+}
+
+describe('the three-dqs example app installed from the package tarball', () => {
+  const version = JSON.parse(readFileSync(path.join(PACKAGE, 'package.json'), 'utf8')).version as string;
+  let app: string;
+  let site: Awaited<ReturnType<typeof serveStatic>>;
+  const open = async (mode: string) => {
+    const p = await newPage(browser);
+    const errors: string[] = [];
+    p.on('pageerror', (e) => errors.push(e.message));
+    await p.goto(`${site.url}?mode=${mode}`);
+    await p.waitForFunction(() => document.title === 'drawn', null, { timeout: 60_000 });
+    const state = await p.evaluate(() => (window as unknown as { example: Example }).example);
+    return { p, state, errors };
+  };
+
+  beforeAll(() => {
+    app = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'three-dqs-example-'));
+    cpSync(path.join(PACKAGE, 'example'), app, { recursive: true });
+    execFileSync('npm', ['install', '--no-audit', '--no-fund', path.join(root, 'target/npm', `three-dqs-${version}.tgz`)], { cwd: app, stdio: 'inherit' });
+    mkdirSync(path.join(app, 'public'));
+    copyFileSync(path.join(root, 'third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb'), path.join(app, 'public/hand.glb'));
+    execFileSync(path.join(app, 'node_modules/.bin/vite'), ['build', '--logLevel', 'warn'], { cwd: app, stdio: 'inherit' });
+  }, 300_000);
+
+  afterAll(async () => {
+    await site?.stop();
+  });
+
+  test('the installed package needs nothing but three', () => {
+    const installed = JSON.parse(readFileSync(path.join(app, 'node_modules/three-dqs/package.json'), 'utf8'));
+    expect(Object.keys(installed.peerDependencies ?? {})).toEqual(['three']);
+    expect(installed.dependencies ?? {}).toEqual({});
+  });
+
+  test('a glTF hand made elsewhere is drawn with dual quaternions, and differently from linear skinning where its fingers bend', async () => {
+    site = await serveStatic(path.join(app, 'dist'));
+    const dqs = await open('dqs');
+    const lbs = await open('lbs');
+    try {
+      expect(dqs.errors).toEqual([]);
+      expect(dqs.state.meshes).toBe(1);
+      expect(dqs.state.bones).toBeGreaterThanOrEqual(25);
+      expect(dqs.state.programs.some((k) => k.includes('dqs-dqs')), dqs.state.programs.join('\n')).toBe(true);
+      expect(lbs.state.programs.some((k) => k.includes('dqs-')), lbs.state.programs.join('\n')).toBe(false);
+      // The skin is drawn (its lit colour covers part of the frame) in both.
+      const skin = { r: [120, 255], g: [70, 210], b: [50, 190] };
+      const drawn = await countColour(dqs.p, skin);
+      expect(drawn).toBeGreaterThan(2000);
+      expect(await countColour(lbs.p, skin)).toBeGreaterThan(2000);
+      // Both frame the same box within a centimetre (the CPU path skins as the GPU does), and
+      // the pictures differ where the knuckles bend.
+      for (let k = 0; k < 3; k++) expect(Math.abs(dqs.state.box[k] - lbs.state.box[k])).toBeLessThan(0.01);
+      expect(thumbDifference(await canvasStats(dqs.p), await canvasStats(lbs.p))).toBeGreaterThan(0.05);
+    } finally {
+      await dqs.p.close();
+      await lbs.p.close();
+    }
+  });
+});
