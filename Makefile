@@ -167,7 +167,7 @@ test: assets viewer chromium recordings package dqs-package
 
 # docs/figures/*.png: the paper's Figures 5-7 and 9 on our hand, rendered by the real page
 # (Figure 9 makes its own scripted grasp recording with the release binary).
-figures: build viewer chromium
+figures: build viewer chromium dqs-package
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/release/dqhand CHROMIUM=$(CHROMIUM) node scripts/figures.mjs
 
 # Coverage-guided fuzzing of every parser (nightly toolchain + cargo-fuzz), FUZZ_SECONDS each:

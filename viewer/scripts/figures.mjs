@@ -6,9 +6,10 @@
 //   fig7-gestures-{dqb,qb,lb}.png   the daily gestures (Fig. 7)
 //   viewer-split.png      the viewer itself, split view on the fist
 //   fig9-grasp.png        the ball and the Utah teapot grasped, lifted, carried and set down (Fig. 9)
+//   dqs-twist-bend.png    three.js's linear skinning beside three-dqs on a twisted and a bent limb
 //
-// `node scripts/figures.mjs hand` makes the first four only, `… grasp` Figure 9 only; no
-// argument, all of them.
+// `node scripts/figures.mjs hand` makes the first four only, `… grasp` Figure 9 only, `… dqs`
+// the last (it needs `make dqs-package`'s install); no argument, all of them.
 //
 // Joint limits are switched off for Figure 5/6 so the PIP can reach 120° (its range is 0–110°).
 
@@ -16,7 +17,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { dqhandBin, launchBrowser, root, settle, startServer, waitState } from './harness.mjs';
+import { dqhandBin, launchBrowser, root, serveStatic, settle, startServer, waitState } from './harness.mjs';
 
 const out = path.join(root, 'docs/figures');
 mkdirSync(out, { recursive: true });
@@ -31,7 +32,7 @@ const STAGES = [
   { at: (t) => t.carry_end + 0.1, held: true, caption: 'lifted and carried 20 cm' },
   { at: (t) => t.release + 0.75, held: false, caption: 'set down and let go' },
 ];
-const GROUPS = ['hand', 'grasp'];
+const GROUPS = ['hand', 'grasp', 'dqs'];
 const asked = process.argv.slice(2);
 for (const a of asked) if (!GROUPS.includes(a)) throw new Error(`unknown figure group ${JSON.stringify(a)}: ${GROUPS.join(', ')}`);
 const wanted = (group) => asked.length === 0 || asked.includes(group);
@@ -65,6 +66,7 @@ try {
   };
   if (wanted('hand')) await handFigures(compose);
   if (wanted('grasp')) await graspFigure(compose);
+  if (wanted('dqs')) await dqsFigure(compose);
 } finally {
   await browser.close();
 }
@@ -270,6 +272,37 @@ async function graspFigure(compose) {
     });
   } finally {
     await server?.stop();
+    rmSync(work, { recursive: true, force: true });
+  }
+}
+
+/** three.js's linear skinning beside three-dqs (packages/three-dqs, its test page's `?figure`). */
+async function dqsFigure(compose) {
+  const pkg = path.join(root, 'packages/three-dqs');
+  const work = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'dqs-figure-'));
+  execFileSync(path.join(pkg, 'node_modules/.bin/vite'), ['build', '--config', 'test/vite.config.js', '--outDir', work, '--logLevel', 'warn'], { cwd: pkg, stdio: 'inherit' });
+  const server = await serveStatic(work);
+  try {
+    const page = await browser.newPage({ viewport: { width: 400, height: 400 } });
+    await page.goto(`${server.url}?figure`);
+    await page.waitForFunction(() => document.title === 'ready');
+    const shot = async (kind, dual) => {
+      await page.evaluate(([kind, dual]) => window.figure(kind, dual, 360), [kind, dual]);
+      const png = await page.locator('#view').screenshot();
+      return `data:image/png;base64,${png.toString('base64')}`;
+    };
+    const rows = [];
+    for (const [kind, label] of [['twist', 'twisted 150°'], ['bend', 'bent 120°']]) {
+      rows.push({ label, cells: [{ src: await shot(kind, false), caption: "three.js's linear skinning" }, { src: await shot(kind, true), caption: 'three-dqs' }] });
+    }
+    await page.close();
+    await compose('dqs-twist-bend.png', 'Linear and dual quaternion skinning in three.js, a limb on two bones', rows, 2, {
+      size: [300, 300],
+      label: 80,
+      note: 'A cylinder 30 cm long, 3.5 cm in radius, its skin shared by the two bones over 8 cm around the joint. Linear skinning pinches the twist into a candy wrapper and thins the bend; dual quaternions keep the limb round (and bulge a little at the bend\'s outside).',
+    });
+  } finally {
+    await server.stop();
     rmSync(work, { recursive: true, force: true });
   }
 }

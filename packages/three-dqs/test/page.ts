@@ -1,6 +1,12 @@
-// One page for both: `?bench` the speed page (window.bench), else the conformance page
-// (window.conformance). The title says when either is ready.
-const page = new URLSearchParams(location.search).has('bench') ? { bench: (await import('./bench')).bench } : { conformance: (await import('./conformance')).conformance };
+// One page for three: `?bench` the speed page (window.bench), `?figure` the side-by-side
+// pictures (window.figure), else the conformance page (window.conformance). The title says
+// when it is ready.
+const query = new URLSearchParams(location.search);
+const page = query.has('bench')
+  ? { bench: (await import('./bench')).bench }
+  : query.has('figure')
+    ? { figure: (await import('./figure')).figure }
+    : { conformance: (await import('./conformance')).conformance };
 Object.assign(window, page);
 document.title = 'ready';
 export {};
