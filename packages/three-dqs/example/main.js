@@ -1,5 +1,6 @@
 // A skinned glTF (public/hand.glb, or ?model=URL) with its fingers bent 70° at every knuckle,
-// drawn with dual quaternion skinning; ?mode=lbs draws three.js's own linear skinning instead.
+// drawn with dual quaternion skinning and casting its shadow; ?mode=lbs draws three.js's own
+// linear skinning instead.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { useDualQuaternionSkinning } from 'three-dqs';
@@ -10,29 +11,50 @@ const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffe
 renderer.setSize(innerWidth, innerHeight);
 renderer.domElement.id = 'view';
 document.body.append(renderer.domElement);
+renderer.shadowMap.enabled = true;
 const scene = new THREE.Scene();
-scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2), new THREE.DirectionalLight(0xffffff, 2));
+const sun = new THREE.DirectionalLight(0xffffff, 2);
+sun.castShadow = true;
+scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2), sun);
 const camera = new THREE.PerspectiveCamera(40, innerWidth / innerHeight, 0.01, 10);
 
 const gltf = await new GLTFLoader().loadAsync(query.get('model') ?? './hand.glb');
 scene.add(gltf.scene);
 const meshes = [];
-const phalanges = [];
 gltf.scene.traverse((o) => {
   if (o.isSkinnedMesh) meshes.push(o);
-  if (o.isBone && /phalanx/.test(o.name) && !/distal$/.test(o.name)) phalanges.push(o);
 });
-// Bend every finger joint but the metacarpals' by 70° towards the palm: about the axis across
-// the hand (index knuckle to little knuckle), whatever way the model's bones are oriented.
+// Bend each finger's knuckles towards the palm, about the axis across the hand (index knuckle to
+// little knuckle). A joint turns everything beyond it on its finger: glTF hands may keep their
+// joints side by side under one parent (the WebXR generic hand does), so the turn is applied to
+// the joint and to every later one, about the joint, in their parent's frame.
 gltf.scene.updateMatrixWorld(true);
-const at = (name) => gltf.scene.getObjectByName(name)?.getWorldPosition(new THREE.Vector3());
+const joint = (name) => gltf.scene.getObjectByName(name);
+const at = (name) => joint(name)?.getWorldPosition(new THREE.Vector3());
 const across = at('pinky-finger-phalanx-proximal')?.sub(at('index-finger-phalanx-proximal')).normalize() ?? new THREE.Vector3(1, 0, 0);
-for (const bone of phalanges) {
-  const local = across.clone().applyQuaternion(bone.getWorldQuaternion(new THREE.Quaternion()).invert());
-  bone.rotateOnAxis(local, /thumb/.test(bone.name) ? 0.6 : 1.2);
+const fingers = [
+  { chain: ['thumb-phalanx-proximal', 'thumb-phalanx-distal', 'thumb-tip'], bends: [0.5, 0.5] },
+  ...['index', 'middle', 'ring', 'pinky'].map((f) => ({ chain: ['proximal', 'intermediate', 'distal'].map((p) => `${f}-finger-phalanx-${p}`).concat(`${f}-finger-tip`), bends: [1.2, 1.2, 0.4] })),
+];
+for (const { chain, bends } of fingers) {
+  const joints = chain.map(joint);
+  if (joints.some((j) => !j)) continue;
+  bends.forEach((angle, k) => {
+    const pivot = joints[k].position.clone();
+    const parent = joints[k].parent;
+    const axis = across.clone().applyQuaternion(parent.getWorldQuaternion(new THREE.Quaternion()).invert());
+    const turn = new THREE.Quaternion().setFromAxisAngle(axis, -angle);
+    // Joints deeper than this one in the chain, whichever node holds them.
+    for (const j of joints.slice(k)) {
+      if (j.parent !== parent && j !== joints[k]) continue;
+      if (j !== joints[k]) j.position.sub(pivot).applyQuaternion(turn).add(pivot);
+      j.quaternion.premultiply(turn);
+    }
+  });
 }
 for (const mesh of meshes) {
   mesh.material = new THREE.MeshStandardMaterial({ color: 0xe0a98f, roughness: 0.6 });
+  mesh.castShadow = true;
   if (mode === 'dqs') useDualQuaternionSkinning(mesh);
 }
 gltf.scene.updateMatrixWorld(true);
@@ -45,9 +67,19 @@ for (const mesh of meshes) {
 }
 const centre = box.getCenter(new THREE.Vector3());
 const size = box.getSize(new THREE.Vector3()).length();
-// From the little finger's side: the fingers' profile, where linear skinning thins the knuckles.
-camera.position.copy(centre).addScaledVector(across, size * 1.4);
+// From the little finger's side and a little behind: the bent fingers, where linear skinning thins the knuckles.
+camera.position.copy(centre).addScaledVector(across, size).add(new THREE.Vector3(size, size * 0.4, 0));
 camera.lookAt(centre);
+// The light shines over the hand onto a floor beneath it: the hand's shadow is drawn with its
+// skinning too.
+sun.position.copy(centre).add(new THREE.Vector3(0, 2, 0.4));
+sun.target.position.copy(centre);
+scene.add(sun.target);
+const floor = new THREE.Mesh(new THREE.PlaneGeometry(4 * size, 4 * size), new THREE.MeshStandardMaterial({ color: 0x808890 }));
+floor.rotation.x = -Math.PI / 2;
+floor.position.copy(centre).y -= size / 2;
+floor.receiveShadow = true;
+scene.add(floor);
 renderer.render(scene, camera);
 
 window.example = {

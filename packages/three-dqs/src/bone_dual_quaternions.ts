@@ -11,6 +11,9 @@ export const FLOATS_PER_BONE = 20;
 /** How far from the identity a bone's scale–shear may be and still count as rigid. */
 const RIGID = 1e-6;
 
+/** A bone's 3×3 part with a determinant this small is singular (scaled to nothing). */
+const SINGULAR = 1e-12;
+
 /** Texels per bone in {@link BoneDualQuaternions.texture} (one row per bone). */
 export const TEXELS_PER_BONE = FLOATS_PER_BONE / 4;
 
@@ -55,9 +58,11 @@ export class BoneDualQuaternions {
   private split(b: number): void {
     const e = this.full.elements;
     const a = [e[0], e[1], e[2], e[4], e[5], e[6], e[8], e[9], e[10]];
-    // A mirroring bone (negative determinant) has no rotation: its mirror goes into S.
-    const sign = determinant(a) < 0 ? -1 : 1;
-    const r = polarRotation(a.map((x) => x * sign));
+    const det = determinant(a);
+    // A bone scaled to nothing (glTF animations hide parts so) has no rotation to find: it is
+    // all S. A mirroring bone (negative determinant) has no rotation either: its mirror goes
+    // into S.
+    const r = Math.abs(det) < SINGULAR ? [1, 0, 0, 0, 1, 0, 0, 0, 1] : polarRotation(a.map((x) => (det < 0 ? -x : x)));
     this.rotation.set(r[0], r[3], r[6], 0, r[1], r[4], r[7], 0, r[2], r[5], r[8], 0, 0, 0, 0, 1);
     const q = this.quaternion.setFromRotationMatrix(this.rotation);
     const [tx, ty, tz] = [e[12], e[13], e[14]];
@@ -98,7 +103,7 @@ function determinant(m: number[]): number {
 /**
  * The rotation of the polar decomposition `A = R S` of a column-major 3×3 matrix with a
  * positive determinant: Higham's iteration `X ← (X + X⁻ᵀ) / 2`, which converges quadratically
- * (a rigid bone's matrix is already a rotation and stops after one step).
+ * (a rigid bone's matrix, a rotation up to float rounding, stops after two steps).
  */
 function polarRotation(a: number[]): number[] {
   let x = a.slice();

@@ -43,6 +43,8 @@ export class CpuSkinning {
     for (let j = 0; j < 4; j++) {
       const o = offsets[j];
       const w = weights[j];
+      // (An unused influence may name any bone, even one the skeleton lacks.)
+      if (w === 0) continue;
       const aligned = d[o] * d[p] + d[o + 1] * d[p + 1] + d[o + 2] * d[p + 2] + d[o + 3] * d[p + 3] < 0 ? -w : w;
       for (let k = 0; k < 4; k++) {
         this.real[k] += aligned * d[o + k];
@@ -51,14 +53,14 @@ export class CpuSkinning {
       // A rigid bone's scale–shear is the identity (its flag, the first column's w, is 0).
       const scaleOf = (c: number, r: number) => (d[o + 11] === 0 ? Number(c === r) : d[o + 8 + 4 * c + r]);
       for (let c = 0; c < 3; c++) for (let r = 0; r < 3; r++) this.scale[3 * c + r] += w * scaleOf(c, r);
-      if (this.mode !== 'dqs' && w !== 0) {
+      if (this.mode !== 'dqs') {
         const s = [0, 1, 2].map((r) => scaleOf(0, r) * x + scaleOf(1, r) * y + scaleOf(2, r) * z);
         const moved = rotate([d[o], d[o + 1], d[o + 2], d[o + 3]], s);
         const t = translation([d[o], d[o + 1], d[o + 2], d[o + 3]], [d[o + 4], d[o + 5], d[o + 6], d[o + 7]]);
         for (let k = 0; k < 3; k++) this.linear[k] += w * (moved[k] + point * t[k]);
       }
     }
-    const length = Math.hypot(this.real[0], this.real[1], this.real[2], this.real[3]);
+    const length = Math.max(Math.hypot(this.real[0], this.real[1], this.real[2], this.real[3]), 1e-20);
     const q = [0, 1, 2, 3].map((k) => this.real[k] / length);
     const qd = [0, 1, 2, 3].map((k) => this.dual[k] / length);
     const m = this.scale;

@@ -1,4 +1,4 @@
-import type { Material, Skeleton, SkinnedMesh, Vector3, Vector4, WebGLProgramParametersWithUniforms } from 'three';
+import { MeshDepthMaterial, MeshDistanceMaterial, RGBADepthPacking, type Material, type Skeleton, type SkinnedMesh, type Vector3, type Vector4, type WebGLProgramParametersWithUniforms } from 'three';
 import { BoneDualQuaternions } from './bone_dual_quaternions.js';
 import { CpuSkinning } from './cpu_skinning.js';
 import { patchVertexShader, type SkinningMode } from './skinning_chunks.js';
@@ -78,14 +78,16 @@ function patchMaterial(material: Material, mode: SkinningMode, share: boolean): 
     if (done !== mode) throw new Error(`${material.name || material.type}: already skinned in mode '${done}', not '${mode}'`);
     return material;
   }
+  // The material's own hook and key, which a clone does not copy: they stay in force.
+  const before = material.onBeforeCompile;
+  const key = material.customProgramCacheKey;
   const patched = share ? material : material.clone();
-  const before = patched.onBeforeCompile;
-  const key = patched.customProgramCacheKey;
   patched.onBeforeCompile = (shader: WebGLProgramParametersWithUniforms, renderer) => {
     before.call(patched, shader, renderer);
     shader.vertexShader = patchVertexShader(shader.vertexShader, mode);
   };
-  patched.customProgramCacheKey = () => `${key.call(patched)}|dqs-${mode}`;
+  // (three.js's default key is the hook's source, now this wrapper's: the user's goes in.)
+  patched.customProgramCacheKey = () => `${before.toString()}|${key.call(patched)}|dqs-${mode}`;
   patched.needsUpdate = true;
   patchedMaterials.set(patched, mode);
   return patched;
@@ -93,8 +95,9 @@ function patchMaterial(material: Material, mode: SkinningMode, share: boolean): 
 
 /**
  * Skins `mesh` with dual quaternions from now on, on the GPU (WebGLRenderer: its materials'
- * skinning chunks replaced) and on the CPU (`applyBoneTransform`, which raycasting and bounding
- * volumes use). Bones may scale and shear: that part is blended linearly before the rigid
+ * and its shadow depth materials' skinning chunks replaced) and on the CPU
+ * (`applyBoneTransform`, which raycasting and bounding volumes use; they update the skeleton
+ * first, `getVertexPosition` alone reads it as last updated). Bones may scale and shear: that part is blended linearly before the rigid
  * part (Kavan et al. 2008, §4); a mirroring bone's mirror is in that part too. Meshes sharing a
  * skeleton share its dual quaternions, computed once a frame.
  *
@@ -112,20 +115,37 @@ export function useDualQuaternionSkinning(mesh: SkinnedMesh, options: DualQuater
   const state = share(skeleton);
   skeleton.update();
   const cpu = new CpuSkinning(state.bones.data, mode);
-  const original = mesh.material;
+  const original = { material: mesh.material, depth: mesh.customDepthMaterial, distance: mesh.customDistanceMaterial };
   const patch = (m: Material) => patchMaterial(m, mode, options.shareMaterials ?? false);
-  mesh.material = Array.isArray(original) ? original.map(patch) : patch(original);
+  mesh.material = Array.isArray(original.material) ? original.material.map(patch) : patch(original.material);
+  // Shadow maps draw the mesh with their own depth materials, which would read the dual
+  // quaternions as three.js's matrices: the mesh gets patched ones (three.js's defaults for a
+  // shadow's depth, or copies of its own).
+  mesh.customDepthMaterial = patchMaterial(original.depth ?? new MeshDepthMaterial({ depthPacking: RGBADepthPacking }), mode, !original.depth);
+  mesh.customDistanceMaterial = patchMaterial(original.distance ?? new MeshDistanceMaterial(), mode, !original.distance);
   mesh.applyBoneTransform = (index: number, target: Vector3 | Vector4) => {
     cpu.apply(mesh, index, target);
     return target as never;
   };
+  // three.js's own CPU path reads the bones as they are; this one reads the data of the last
+  // skeleton update, so the bounding volumes and raycasting update it first (once per call).
+  const refreshed = (['computeBoundingBox', 'computeBoundingSphere', 'raycast'] as const).map((name) => {
+    const own = mesh[name];
+    mesh[name] = function (this: SkinnedMesh, ...args: unknown[]) {
+      skeleton.update();
+      return (own as (...a: unknown[]) => void).apply(this, args);
+    } as never;
+    return name;
+  });
   return {
     bones: state.bones,
     dispose() {
-      const patched = mesh.material;
-      if (!options.shareMaterials) for (const m of Array.isArray(patched) ? patched : [patched]) m.dispose();
-      mesh.material = original;
-      delete (mesh as { applyBoneTransform?: unknown }).applyBoneTransform;
+      const patched = [mesh.material, mesh.customDepthMaterial, mesh.customDistanceMaterial].flat();
+      if (!options.shareMaterials) for (const m of patched) m?.dispose();
+      mesh.material = original.material;
+      mesh.customDepthMaterial = original.depth;
+      mesh.customDistanceMaterial = original.distance;
+      for (const name of [...refreshed, 'applyBoneTransform']) delete (mesh as unknown as Record<string, unknown>)[name];
       unshare(skeleton, state);
     },
   };

@@ -61,7 +61,8 @@ export const skinbaseVertex = /* glsl */ `
 	vec4 dqsBlendReal = vec4( 0.0 );
 	vec4 dqsBlendDual = vec4( 0.0 );
 	${each((j, c) => `{ float w = dot( dqsReal${j}, dqsPivot ) < 0.0 ? - skinWeight.${c} : skinWeight.${c}; dqsBlendReal += w * dqsReal${j}; dqsBlendDual += w * dqsDual${j}; }`)}
-	float dqsLength = length( dqsBlendReal );
+	// (A vertex with no weight at all keeps a zero transform rather than a division by zero.)
+	float dqsLength = max( length( dqsBlendReal ), 1e-20 );
 	dqsBlendReal /= dqsLength;
 	dqsBlendDual /= dqsLength;
 	mat3 dqsScale = mat3( 1.0 );
@@ -69,7 +70,8 @@ export const skinbaseVertex = /* glsl */ `
 	if ( dqsScaled ) {
 		dqsScale = skinWeight.x * dqsScale0 + skinWeight.y * dqsScale1 + skinWeight.z * dqsScale2 + skinWeight.w * dqsScale3;
 		// Normals: the blended scale–shear's inverse transpose (its cofactors, up to the determinant).
-		dqsNormalScale = mat3( cross( dqsScale[ 1 ], dqsScale[ 2 ] ), cross( dqsScale[ 2 ], dqsScale[ 0 ] ), cross( dqsScale[ 0 ], dqsScale[ 1 ] ) );
+		// The determinant's sign keeps a mirrored normal pointing out.
+		dqsNormalScale = sign( determinant( dqsScale ) ) * mat3( cross( dqsScale[ 1 ], dqsScale[ 2 ] ), cross( dqsScale[ 2 ], dqsScale[ 0 ] ), cross( dqsScale[ 0 ], dqsScale[ 1 ] ) );
 	}
 #endif
 `;

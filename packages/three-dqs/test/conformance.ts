@@ -4,6 +4,7 @@
 // definitions (double precision; it shares no code with the package).
 
 import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { loadRig, type Rig } from './rig';
 import { useDualQuaternionSkinning, type SkinningMode } from '../src/index';
 
@@ -288,6 +289,50 @@ function scaledPose(rig: Rig, seed: number): { matrices: Float32Array; rigid: Fl
   return { matrices, rigid, scales };
 }
 
+/**
+ * The WebXR generic hand (hand.glb beside the page: a skinned glTF from the WebXR input
+ * profiles, made elsewhere) as a rig: its vertices and normals carried into its skeleton's
+ * space by its bind matrix, its own influences; and its bones' matrices in three poses, the
+ * hand turned up to 180° and every joint up to 90° about a random axis.
+ */
+async function outsideHand(): Promise<{ rig: Rig; poses: Float32Array[] }> {
+  const gltf = await new GLTFLoader().loadAsync('hand.glb');
+  let mesh: THREE.SkinnedMesh | undefined;
+  gltf.scene.traverse((o) => {
+    if ((o as THREE.SkinnedMesh).isSkinnedMesh) mesh = o as THREE.SkinnedMesh;
+  });
+  if (!mesh) throw new Error('hand.glb: no skinned mesh');
+  const { geometry, skeleton, bindMatrix } = mesh;
+  const n = geometry.attributes.position.count;
+  const rest = new Float32Array(3 * n);
+  const restNormals = new Float32Array(3 * n);
+  const joint = new Uint32Array(4 * n);
+  const weight = new Float32Array(4 * n);
+  const normalMatrix = new THREE.Matrix3().getNormalMatrix(bindMatrix);
+  const v = new THREE.Vector3();
+  for (let i = 0; i < n; i++) {
+    v.fromBufferAttribute(geometry.attributes.position, i).applyMatrix4(bindMatrix).toArray(rest, 3 * i);
+    v.fromBufferAttribute(geometry.attributes.normal, i).applyMatrix3(normalMatrix).normalize().toArray(restNormals, 3 * i);
+    for (let k = 0; k < 4; k++) {
+      joint[4 * i + k] = geometry.attributes.skinIndex.getComponent(i, k);
+      weight[4 * i + k] = geometry.attributes.skinWeight.getComponent(i, k);
+    }
+  }
+  const empty = new Float32Array(0);
+  const rig: Rig = { vertices: n, joints: skeleton.bones.length, rest, restNormals, joint, weight, triangles: new Uint32Array(0), skinning: empty, lb: empty, dqb: empty, dqbNormals: empty };
+  const poses = [21, 22, 23].map((seed) => {
+    let state = seed;
+    const random = () => ((state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32);
+    const axis = () => new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+    skeleton.pose();
+    skeleton.bones.forEach((bone, j) => bone.quaternion.multiply(new THREE.Quaternion().setFromAxisAngle(axis(), (j === 0 ? Math.PI : Math.PI / 2) * random())));
+    gltf.scene.updateMatrixWorld(true);
+    skeleton.update();
+    return new Float32Array(skeleton.boneMatrices!);
+  });
+  return { rig, poses };
+}
+
 /** Everything the test asserts, measured in one go. */
 export async function conformance() {
   const rig = await loadRig();
@@ -326,5 +371,16 @@ export async function conformance() {
       cpu: worst(cpuPositions(rig, pose.matrices), ref.positions),
     });
   }
-  return { size, vertices: rig.vertices, exported, random, scaled };
+  const outside = await outsideHand();
+  const outsideSize = new THREE.Box3().setFromArray(outside.rig.rest).getSize(new THREE.Vector3()).length();
+  const generic = outside.poses.map((pose, k) => {
+    const ref = reference(outside.rig, pose);
+    return {
+      seed: 21 + k,
+      dqs: worst(readBack(outside.rig, pose, 'dqs', 'position'), ref.positions),
+      dqsNormals: worst(readBack(outside.rig, pose, 'dqs', 'normal'), ref.normals, true),
+      cpu: worst(cpuPositions(outside.rig, pose), ref.positions),
+    };
+  });
+  return { size, vertices: rig.vertices, exported, random, scaled, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
 }
