@@ -61,6 +61,9 @@ const DRIP_WAIT: Duration = Duration::from_secs(15);
 /// How long a viewer that does not read is watched for the server to close it (the server's
 /// limits: a send blocked for 5 s, or 15 s without a sign of life).
 const SLOW_READER_WAIT: Duration = Duration::from_secs(30);
+/// How long the relay's pages are given to receive the records still on their way once the
+/// sender stops.
+const DELIVERY_WAIT: Duration = Duration::from_secs(5);
 /// How long the flood's client waits for the errors still owed once it stops sending.
 const ANSWER_WAIT: Duration = Duration::from_secs(10);
 
@@ -95,7 +98,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let t = Instant::now();
         let sent = send_records(a, clock, period)?;
         let cpu_share = (server.cpu_ns() - cpu) as f64 / t.elapsed().as_nanos() as f64;
-        std::thread::sleep(Duration::from_millis(500)); // the last records' way to the pages
+        // The last records' way to the pages: until every page has them all, or a record is
+        // lost (a machine busy with other work can hold a page's thread for a while).
+        let deliver = Instant::now();
+        while deliver.elapsed() < DELIVERY_WAIT && pages.iter().any(|p| p.count() < sent) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
         let (received, latencies) = RelayPage::stop(pages);
         let share = received.iter().map(|&r| r as f64 / sent.max(1) as f64).collect::<Vec<_>>();
         rows.push(json!({
@@ -260,6 +268,8 @@ fn print_table(r: &Value, seconds: f64) {
 /// A page following the relay: a thread reading the records, each one's latency kept.
 struct RelayPage {
     running: Arc<AtomicBool>,
+    /// Records received so far.
+    received: Arc<AtomicU64>,
     thread: JoinHandle<Vec<f64>>,
 }
 
@@ -271,7 +281,8 @@ impl RelayPage {
             s.set_read_timeout(Some(Duration::from_millis(100)))?;
         }
         let running = Arc::new(AtomicBool::new(true));
-        let run = Arc::clone(&running);
+        let received = Arc::new(AtomicU64::new(0));
+        let (run, count) = (Arc::clone(&running), Arc::clone(&received));
         let thread = std::thread::spawn(move || {
             let mut latencies = Vec::new();
             while run.load(Ordering::Relaxed) {
@@ -280,6 +291,7 @@ impl RelayPage {
                         let now = clock.elapsed().as_secs_f64();
                         if let Some(t) = serde_json::from_slice::<Value>(&b).ok().and_then(|v| v["t"].as_f64()) {
                             latencies.push(now - t);
+                            count.fetch_add(1, Ordering::Relaxed);
                         }
                     }
                     Ok(_) => {}
@@ -289,7 +301,12 @@ impl RelayPage {
             }
             latencies
         });
-        Ok(Self { running, thread })
+        Ok(Self { running, received, thread })
+    }
+
+    /// The records it has received so far.
+    fn count(&self) -> u64 {
+        self.received.load(Ordering::Relaxed)
     }
 
     /// Stops the pages: the records each received, and every latency (s).
