@@ -10,7 +10,7 @@
 // made elsewhere (the WebXR generic hand) with its fingers bent.
 
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, cpSync, mkdirSync, mkdtempSync, readFileSync } from 'node:fs';
+import { copyFileSync, cpSync, mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { afterAll, beforeAll, describe, expect, test } from 'vitest';
@@ -21,6 +21,7 @@ interface Conformance {
   size: number;
   vertices: number;
   exported: { three: number; lbs: number; dqs: number; dqsNormals: number; cpu: number; blend: number };
+  native: { name: string; dqs: number; dqsNormals: number; cpu: number }[];
   random: { seed: number; dqs: number; dqsNormals: number; cpu: number; unaligned: number }[];
   scaled: { seed: number; dqs: number; dqsNormals: number; cpu: number }[];
   outside: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
@@ -30,6 +31,33 @@ interface Conformance {
 const GENERIC_HAND = path.join(root, 'third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb');
 
 const PACKAGE = path.join(root, 'packages/three-dqs');
+
+/** The random poses dqhand exports for the page (their seeds in their names). */
+const NATIVE = ['pose-1', 'pose-2', 'pose-3'];
+
+/**
+ * A random pose file of seed `seed` for `dqhand export-skinning --pose`: the wrist turned 90–180°
+ * about a random axis, every finger joint flexed −20–100° and spread ±20° (beyond the hand's
+ * ranges: the export runs without limits).
+ */
+function randomPose(seed: number) {
+  let state = seed * 2654435761;
+  const random = () => ((state = (Math.imul(state, 1664525) + 1013904223) >>> 0) / 2 ** 32);
+  const axis = [random() - 0.5, random() - 0.5, random() - 0.5];
+  const length = Math.hypot(...axis);
+  const half = (Math.PI * (0.5 + 0.5 * random())) / 2;
+  const rotation = [...axis.map((a) => (a / length) * Math.sin(half)), Math.cos(half)];
+  // Every DOF of the full joint model: flexion everywhere, spread at the thumb and the knuckles.
+  const fingers = ['index', 'middle', 'ring', 'pinky'];
+  const flex = ['thumb-metacarpal', 'thumb-phalanx-proximal', 'thumb-phalanx-distal', 'ring-finger-metacarpal', 'pinky-finger-metacarpal'].concat(
+    ...fingers.map((f) => ['proximal', 'intermediate', 'distal'].map((p) => `${f}-finger-phalanx-${p}`)),
+  );
+  const spread = ['thumb-metacarpal', 'thumb-phalanx-proximal', ...fingers.map((f) => `${f}-finger-phalanx-proximal`)];
+  const angles: Record<string, number> = {};
+  for (const bone of flex) angles[`${bone}.flex`] = -20 + 120 * random();
+  for (const bone of spread) angles[`${bone}.abd`] = -20 + 40 * random();
+  return { model: 'full', wrist: { translation: [0.1, 1.1, -0.2], rotation }, angles_deg: angles };
+}
 let browser: Browser;
 let server: Awaited<ReturnType<typeof serveStatic>>;
 let result: Conformance;
@@ -40,13 +68,20 @@ beforeAll(async () => {
   execFileSync(path.join(PACKAGE, 'node_modules/.bin/vite'), ['build', '--config', 'test/vite.config.js', '--outDir', page, '--logLevel', 'warn'], { cwd: PACKAGE, stdio: 'inherit' });
   execFileSync(dqhandBin(), ['export-skinning', '--out', path.join(work, 'rig'), '--frames', '10'], { stdio: 'inherit' });
   for (const file of ['rig.json', 'rig.bin']) copyFileSync(path.join(work, 'rig', file), path.join(page, file));
+  // Random poses dqhand itself exports too (its native DQB of each is the reference).
+  for (const name of NATIVE) {
+    const pose = path.join(work, `${name}.json`);
+    writeFileSync(pose, JSON.stringify(randomPose(Number(name.slice(5)))));
+    execFileSync(dqhandBin(), ['export-skinning', '--out', path.join(work, name), '--pose', pose, '--no-limits', '--frames', '10'], { stdio: 'inherit' });
+    for (const ext of ['json', 'bin']) copyFileSync(path.join(work, name, `rig.${ext}`), path.join(page, `${name}.${ext}`));
+  }
   copyFileSync(GENERIC_HAND, path.join(page, 'hand.glb'));
   server = await serveStatic(page);
   browser = await launchBrowser();
   const p = await newPage(browser);
   await p.goto(server.url);
   await p.waitForFunction(() => document.title === 'ready', null, { timeout: 60_000 });
-  result = await p.evaluate(() => (window as unknown as { conformance(): Promise<Conformance> }).conformance());
+  result = await p.evaluate((names) => (window as unknown as { conformance(n: string[]): Promise<Conformance> }).conformance(names), NATIVE);
 }, 180_000);
 
 afterAll(async () => {
@@ -77,6 +112,15 @@ describe('three-dqs on the GPU against dqhand and a reference from the definitio
     expect(result.exported.dqs).toBeLessThan(positions());
     expect(result.exported.dqsNormals).toBeLessThan(normals);
     expect(result.exported.cpu).toBeLessThan(positions());
+  });
+
+  test('three random poses dqhand exports itself (wrist turned 90–180°, fingers beyond their ranges) match its native DQB', () => {
+    expect(result.native.length).toBe(NATIVE.length);
+    for (const r of result.native) {
+      expect(r.dqs, r.name).toBeLessThan(positions());
+      expect(r.dqsNormals, r.name).toBeLessThan(normals);
+      expect(r.cpu, r.name).toBeLessThan(positions());
+    }
   });
 
   test('mode blend follows its vertex attribute: linear where it is 0, dual quaternion where it is 1', () => {

@@ -333,8 +333,12 @@ async function outsideHand(): Promise<{ rig: Rig; poses: Float32Array[] }> {
   return { rig, poses };
 }
 
-/** Everything the test asserts, measured in one go. */
-export async function conformance() {
+/**
+ * Everything the test asserts, measured in one go. `exports` names more frames of the same hand
+ * that dqhand exported in other poses (`name`.json, `name`.bin), each compared with dqhand's own
+ * DQB of it.
+ */
+export async function conformance(exports: string[] = []) {
   const rig = await loadRig();
   const size = (() => {
     const box = new THREE.Box3().setFromArray(rig.rest);
@@ -348,6 +352,16 @@ export async function conformance() {
     cpu: worst(cpuPositions(rig, rig.skinning), rig.dqb),
     blend: worst(readBack(rig, rig.skinning, 'blend', 'position'), alternate(rig.lb, rig.dqb)),
   };
+  const native = [];
+  for (const name of exports) {
+    const other = await loadRig(name);
+    native.push({
+      name,
+      dqs: worst(readBack(other, other.skinning, 'dqs', 'position'), other.dqb),
+      dqsNormals: worst(readBack(other, other.skinning, 'dqs', 'normal'), other.dqbNormals, true),
+      cpu: worst(cpuPositions(other, other.skinning), other.dqb),
+    });
+  }
   const random = [];
   for (let seed = 1; seed <= 6; seed++) {
     const pose = randomPose(rig, seed);
@@ -382,5 +396,5 @@ export async function conformance() {
       cpu: worst(cpuPositions(outside.rig, pose), ref.positions),
     };
   });
-  return { size, vertices: rig.vertices, exported, random, scaled, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
+  return { size, vertices: rig.vertices, exported, native, random, scaled, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
 }

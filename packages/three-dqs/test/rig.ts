@@ -1,4 +1,4 @@
-// The frame `dqhand export-skinning` writes (rig.json and rig.bin beside the page): the
+// A frame `dqhand export-skinning` writes (rig.json and rig.bin beside the page, or another name): the
 // built-in hand's rest mesh, influences and triangles, each joint's skinning matrix, and
 // dqhand's own LB and DQB of it.
 
@@ -17,9 +17,10 @@ export interface Rig {
   dqbNormals: Float32Array;
 }
 
-export async function loadRig(): Promise<Rig> {
-  const meta = await (await fetch('rig.json')).json();
-  const bin = await (await fetch('rig.bin')).arrayBuffer();
+/** The frame written as `name`.json and `name`.bin. */
+export async function loadRig(name = 'rig'): Promise<Rig> {
+  const meta = await (await fetch(`${name}.json`)).json();
+  const bin = await (await fetch(`${name}.bin`)).arrayBuffer();
   const view = <T>(make: new (b: ArrayBuffer, o: number, n: number) => T, name: string) => new make(bin, meta.arrays[name].offset, meta.arrays[name].shape.reduce((a: number, b: number) => a * b, 1));
   return {
     vertices: meta.vertices,
