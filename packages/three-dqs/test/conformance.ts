@@ -251,10 +251,15 @@ function worst(a: ArrayLike<number>, b: ArrayLike<number>, angles = false): numb
   return most;
 }
 
+/** Numbers in [0, 1) from a linear congruential generator started at `seed`: the same poses every run. */
+function seeded(seed: number): () => number {
+  let state = seed;
+  return () => (state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32;
+}
+
 /** Random rigid skinning matrices: the whole hand turned up to 180° about a random axis, each joint by up to 60° more, and moved. */
 function randomPose(rig: Rig, seed: number): Float32Array {
-  let state = seed;
-  const random = () => ((state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32);
+  const random = seeded(seed);
   const axis = () => new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
   const whole = new THREE.Quaternion().setFromAxisAngle(axis(), Math.PI * (0.5 + 0.5 * random()));
   const out = new Float32Array(16 * rig.joints);
@@ -274,8 +279,7 @@ function randomPose(rig: Rig, seed: number): Float32Array {
  */
 function scaledPose(rig: Rig, seed: number): { matrices: Float32Array; rigid: Float32Array; scales: number[][] } {
   const rigid = randomPose(rig, seed);
-  let state = seed * 7919;
-  const random = () => ((state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32);
+  const random = seeded(seed * 7919);
   const matrices = new Float32Array(rigid.length);
   const scales: number[][] = [];
   for (let j = 0; j < rig.joints; j++) {
@@ -321,8 +325,7 @@ async function outsideHand(): Promise<{ rig: Rig; poses: Float32Array[] }> {
   const empty = new Float32Array(0);
   const rig: Rig = { vertices: n, joints: skeleton.bones.length, rest, restNormals, joint, weight, triangles: new Uint32Array(0), skinning: empty, lb: empty, dqb: empty, dqbNormals: empty };
   const poses = [21, 22, 23].map((seed) => {
-    let state = seed;
-    const random = () => ((state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32);
+    const random = seeded(seed);
     const axis = () => new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
     skeleton.pose();
     skeleton.bones.forEach((bone, j) => bone.quaternion.multiply(new THREE.Quaternion().setFromAxisAngle(axis(), (j === 0 ? Math.PI : Math.PI / 2) * random())));
