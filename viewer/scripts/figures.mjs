@@ -7,14 +7,15 @@
 //   viewer-split.png      the viewer itself, split view on the fist
 //   fig9-grasp.png        the ball and the Utah teapot grasped, lifted, carried and set down (Fig. 9)
 //   dqs-twist-bend.png    three.js's linear skinning beside three-dqs on a twisted and a bent limb
+//   dqs-hand.png          the same on the WebXR generic hand (a glTF made elsewhere), its index finger twisted and bent
 //
 // `node scripts/figures.mjs hand` makes the first four only, `… grasp` Figure 9 only, `… dqs`
-// the last (it needs `make dqs-package`'s install); no argument, all of them.
+// the last two (they need `make dqs-package`'s install); no argument, all of them.
 //
 // Joint limits are switched off for Figure 5/6 so the PIP can reach 120° (its range is 0–110°).
 
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { dqhandBin, launchBrowser, root, serveStatic, settle, startServer, waitState } from './harness.mjs';
@@ -281,21 +282,33 @@ async function dqsFigure(compose) {
   const pkg = path.join(root, 'packages/three-dqs');
   const work = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'dqs-figure-'));
   execFileSync(path.join(pkg, 'node_modules/.bin/vite'), ['build', '--config', 'test/vite.config.js', '--outDir', work, '--logLevel', 'warn'], { cwd: pkg, stdio: 'inherit' });
+  copyFileSync(path.join(root, 'third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb'), path.join(work, 'hand.glb'));
   const server = await serveStatic(work);
   try {
     const page = await browser.newPage({ viewport: { width: 400, height: 400 } });
     await page.goto(`${server.url}?figure`);
     await page.waitForFunction(() => document.title === 'ready');
-    const shot = async (kind, dual) => {
-      await page.evaluate(([kind, dual]) => window.figure(kind, dual, 360), [kind, dual]);
+    /** The picture `draw` (window.figure or window.handFigure) makes of `kind`, as a data URL. */
+    const shot = async (draw, kind, dual) => {
+      await page.evaluate(([draw, kind, dual]) => window[draw](kind, dual, 360), [draw, kind, dual]);
       const png = await page.locator('#view').screenshot();
       return `data:image/png;base64,${png.toString('base64')}`;
     };
-    const rows = [];
-    for (const [kind, label] of [['twist', 'twisted 150°'], ['bend', 'bent 120°']]) {
-      rows.push({ label, cells: [{ src: await shot(kind, false), caption: "three.js's linear skinning" }, { src: await shot(kind, true), caption: 'three-dqs' }] });
-    }
+    const rowsOf = async (draw, kinds) => {
+      const rows = [];
+      for (const [kind, label] of kinds) {
+        rows.push({ label, cells: [{ src: await shot(draw, kind, false), caption: "three.js's linear skinning" }, { src: await shot(draw, kind, true), caption: 'three-dqs' }] });
+      }
+      return rows;
+    };
+    const rows = await rowsOf('figure', [['twist', 'twisted 150°'], ['bend', 'bent 120°']]);
+    const hand = await rowsOf('handFigure', [['twist', 'twisted 150°'], ['bend', 'bent 30° + 120°']]);
     await page.close();
+    await compose('dqs-hand.png', 'Linear and dual quaternion skinning in three.js, the WebXR generic hand (glTF)', hand, 2, {
+      size: [300, 300],
+      label: 80,
+      note: "The WebXR input profiles' generic hand, as GLTFLoader gives it, its index finger twisted 150° about its own axis at the knuckle (seen from the back of the hand), or bent 30° at the knuckle and 120° at the middle joint (seen from the side). Linear skinning wrings the twisted knuckle thin and folds the bent joint's inside in; dual quaternions keep the finger's thickness.",
+    });
     await compose('dqs-twist-bend.png', 'Linear and dual quaternion skinning in three.js, a limb on two bones', rows, 2, {
       size: [300, 300],
       label: 80,

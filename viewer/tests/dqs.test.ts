@@ -1,6 +1,7 @@
-// The three-dqs package (packages/three-dqs) on the GPU, in headless Chromium's software WebGL:
-// its conformance page (packages/three-dqs/test) reads back what the package's shader chunks
-// compute for every vertex of the built-in hand, from a float render target, and compares it
+// The three-dqs package (packages/three-dqs) on the GPU, in headless Chromium's software WebGL
+// and WebGPU (SwiftShader): its conformance page (packages/three-dqs/test) reads back what the
+// package's shader chunks (WebGLRenderer) and TSL nodes (WebGPURenderer, on WebGPU and on its
+// WebGL 2 fallback) compute for every vertex of the built-in hand, from a float render target, and compares it
 // with dqhand's native DQB of the same frame (`dqhand export-skinning`) and, over random poses
 // (the whole hand turned up to 180°) and poses whose bones scale and shear, with a reference the
 // page writes from the definitions. The same page shows that a shader without the sign
@@ -25,6 +26,9 @@ interface Conformance {
   random: { seed: number; dqs: number; dqsNormals: number; cpu: number; unaligned: number }[];
   scaled: { seed: number; dqs: number; dqsNormals: number; cpu: number }[];
   outside: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
+  /** WebGPURenderer only: which backend drew, and the shadow pictures (pixels) of two random poses. */
+  backend?: string;
+  shadows?: { seed: number; shadowed: number; dqs: number; three: number }[];
 }
 
 /** The WebXR generic hand: a skinned glTF from the WebXR input profiles (third_party/). */
@@ -60,7 +64,10 @@ function randomPose(seed: number) {
 }
 let browser: Browser;
 let server: Awaited<ReturnType<typeof serveStatic>>;
-let result: Conformance;
+/** The conformance page's results through each renderer (WebGLRenderer; WebGPURenderer on WebGPU, and on its WebGL 2 fallback). */
+const results: Record<string, Conformance> = {};
+/** The page's query for each renderer. */
+const RENDERERS = { WebGLRenderer: '', 'WebGPURenderer on WebGPU': '?webgpu', 'WebGPURenderer on WebGL 2': '?webgpu&webgl' };
 
 beforeAll(async () => {
   const work = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'three-dqs-'));
@@ -77,19 +84,24 @@ beforeAll(async () => {
   }
   copyFileSync(GENERIC_HAND, path.join(page, 'hand.glb'));
   server = await serveStatic(page);
-  browser = await launchBrowser();
-  const p = await newPage(browser);
-  await p.goto(server.url);
-  await p.waitForFunction(() => document.title === 'ready', null, { timeout: 60_000 });
-  result = await p.evaluate((names) => (window as unknown as { conformance(n: string[]): Promise<Conformance> }).conformance(names), NATIVE);
-}, 180_000);
+  browser = await launchBrowser(['--enable-unsafe-webgpu']);
+  for (const [name, query] of Object.entries(RENDERERS)) {
+    const p = await newPage(browser);
+    await p.goto(server.url + query);
+    await p.waitForFunction(() => document.title === 'ready', null, { timeout: 60_000 });
+    results[name] = await p.evaluate((names) => (window as unknown as { conformance(n: string[]): Promise<Conformance> }).conformance(names), NATIVE);
+    await p.close();
+  }
+}, 240_000);
 
 afterAll(async () => {
   await browser?.close();
   await server?.stop();
 });
 
-describe('three-dqs on the GPU against dqhand and a reference from the definitions', () => {
+describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a reference from the definitions', (renderer) => {
+  const result = {} as Conformance;
+  beforeAll(() => void Object.assign(result, results[renderer]));
   /** Positions within 1e-4 of the mesh's size; normals within 1e-3 rad. */
   const positions = () => 1e-4 * result.size;
   const normals = 1e-3;
@@ -151,10 +163,26 @@ describe('three-dqs on the GPU against dqhand and a reference from the definitio
     const failing = result.random.filter((r) => r.unaligned > 100 * positions());
     expect(failing.length, JSON.stringify(result.random.map((r) => r.unaligned))).toBeGreaterThanOrEqual(3);
   });
+
+  if (renderer !== 'WebGLRenderer') {
+    test('it ran where it says (WebGPU, or the WebGL 2 fallback)', () => {
+      expect(result.backend).toBe(renderer.endsWith('WebGPU') ? 'webgpu' : 'webgl2');
+    });
+
+    test('shadow maps draw the dual quaternion skin: its shadow is the reference\'s to the pixel, three.js\'s linear skin\'s is not', () => {
+      expect(result.shadows?.length).toBe(2);
+      for (const r of result.shadows ?? []) {
+        expect(r.shadowed, `seed ${r.seed}`).toBeGreaterThan(1000);
+        expect(r.dqs, `seed ${r.seed}`).toBeLessThanOrEqual(0.01 * r.shadowed);
+        expect(r.three, `seed ${r.seed}`).toBeGreaterThan(0.05 * r.shadowed);
+      }
+    });
+  }
 });
 
 interface Example {
   mode: string;
+  renderer: string;
   meshes: number;
   bones: number;
   programs: string[];
@@ -165,11 +193,13 @@ describe('the three-dqs example app installed from the package tarball', () => {
   const version = JSON.parse(readFileSync(path.join(PACKAGE, 'package.json'), 'utf8')).version as string;
   let app: string;
   let site: Awaited<ReturnType<typeof serveStatic>>;
-  const open = async (mode: string) => {
+  const open = async (mode: string, renderer = 'webgl') => {
     const p = await newPage(browser);
     const errors: string[] = [];
     p.on('pageerror', (e) => errors.push(e.message));
-    await p.goto(`${site.url}?mode=${mode}`);
+    // (WebGPU reports a pipeline that fails to compile on the console.)
+    p.on('console', (m) => void (m.type() === 'error' && !m.text().includes('404') && errors.push(m.text())));
+    await p.goto(`${site.url}?mode=${mode}&renderer=${renderer}`);
     await p.waitForFunction(() => document.title === 'drawn', null, { timeout: 60_000 });
     const state = await p.evaluate(() => (window as unknown as { example: Example }).example);
     return { p, state, errors };
@@ -217,6 +247,20 @@ describe('the three-dqs example app installed from the package tarball', () => {
     } finally {
       await dqs.p.close();
       await lbs.p.close();
+    }
+  });
+
+  test('with WebGPURenderer (three-dqs/webgpu from the same tarball) the same hand compiles, skin and shadow, and its CPU path gives the WebGL entry\'s box', async () => {
+    const webgl = await open('dqs');
+    const webgpu = await open('dqs', 'webgpu');
+    try {
+      expect(webgpu.errors).toEqual([]);
+      expect(webgpu.state.renderer).toBe('webgpu');
+      expect(webgpu.state.meshes).toBe(1);
+      for (let k = 0; k < 3; k++) expect(Math.abs(webgpu.state.box[k] - webgl.state.box[k])).toBeLessThan(1e-6);
+    } finally {
+      await webgl.p.close();
+      await webgpu.p.close();
     }
   });
 });

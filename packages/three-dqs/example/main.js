@@ -1,13 +1,18 @@
 // A skinned glTF (public/hand.glb, or ?model=URL) with its fingers bent 70° at every knuckle,
 // drawn with dual quaternion skinning and casting its shadow; ?mode=lbs draws three.js's own
-// linear skinning instead.
+// linear skinning instead. ?renderer=webgpu draws with WebGPURenderer and three-dqs/webgpu;
+// ?view=shadow draws the floor and the hand's shadow without the hand.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { useDualQuaternionSkinning } from 'three-dqs';
 
 const query = new URLSearchParams(location.search);
 const mode = query.get('mode') === 'lbs' ? 'lbs' : 'dqs';
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+const webgpu = query.get('renderer') === 'webgpu';
+const { useDualQuaternionSkinning } = webgpu ? await import('three-dqs/webgpu') : await import('three-dqs');
+const renderer = webgpu
+  ? new (await import('three/webgpu')).WebGPURenderer({ antialias: true })
+  : new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+if (webgpu) await renderer.init();
 renderer.setSize(innerWidth, innerHeight);
 renderer.domElement.id = 'view';
 document.body.append(renderer.domElement);
@@ -52,9 +57,13 @@ for (const { chain, bends } of fingers) {
     }
   });
 }
+const shadowOnly = query.get('view') === 'shadow';
+// (The hand on a layer the camera does not see and the sun's shadow camera does.)
+if (shadowOnly) sun.shadow.camera.layers.enable(1);
 for (const mesh of meshes) {
   mesh.material = new THREE.MeshStandardMaterial({ color: 0xe0a98f, roughness: 0.6 });
   mesh.castShadow = true;
+  if (shadowOnly) mesh.layers.set(1);
   if (mode === 'dqs') useDualQuaternionSkinning(mesh);
 }
 gltf.scene.updateMatrixWorld(true);
@@ -80,13 +89,16 @@ floor.rotation.x = -Math.PI / 2;
 floor.position.copy(centre).y -= size / 2;
 floor.receiveShadow = true;
 scene.add(floor);
+// (WebGPURenderer compiles its pipelines asynchronously: wait for them, errors included.)
+if (webgpu) await renderer.compileAsync(scene, camera);
 renderer.render(scene, camera);
 
 window.example = {
   mode,
   meshes: meshes.length,
   bones: meshes.reduce((n, m) => n + m.skeleton.bones.length, 0),
-  programs: renderer.info.programs.map((p) => p.cacheKey),
+  renderer: webgpu ? (renderer.backend.isWebGPUBackend ? 'webgpu' : 'webgl2') : 'webgl',
+  programs: webgpu ? [] : renderer.info.programs.map((p) => p.cacheKey),
   box: box.getSize(new THREE.Vector3()).toArray(),
 };
 document.title = 'drawn';

@@ -1,6 +1,6 @@
-import { MeshDepthMaterial, MeshDistanceMaterial, RGBADepthPacking, type Material, type Skeleton, type SkinnedMesh, type Vector3, type Vector4, type WebGLProgramParametersWithUniforms } from 'three';
-import { BoneDualQuaternions } from './bone_dual_quaternions.js';
-import { CpuSkinning } from './cpu_skinning.js';
+import { MeshDepthMaterial, MeshDistanceMaterial, RGBADepthPacking, type Material, type SkinnedMesh, type WebGLProgramParametersWithUniforms } from 'three';
+import type { BoneDualQuaternions } from './bone_dual_quaternions.js';
+import { attach } from './dual_quaternion_mesh.js';
 import { patchVertexShader, type SkinningMode } from './skinning_chunks.js';
 
 export { BoneDualQuaternions, FLOATS_PER_BONE, TEXELS_PER_BONE } from './bone_dual_quaternions.js';
@@ -30,46 +30,8 @@ export interface DualQuaternionSkinning {
   dispose(): void;
 }
 
-/** A skeleton's bone data, shared by the meshes that use it: its texture takes the place of three.js's. */
-interface SkeletonState {
-  bones: BoneDualQuaternions;
-  users: number;
-  update: Skeleton['update'];
-  boneTexture: Skeleton['boneTexture'];
-}
-
-const skeletons = new WeakMap<Skeleton, SkeletonState>();
 /** Materials already patched, and for which mode. */
 const patchedMaterials = new WeakMap<Material, SkinningMode>();
-
-/** The bone data of `skeleton`, made and hooked into its `update` by the first mesh to ask. */
-function share(skeleton: Skeleton): SkeletonState {
-  let state = skeletons.get(skeleton);
-  if (!state) {
-    const bones = new BoneDualQuaternions(skeleton.bones.length);
-    const made: SkeletonState = { bones, users: 0, update: skeleton.update, boneTexture: skeleton.boneTexture };
-    // three.js updates each skeleton once a frame before drawing, and binds `boneTexture` to
-    // every mesh of it (each through its own bind matrix): the dual quaternions go there.
-    skeleton.update = function (this: Skeleton) {
-      made.update.call(this);
-      bones.update(this);
-    };
-    skeleton.boneTexture = bones.texture;
-    skeletons.set(skeleton, made);
-    state = made;
-  }
-  state.users++;
-  return state;
-}
-
-/** Gives `skeleton` back its own update and texture once no mesh uses its dual quaternions. */
-function unshare(skeleton: Skeleton, state: SkeletonState): void {
-  if (--state.users > 0) return;
-  skeleton.update = state.update;
-  skeleton.boneTexture = state.boneTexture;
-  state.bones.dispose();
-  skeletons.delete(skeleton);
-}
 
 /** `material` (or a copy of it) with three.js's skinning chunks replaced for `mode`. */
 function patchMaterial(material: Material, mode: SkinningMode, share: boolean): Material {
@@ -108,13 +70,7 @@ function patchMaterial(material: Material, mode: SkinningMode, share: boolean): 
  */
 export function useDualQuaternionSkinning(mesh: SkinnedMesh, options: DualQuaternionSkinningOptions = {}): DualQuaternionSkinning {
   const mode = options.mode ?? 'dqs';
-  const name = mesh.name || 'mesh';
-  if (!mesh.isSkinnedMesh || !mesh.skeleton) throw new Error(`${name}: not a SkinnedMesh with a skeleton`);
-  if (mode === 'blend' && !mesh.geometry.attributes.dqsBlend) throw new Error(`${name}: mode 'blend' needs the vertex attribute dqsBlend`);
-  const skeleton = mesh.skeleton;
-  const state = share(skeleton);
-  skeleton.update();
-  const cpu = new CpuSkinning(state.bones.data, mode);
+  const attached = attach(mesh, mode);
   const original = { material: mesh.material, depth: mesh.customDepthMaterial, distance: mesh.customDistanceMaterial };
   const patch = (m: Material) => patchMaterial(m, mode, options.shareMaterials ?? false);
   mesh.material = Array.isArray(original.material) ? original.material.map(patch) : patch(original.material);
@@ -123,30 +79,15 @@ export function useDualQuaternionSkinning(mesh: SkinnedMesh, options: DualQuater
   // shadow's depth, or copies of its own).
   mesh.customDepthMaterial = patchMaterial(original.depth ?? new MeshDepthMaterial({ depthPacking: RGBADepthPacking }), mode, !original.depth);
   mesh.customDistanceMaterial = patchMaterial(original.distance ?? new MeshDistanceMaterial(), mode, !original.distance);
-  mesh.applyBoneTransform = (index: number, target: Vector3 | Vector4) => {
-    cpu.apply(mesh, index, target);
-    return target as never;
-  };
-  // three.js's own CPU path reads the bones as they are; this one reads the data of the last
-  // skeleton update, so the bounding volumes and raycasting update it first (once per call).
-  const refreshed = (['computeBoundingBox', 'computeBoundingSphere', 'raycast'] as const).map((name) => {
-    const own = mesh[name];
-    mesh[name] = function (this: SkinnedMesh, ...args: unknown[]) {
-      skeleton.update();
-      return (own as (...a: unknown[]) => void).apply(this, args);
-    } as never;
-    return name;
-  });
   return {
-    bones: state.bones,
+    bones: attached.bones,
     dispose() {
       const patched = [mesh.material, mesh.customDepthMaterial, mesh.customDistanceMaterial].flat();
       if (!options.shareMaterials) for (const m of patched) m?.dispose();
       mesh.material = original.material;
       mesh.customDepthMaterial = original.depth;
       mesh.customDistanceMaterial = original.distance;
-      for (const name of [...refreshed, 'applyBoneTransform']) delete (mesh as unknown as Record<string, unknown>)[name];
-      unshare(skeleton, state);
+      attached.detach();
     },
   };
 }

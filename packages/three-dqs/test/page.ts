@@ -1,12 +1,24 @@
-// One page for three: `?bench` the speed page (window.bench), `?figure` the side-by-side
-// pictures (window.figure), else the conformance page (window.conformance). The title says
-// when it is ready.
+// One page for four: `?bench` the speed page (window.bench), `?figure` the side-by-side
+// pictures (window.figure, window.handFigure), `?webgpu` the conformance page through WebGPURenderer
+// (`?webgpu&webgl`: its WebGL 2 fallback), else the conformance page through WebGLRenderer
+// (window.conformance). The title says when it is ready.
 const query = new URLSearchParams(location.search);
-const page = query.has('bench')
-  ? { bench: (await import('./bench')).bench }
-  : query.has('figure')
-    ? { figure: (await import('./figure')).figure }
-    : { conformance: (await import('./conformance')).conformance };
-Object.assign(window, page);
+async function page(): Promise<object> {
+  if (query.has('bench')) return { bench: (await import('./bench')).bench };
+  if (query.has('figure')) {
+    const { figure, handFigure } = await import('./figure');
+    return { figure, handFigure };
+  }
+  const { conformance, shadowConformance } = await import('./conformance');
+  if (query.has('webgpu')) {
+    const backend = await (await import('./webgpu_readback')).webgpu(query.has('webgl'));
+    return {
+      conformance: async (names: string[]) => ({ backend: backend.backend, ...(await conformance(backend, names)), shadows: await shadowConformance(backend.shadows) }),
+    };
+  }
+  const { webgl } = await import('./webgl_readback');
+  return { conformance: (names: string[]) => conformance(webgl, names) };
+}
+Object.assign(window, await page());
 document.title = 'ready';
 export {};

@@ -1,0 +1,165 @@
+// What the conformance pages skin: random poses (seeded, the same every run), the WebXR
+// generic hand made elsewhere, and the read-back geometry that puts each vertex on its own pixel.
+
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import type { Rig } from './rig';
+
+/**
+ * The rig's vertices as the conformance pages draw them: each one three times, a tiny triangle
+ * (`corner`, in pixels) over pixel `slot` of a float target, with its skinning attributes, and
+ * with `blend` the attribute `dqsBlend`.
+ */
+export function readbackGeometry(rig: Rig, blend?: (v: number) => number): THREE.BufferGeometry {
+  const n = rig.vertices;
+  const geometry = new THREE.BufferGeometry();
+  const corners = [-0.4, -0.4, 0.8, -0.4, -0.4, 0.8];
+  const position = new Float32Array(9 * n);
+  const normal = new Float32Array(9 * n);
+  const skinIndex = new Uint16Array(12 * n);
+  const skinWeight = new Float32Array(12 * n);
+  const corner = new Float32Array(6 * n);
+  const slot = new Float32Array(3 * n);
+  for (let v = 0; v < n; v++) {
+    for (let c = 0; c < 3; c++) {
+      const k = 3 * v + c;
+      position.set(rig.rest.subarray(3 * v, 3 * v + 3), 3 * k);
+      normal.set(rig.restNormals.subarray(3 * v, 3 * v + 3), 3 * k);
+      skinIndex.set(rig.joint.subarray(4 * v, 4 * v + 4), 4 * k);
+      skinWeight.set(rig.weight.subarray(4 * v, 4 * v + 4), 4 * k);
+      corner.set(corners.slice(2 * c, 2 * c + 2), 2 * k);
+      slot[k] = v;
+    }
+  }
+  geometry.setAttribute('position', new THREE.BufferAttribute(position, 3));
+  geometry.setAttribute('normal', new THREE.BufferAttribute(normal, 3));
+  geometry.setAttribute('skinIndex', new THREE.BufferAttribute(skinIndex, 4));
+  geometry.setAttribute('skinWeight', new THREE.BufferAttribute(skinWeight, 4));
+  geometry.setAttribute('corner', new THREE.BufferAttribute(corner, 2));
+  geometry.setAttribute('slot', new THREE.BufferAttribute(slot, 1));
+  if (blend) geometry.setAttribute('dqsBlend', new THREE.BufferAttribute(slot.map(blend), 1));
+  return geometry;
+}
+
+/** What both renderers offer to draw into a render target. */
+export interface Drawer<Target> {
+  setRenderTarget(target: Target | null): void;
+  setClearColor(color: number, alpha: number): void;
+  clear(): unknown;
+  render(scene: THREE.Scene, camera: THREE.Camera): unknown;
+}
+
+/** `mesh` drawn alone into `target`, cleared to transparent black first (the renderer left drawing there). */
+export function drawAlone<Target>(renderer: Drawer<Target>, target: Target, mesh: THREE.Object3D, camera: THREE.Camera): void {
+  const scene = new THREE.Scene();
+  scene.add(mesh);
+  renderer.setRenderTarget(target);
+  renderer.setClearColor(0x000000, 0);
+  renderer.clear();
+  renderer.render(scene, camera);
+}
+
+/** Bones whose skinning matrices are `matrices` (16 per joint, column-major): their world matrices, with identity inverses. */
+export function bonesOf(matrices: ArrayLike<number>, joints: number): THREE.Bone[] {
+  return Array.from({ length: joints }, (_, j) => {
+    const bone = new THREE.Bone();
+    bone.matrixAutoUpdate = false;
+    bone.matrixWorldAutoUpdate = false;
+    bone.matrixWorld.fromArray(Array.from(matrices).slice(16 * j, 16 * j + 16));
+    return bone;
+  });
+}
+
+/** The `dqsBlend` of vertex `v` in mode 'blend': 0 (linear) for even vertices, 1 (dual quaternion) for odd ones. */
+export const blendOf = (v: number) => v % 2;
+
+/** Positions that are `even`'s on even vertices and `odd`'s on odd ones. */
+export function alternate(even: ArrayLike<number>, odd: ArrayLike<number>): Float32Array {
+  return Float32Array.from({ length: even.length }, (_, i) => (Math.floor(i / 3) % 2 ? odd[i] : even[i]));
+}
+
+/** Numbers in [0, 1) from a linear congruential generator started at `seed`: the same poses every run. */
+function seeded(seed: number): () => number {
+  let state = seed;
+  return () => (state = (state * 1664525 + 1013904223) >>> 0) / 2 ** 32;
+}
+
+/** Random rigid skinning matrices: the whole hand turned up to 180° about a random axis, each joint by up to 60° more, and moved. */
+export function randomPose(rig: Rig, seed: number): Float32Array {
+  const random = seeded(seed);
+  const axis = () => new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+  const whole = new THREE.Quaternion().setFromAxisAngle(axis(), Math.PI * (0.5 + 0.5 * random()));
+  const out = new Float32Array(16 * rig.joints);
+  const m = new THREE.Matrix4();
+  for (let j = 0; j < rig.joints; j++) {
+    const own = new THREE.Quaternion().setFromAxisAngle(axis(), (Math.PI / 3) * random());
+    m.compose(new THREE.Vector3(random() * 0.1, random() * 0.1, random() * 0.1), whole.clone().multiply(own), new THREE.Vector3(1, 1, 1));
+    out.set(m.elements, 16 * j);
+  }
+  return out;
+}
+
+/**
+ * A random pose whose bones also scale and shear: each joint's matrix is a rigid one (as
+ * {@link randomPose}) times a symmetric positive matrix U diag(s) Uᵀ, s from 0.7 to 1.4 along a
+ * random frame U. Returns the matrices and the scales, which the reference takes as given.
+ */
+export function scaledPose(rig: Rig, seed: number): { matrices: Float32Array; rigid: Float32Array; scales: number[][] } {
+  const rigid = randomPose(rig, seed);
+  const random = seeded(seed * 7919);
+  const matrices = new Float32Array(rigid.length);
+  const scales: number[][] = [];
+  for (let j = 0; j < rig.joints; j++) {
+    const u = new THREE.Matrix4().makeRotationFromQuaternion(new THREE.Quaternion(random() - 0.5, random() - 0.5, random() - 0.5, random() - 0.5).normalize());
+    const d = new THREE.Matrix4().makeScale(0.7 + 0.7 * random(), 0.7 + 0.7 * random(), 0.7 + 0.7 * random());
+    const s = u.clone().multiply(d).multiply(u.clone().transpose());
+    const e = s.elements;
+    scales.push([e[0], e[1], e[2], e[4], e[5], e[6], e[8], e[9], e[10]]);
+    matrices.set(new THREE.Matrix4().fromArray(Array.from(rigid.subarray(16 * j, 16 * j + 16))).multiply(s).elements, 16 * j);
+  }
+  return { matrices, rigid, scales };
+}
+
+/**
+ * The WebXR generic hand (hand.glb beside the page: a skinned glTF from the WebXR input
+ * profiles, made elsewhere) as a rig: its vertices and normals carried into its skeleton's
+ * space by its bind matrix, its own influences; and its bones' matrices in three poses, the
+ * hand turned up to 180° and every joint up to 90° about a random axis.
+ */
+export async function outsideHand(): Promise<{ rig: Rig; poses: Float32Array[] }> {
+  const gltf = await new GLTFLoader().loadAsync('hand.glb');
+  let mesh: THREE.SkinnedMesh | undefined;
+  gltf.scene.traverse((o) => {
+    if ((o as THREE.SkinnedMesh).isSkinnedMesh) mesh = o as THREE.SkinnedMesh;
+  });
+  if (!mesh) throw new Error('hand.glb: no skinned mesh');
+  const { geometry, skeleton, bindMatrix } = mesh;
+  const n = geometry.attributes.position.count;
+  const rest = new Float32Array(3 * n);
+  const restNormals = new Float32Array(3 * n);
+  const joint = new Uint32Array(4 * n);
+  const weight = new Float32Array(4 * n);
+  const normalMatrix = new THREE.Matrix3().getNormalMatrix(bindMatrix);
+  const v = new THREE.Vector3();
+  for (let i = 0; i < n; i++) {
+    v.fromBufferAttribute(geometry.attributes.position, i).applyMatrix4(bindMatrix).toArray(rest, 3 * i);
+    v.fromBufferAttribute(geometry.attributes.normal, i).applyMatrix3(normalMatrix).normalize().toArray(restNormals, 3 * i);
+    for (let k = 0; k < 4; k++) {
+      joint[4 * i + k] = geometry.attributes.skinIndex.getComponent(i, k);
+      weight[4 * i + k] = geometry.attributes.skinWeight.getComponent(i, k);
+    }
+  }
+  const empty = new Float32Array(0);
+  const rig: Rig = { vertices: n, joints: skeleton.bones.length, rest, restNormals, joint, weight, triangles: new Uint32Array(0), skinning: empty, lb: empty, dqb: empty, dqbNormals: empty };
+  const poses = [21, 22, 23].map((seed) => {
+    const random = seeded(seed);
+    const axis = () => new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+    skeleton.pose();
+    skeleton.bones.forEach((bone, j) => bone.quaternion.multiply(new THREE.Quaternion().setFromAxisAngle(axis(), (j === 0 ? Math.PI : Math.PI / 2) * random())));
+    gltf.scene.updateMatrixWorld(true);
+    skeleton.update();
+    return new Float32Array(skeleton.boneMatrices!);
+  });
+  return { rig, poses };
+}
+

@@ -1,0 +1,102 @@
+// The conformance page's WebGL side: the package's shader chunks run by WebGLRenderer and read
+// back from a float render target.
+
+import * as THREE from 'three';
+import { useDualQuaternionSkinning, type SkinningMode } from '../src/index';
+import type { Backend } from './conformance';
+import { blendOf, bonesOf, drawAlone, readbackGeometry } from './poses';
+import type { Rig } from './rig';
+
+const renderer = new THREE.WebGLRenderer();
+const camera = new THREE.OrthographicCamera();
+
+/**
+ * A SkinnedMesh whose every vertex is drawn as a tiny triangle over its own pixel of a float
+ * target: the fragment holds the skinned position (or normal), as the material's skinning
+ * chunks computed it.
+ */
+function readbackMesh(rig: Rig, bones: THREE.Bone[], width: number, output: 'position' | 'normal', blend?: (v: number) => number): THREE.SkinnedMesh {
+  const geometry = readbackGeometry(rig, blend);
+  const n = rig.vertices;
+  const material = new THREE.ShaderMaterial({
+    defines: output === 'normal' ? { OUTPUT_NORMAL: '' } : {},
+    uniforms: { size: { value: new THREE.Vector2(width, Math.ceil(n / width)) } },
+    vertexShader: /* glsl */ `
+      #include <common>
+      #include <skinning_pars_vertex>
+      attribute vec2 corner;
+      attribute float slot;
+      uniform vec2 size;
+      varying vec3 vValue;
+      void main() {
+        vec3 objectNormal = vec3( normal );
+        #include <skinbase_vertex>
+        #include <skinnormal_vertex>
+        vec3 transformed = vec3( position );
+        #include <skinning_vertex>
+        #ifdef OUTPUT_NORMAL
+          vValue = normalize( objectNormal );
+        #else
+          vValue = transformed;
+        #endif
+        vec2 pixel = vec2( mod( slot, size.x ), floor( slot / size.x ) ) + 0.5 + corner;
+        gl_Position = vec4( pixel / size * 2.0 - 1.0, 0.0, 1.0 );
+      }`,
+    fragmentShader: /* glsl */ `
+      varying vec3 vValue;
+      void main() { gl_FragColor = vec4( vValue, 1.0 ); }`,
+  });
+  const mesh = new THREE.SkinnedMesh(geometry, material);
+  mesh.frustumCulled = false;
+  mesh.bind(new THREE.Skeleton(bones, bones.map(() => new THREE.Matrix4())), new THREE.Matrix4());
+  return mesh;
+}
+
+/** The mesh's skinned positions or normals as the GPU computes them, 3 floats per vertex. */
+function readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 'three', output: 'position' | 'normal', breakAlignment = false): Float32Array {
+  const width = 128;
+  const height = Math.ceil(rig.vertices / width);
+  const mesh = readbackMesh(rig, bonesOf(matrices, rig.joints), width, output, mode === 'blend' ? blendOf : undefined);
+  if (mode !== 'three') {
+    useDualQuaternionSkinning(mesh, { mode });
+    if (breakAlignment) {
+      // The mistake this package avoids, injected: no sign alignment at all.
+      const material = mesh.material as THREE.ShaderMaterial;
+      const compile = material.onBeforeCompile;
+      material.onBeforeCompile = (shader, r) => {
+        compile.call(material, shader, r);
+        shader.vertexShader = shader.vertexShader.replace(/dot\( dqsReal\d, dqsPivot \) < 0\.0/g, 'false');
+      };
+      material.customProgramCacheKey = () => 'broken-alignment';
+    }
+  }
+  const target = new THREE.WebGLRenderTarget(width, height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+  drawAlone(renderer, target, mesh, camera);
+  const pixels = new Float32Array(4 * width * height);
+  renderer.readRenderTargetPixels(target, 0, 0, width, height, pixels);
+  renderer.setRenderTarget(null);
+  target.dispose();
+  const out = new Float32Array(3 * rig.vertices);
+  for (let v = 0; v < rig.vertices; v++) out.set(pixels.subarray(4 * v, 4 * v + 3), 3 * v);
+  return out;
+}
+
+/** The package's CPU path (applyBoneTransform) for every vertex. */
+function cpuPositions(rig: Rig, matrices: ArrayLike<number>): Float32Array {
+  const mesh = readbackMesh(rig, bonesOf(matrices, rig.joints), 128, 'position');
+  useDualQuaternionSkinning(mesh);
+  const out = new Float32Array(3 * rig.vertices);
+  const p = new THREE.Vector3();
+  for (let v = 0; v < rig.vertices; v++) {
+    // Vertex 3v of the read-back geometry is vertex v of the rig.
+    mesh.getVertexPosition(3 * v, p);
+    out.set([p.x, p.y, p.z], 3 * v);
+  }
+  return out;
+}
+
+
+export const webgl: Backend = {
+  readBack: async (rig, matrices, mode, output, breakAlignment) => readBack(rig, matrices, mode, output, breakAlignment),
+  cpuPositions,
+};
