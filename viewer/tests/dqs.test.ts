@@ -25,6 +25,7 @@ interface Conformance {
   native: { name: string; dqs: number; dqsNormals: number; cpu: number }[];
   random: { seed: number; dqs: number; dqsNormals: number; cpu: number; unaligned: number }[];
   scaled: { seed: number; dqs: number; dqsNormals: number; cpu: number }[];
+  limb: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
   outside: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
   /** WebGPURenderer only: which backend drew, and the shadow pictures (pixels) of two random poses. */
   backend?: string;
@@ -147,6 +148,16 @@ describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a
   test('bones that scale and shear match the reference (scale blended before the rigid part)', () => {
     expect(result.scaled.length).toBe(3);
     expectMatches(result.scaled);
+  });
+
+  test('a cylinder twisted 90–180° at its joint, turned up to 180° as a whole, its bones scaled and sheared, matches the reference in three poses', () => {
+    expect(result.limb.vertices).toBeGreaterThan(4000);
+    expect(result.limb.poses.length).toBe(3);
+    for (const r of result.limb.poses) {
+      expect(r.dqs, `seed ${r.seed}`).toBeLessThan(1e-4 * result.limb.size);
+      expect(r.dqsNormals, `seed ${r.seed}`).toBeLessThan(normals);
+      expect(r.cpu, `seed ${r.seed}`).toBeLessThan(1e-4 * result.limb.size);
+    }
   });
 
   test('a hand made elsewhere (the WebXR generic hand glTF, through its own bind matrix) matches the reference in three poses', () => {

@@ -5,7 +5,7 @@
 
 import * as THREE from 'three';
 import type { SkinningMode } from '../src/index';
-import { alternate, outsideHand, randomPose, scaledPose } from './poses';
+import { alternate, limbRig, outsideHand, randomPose, scaledPose, twistedLimb } from './poses';
 import { reference, worst } from './reference';
 import { loadRig, type Rig } from './rig';
 
@@ -70,6 +70,19 @@ export async function conformance(backend: Backend, exports: string[] = []) {
       cpu: worst(cpuPositions(rig, pose.matrices), ref.positions),
     });
   }
+  // The limb of the figures, its second bone twisted 90–180° about its axis, both bones scaled and sheared.
+  const cylinder = limbRig();
+  const limb = [];
+  for (let seed = 31; seed <= 33; seed++) {
+    const pose = scaledPose(cylinder, seed, twistedLimb(seed));
+    const ref = reference(cylinder, pose.rigid, pose.scales);
+    limb.push({
+      seed,
+      dqs: worst(await readBack(cylinder, pose.matrices, 'dqs', 'position'), ref.positions),
+      dqsNormals: worst(await readBack(cylinder, pose.matrices, 'dqs', 'normal'), ref.normals, true),
+      cpu: worst(cpuPositions(cylinder, pose.matrices), ref.positions),
+    });
+  }
   const outside = await outsideHand();
   const outsideSize = new THREE.Box3().setFromArray(outside.rig.rest).getSize(new THREE.Vector3()).length();
   const generic = [];
@@ -82,7 +95,8 @@ export async function conformance(backend: Backend, exports: string[] = []) {
       cpu: worst(cpuPositions(outside.rig, pose), ref.positions),
     });
   }
-  return { size, vertices: rig.vertices, exported, native, random, scaled, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
+  const limbSize = new THREE.Box3().setFromArray(cylinder.rest).getSize(new THREE.Vector3()).length();
+  return { size, vertices: rig.vertices, exported, native, random, scaled, limb: { size: limbSize, vertices: cylinder.vertices, poses: limb }, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
 }
 
 /**

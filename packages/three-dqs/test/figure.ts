@@ -8,30 +8,9 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { useDualQuaternionSkinning } from '../src/index';
+import { LIMB, limb } from './poses';
 
-const LENGTH = 0.3;
-const RADIUS = 0.035;
-/** Half the width of the band around the joint where the two bones share the skin (m). */
-const BLEND = 0.04;
-
-/** A capped-less cylinder along y from 0 to LENGTH, skinned to a bone at 0 and one at its middle. */
-function limb(): THREE.BufferGeometry {
-  const geometry = new THREE.CylinderGeometry(RADIUS, RADIUS, LENGTH, 48, 96, true);
-  geometry.translate(0, LENGTH / 2, 0);
-  const position = geometry.attributes.position;
-  const index = new Uint16Array(4 * position.count);
-  const weight = new Float32Array(4 * position.count);
-  for (let v = 0; v < position.count; v++) {
-    // The second bone's share rises smoothly across the band around the joint.
-    const t = THREE.MathUtils.clamp((position.getY(v) - LENGTH / 2 + BLEND) / (2 * BLEND), 0, 1);
-    const second = t * t * (3 - 2 * t);
-    index.set([0, 1, 0, 0], 4 * v);
-    weight.set([1 - second, second, 0, 0], 4 * v);
-  }
-  geometry.setAttribute('skinIndex', new THREE.BufferAttribute(index, 4));
-  geometry.setAttribute('skinWeight', new THREE.BufferAttribute(weight, 4));
-  return geometry;
-}
+const LENGTH = LIMB.length;
 
 /** One limb with its joint turned by `turn`, at `x`, `y`; with dual quaternions or not. */
 function posed(turn: THREE.Quaternion, dual: boolean, x: number, y: number): THREE.SkinnedMesh {

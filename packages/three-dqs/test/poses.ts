@@ -100,12 +100,11 @@ export function randomPose(rig: Rig, seed: number): Float32Array {
 }
 
 /**
- * A random pose whose bones also scale and shear: each joint's matrix is a rigid one (as
- * {@link randomPose}) times a symmetric positive matrix U diag(s) Uᵀ, s from 0.7 to 1.4 along a
+ * A random pose whose bones also scale and shear: each joint's matrix is a rigid one (`rigid`,
+ * by default {@link randomPose}) times a symmetric positive matrix U diag(s) Uᵀ, s from 0.7 to 1.4 along a
  * random frame U. Returns the matrices and the scales, which the reference takes as given.
  */
-export function scaledPose(rig: Rig, seed: number): { matrices: Float32Array; rigid: Float32Array; scales: number[][] } {
-  const rigid = randomPose(rig, seed);
+export function scaledPose(rig: Rig, seed: number, rigid = randomPose(rig, seed)): { matrices: Float32Array; rigid: Float32Array; scales: number[][] } {
   const random = seeded(seed * 7919);
   const matrices = new Float32Array(rigid.length);
   const scales: number[][] = [];
@@ -163,3 +162,65 @@ export async function outsideHand(): Promise<{ rig: Rig; poses: Float32Array[] }
   return { rig, poses };
 }
 
+
+/** The limb of the figures: a cylinder 0.3 m long, 3.5 cm in radius. */
+export const LIMB = { length: 0.3, radius: 0.035, blend: 0.04 };
+
+/**
+ * A capless cylinder along y from 0 to {@link LIMB}.length, skinned to a bone at 0 and one at
+ * its middle, the second's share rising smoothly over ±{@link LIMB}.blend around the joint.
+ */
+export function limb(): THREE.BufferGeometry {
+  const { length, radius, blend } = LIMB;
+  const geometry = new THREE.CylinderGeometry(radius, radius, length, 48, 96, true);
+  geometry.translate(0, length / 2, 0);
+  const position = geometry.attributes.position;
+  const index = new Uint16Array(4 * position.count);
+  const weight = new Float32Array(4 * position.count);
+  for (let v = 0; v < position.count; v++) {
+    const t = THREE.MathUtils.clamp((position.getY(v) - length / 2 + blend) / (2 * blend), 0, 1);
+    const second = t * t * (3 - 2 * t);
+    index.set([0, 1, 0, 0], 4 * v);
+    weight.set([1 - second, second, 0, 0], 4 * v);
+  }
+  geometry.setAttribute('skinIndex', new THREE.BufferAttribute(index, 4));
+  geometry.setAttribute('skinWeight', new THREE.BufferAttribute(weight, 4));
+  return geometry;
+}
+
+/** {@link limb} as a rig (its bind pose is the skeleton's space). */
+export function limbRig(): Rig {
+  const g = limb();
+  const attribute = (name: string) => g.attributes[name].array;
+  const empty = new Float32Array(0);
+  return {
+    vertices: g.attributes.position.count,
+    joints: 2,
+    rest: Float32Array.from(attribute('position')),
+    restNormals: Float32Array.from(attribute('normal')),
+    joint: Uint32Array.from(attribute('skinIndex')),
+    weight: Float32Array.from(attribute('skinWeight')),
+    triangles: new Uint32Array(0),
+    skinning: empty,
+    lb: empty,
+    dqb: empty,
+    dqbNormals: empty,
+  };
+}
+
+/**
+ * The limb turned as a whole up to 180° about a random axis and moved, its second bone twisted
+ * 90–180° about the limb's axis at the joint (a wrist turned against its forearm): rigid
+ * skinning matrices for {@link scaledPose}.
+ */
+export function twistedLimb(seed: number): Float32Array {
+  const random = seeded(seed);
+  const axis = new THREE.Vector3(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+  const whole = new THREE.Matrix4().makeRotationAxis(axis, Math.PI * random()).setPosition(random() * 0.1, random() * 0.1, random() * 0.1);
+  const joint = LIMB.length / 2;
+  const twist = new THREE.Matrix4().makeTranslation(0, joint, 0).multiply(new THREE.Matrix4().makeRotationY(Math.PI * (0.5 + 0.5 * random()))).multiply(new THREE.Matrix4().makeTranslation(0, -joint, 0));
+  const out = new Float32Array(32);
+  out.set(whole.elements, 0);
+  out.set(whole.clone().multiply(twist).elements, 16);
+  return out;
+}
