@@ -106,12 +106,13 @@ describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a
   /** Positions within 1e-4 of the mesh's size; normals within 1e-3 rad. */
   const positions = () => 1e-4 * result.size;
   const normals = 1e-3;
-  /** Each pose's GPU positions and normals, and CPU positions, within the bounds. */
-  const expectMatches = (poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[]) => {
+  /** Each pose's GPU positions and normals, and CPU positions, within the bounds (positions: `bound`, by default the built-in hand's). */
+  const expectMatches = (poses: { seed?: number; name?: string; dqs: number; dqsNormals: number; cpu: number }[], bound = positions()) => {
     for (const r of poses) {
-      expect(r.dqs, `seed ${r.seed}`).toBeLessThan(positions());
-      expect(r.dqsNormals, `seed ${r.seed}`).toBeLessThan(normals);
-      expect(r.cpu, `seed ${r.seed}`).toBeLessThan(positions());
+      const label = r.name ?? `seed ${r.seed}`;
+      expect(r.dqs, label).toBeLessThan(bound);
+      expect(r.dqsNormals, label).toBeLessThan(normals);
+      expect(r.cpu, label).toBeLessThan(bound);
     }
   };
 
@@ -129,11 +130,7 @@ describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a
 
   test('three random poses dqhand exports itself (wrist turned 90–180°, fingers beyond their ranges) match its native DQB', () => {
     expect(result.native.length).toBe(NATIVE.length);
-    for (const r of result.native) {
-      expect(r.dqs, r.name).toBeLessThan(positions());
-      expect(r.dqsNormals, r.name).toBeLessThan(normals);
-      expect(r.cpu, r.name).toBeLessThan(positions());
-    }
+    expectMatches(result.native);
   });
 
   test('mode blend follows its vertex attribute: linear where it is 0, dual quaternion where it is 1', () => {
@@ -153,21 +150,13 @@ describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a
   test('a cylinder twisted 90–180° at its joint, turned up to 180° as a whole, its bones scaled and sheared, matches the reference in three poses', () => {
     expect(result.limb.vertices).toBeGreaterThan(4000);
     expect(result.limb.poses.length).toBe(3);
-    for (const r of result.limb.poses) {
-      expect(r.dqs, `seed ${r.seed}`).toBeLessThan(1e-4 * result.limb.size);
-      expect(r.dqsNormals, `seed ${r.seed}`).toBeLessThan(normals);
-      expect(r.cpu, `seed ${r.seed}`).toBeLessThan(1e-4 * result.limb.size);
-    }
+    expectMatches(result.limb.poses, 1e-4 * result.limb.size);
   });
 
   test('a hand made elsewhere (the WebXR generic hand glTF, through its own bind matrix) matches the reference in three poses', () => {
     expect(result.outside.vertices).toBeGreaterThan(1000);
     expect(result.outside.poses.length).toBe(3);
-    for (const r of result.outside.poses) {
-      expect(r.dqs, `seed ${r.seed}`).toBeLessThan(1e-4 * result.outside.size);
-      expect(r.dqsNormals, `seed ${r.seed}`).toBeLessThan(normals);
-      expect(r.cpu, `seed ${r.seed}`).toBeLessThan(1e-4 * result.outside.size);
-    }
+    expectMatches(result.outside.poses, 1e-4 * result.outside.size);
   });
 
   test('without the sign alignment the same comparison fails: the test can tell', () => {

@@ -17,6 +17,9 @@ export interface Backend {
   cpuPositions(rig: Rig, matrices: ArrayLike<number>): Float32Array;
 }
 
+/** The diagonal of the rig's rest box: the bounds are fractions of it. */
+const sizeOf = (rig: Rig) => new THREE.Box3().setFromArray(rig.rest).getSize(new THREE.Vector3()).length();
+
 /**
  * Everything the test asserts, measured in one go. `exports` names more frames of the same hand
  * that dqhand exported in other poses (`name`.json, `name`.bin), each compared with dqhand's own
@@ -25,10 +28,7 @@ export interface Backend {
 export async function conformance(backend: Backend, exports: string[] = []) {
   const { readBack, cpuPositions } = backend;
   const rig = await loadRig();
-  const size = (() => {
-    const box = new THREE.Box3().setFromArray(rig.rest);
-    return box.getSize(new THREE.Vector3()).length();
-  })();
+  const size = sizeOf(rig);
   const exported = {
     three: worst(await readBack(rig, rig.skinning, 'three', 'position'), rig.lb),
     lbs: worst(await readBack(rig, rig.skinning, 'lbs', 'position'), rig.lb),
@@ -37,38 +37,28 @@ export async function conformance(backend: Backend, exports: string[] = []) {
     cpu: worst(cpuPositions(rig, rig.skinning), rig.dqb),
     blend: worst(await readBack(rig, rig.skinning, 'blend', 'position'), alternate(rig.lb, rig.dqb)),
   };
+  /** One pose's GPU positions and normals, and CPU positions, against `positions` and `normals`. */
+  const measure = async (r: Rig, matrices: ArrayLike<number>, positions: ArrayLike<number>, normals: ArrayLike<number>) => ({
+    dqs: worst(await readBack(r, matrices, 'dqs', 'position'), positions),
+    dqsNormals: worst(await readBack(r, matrices, 'dqs', 'normal'), normals, true),
+    cpu: worst(cpuPositions(r, matrices), positions),
+  });
   const native = [];
   for (const name of exports) {
     const other = await loadRig(name);
-    native.push({
-      name,
-      dqs: worst(await readBack(other, other.skinning, 'dqs', 'position'), other.dqb),
-      dqsNormals: worst(await readBack(other, other.skinning, 'dqs', 'normal'), other.dqbNormals, true),
-      cpu: worst(cpuPositions(other, other.skinning), other.dqb),
-    });
+    native.push({ name, ...(await measure(other, other.skinning, other.dqb, other.dqbNormals)) });
   }
   const random = [];
   for (let seed = 1; seed <= 6; seed++) {
     const pose = randomPose(rig, seed);
     const ref = reference(rig, pose);
-    random.push({
-      seed,
-      dqs: worst(await readBack(rig, pose, 'dqs', 'position'), ref.positions),
-      dqsNormals: worst(await readBack(rig, pose, 'dqs', 'normal'), ref.normals, true),
-      cpu: worst(cpuPositions(rig, pose), ref.positions),
-      unaligned: worst(await readBack(rig, pose, 'dqs', 'position', true), ref.positions),
-    });
+    random.push({ seed, ...(await measure(rig, pose, ref.positions, ref.normals)), unaligned: worst(await readBack(rig, pose, 'dqs', 'position', true), ref.positions) });
   }
   const scaled = [];
   for (let seed = 11; seed <= 13; seed++) {
     const pose = scaledPose(rig, seed);
     const ref = reference(rig, pose.rigid, pose.scales);
-    scaled.push({
-      seed,
-      dqs: worst(await readBack(rig, pose.matrices, 'dqs', 'position'), ref.positions),
-      dqsNormals: worst(await readBack(rig, pose.matrices, 'dqs', 'normal'), ref.normals, true),
-      cpu: worst(cpuPositions(rig, pose.matrices), ref.positions),
-    });
+    scaled.push({ seed, ...(await measure(rig, pose.matrices, ref.positions, ref.normals)) });
   }
   // The limb of the figures, its second bone twisted 90–180° about its axis, both bones scaled and sheared.
   const cylinder = limbRig();
@@ -76,27 +66,15 @@ export async function conformance(backend: Backend, exports: string[] = []) {
   for (let seed = 31; seed <= 33; seed++) {
     const pose = scaledPose(cylinder, seed, twistedLimb(seed));
     const ref = reference(cylinder, pose.rigid, pose.scales);
-    limb.push({
-      seed,
-      dqs: worst(await readBack(cylinder, pose.matrices, 'dqs', 'position'), ref.positions),
-      dqsNormals: worst(await readBack(cylinder, pose.matrices, 'dqs', 'normal'), ref.normals, true),
-      cpu: worst(cpuPositions(cylinder, pose.matrices), ref.positions),
-    });
+    limb.push({ seed, ...(await measure(cylinder, pose.matrices, ref.positions, ref.normals)) });
   }
   const outside = await outsideHand();
-  const outsideSize = new THREE.Box3().setFromArray(outside.rig.rest).getSize(new THREE.Vector3()).length();
   const generic = [];
   for (const [k, pose] of outside.poses.entries()) {
     const ref = reference(outside.rig, pose);
-    generic.push({
-      seed: 21 + k,
-      dqs: worst(await readBack(outside.rig, pose, 'dqs', 'position'), ref.positions),
-      dqsNormals: worst(await readBack(outside.rig, pose, 'dqs', 'normal'), ref.normals, true),
-      cpu: worst(cpuPositions(outside.rig, pose), ref.positions),
-    });
+    generic.push({ seed: 21 + k, ...(await measure(outside.rig, pose, ref.positions, ref.normals)) });
   }
-  const limbSize = new THREE.Box3().setFromArray(cylinder.rest).getSize(new THREE.Vector3()).length();
-  return { size, vertices: rig.vertices, exported, native, random, scaled, limb: { size: limbSize, vertices: cylinder.vertices, poses: limb }, outside: { size: outsideSize, vertices: outside.rig.vertices, poses: generic } };
+  return { size, vertices: rig.vertices, exported, native, random, scaled, limb: { size: sizeOf(cylinder), vertices: cylinder.vertices, poses: limb }, outside: { size: sizeOf(outside.rig), vertices: outside.rig.vertices, poses: generic } };
 }
 
 /**
