@@ -27,9 +27,10 @@ interface Conformance {
   scaled: { seed: number; dqs: number; dqsNormals: number; cpu: number }[];
   limb: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
   outside: { size: number; vertices: number; poses: { seed: number; dqs: number; dqsNormals: number; cpu: number }[] };
-  /** WebGPURenderer only: which backend drew, and the shadow pictures (pixels) of two random poses. */
+  /** WebGPURenderer only: which backend drew, the shadow pictures (pixels) of two random poses, and two meshes sharing a build. */
   backend?: string;
   shadows?: { seed: number; shadowed: number; dqs: number; three: number }[];
+  sharedBuild?: { size: number; builds: number; worst: number[] };
 }
 
 /** The WebXR generic hand: a skinned glTF from the WebXR input profiles (third_party/). */
@@ -91,6 +92,10 @@ beforeAll(async () => {
     await p.goto(server.url + query);
     await p.waitForFunction(() => document.title === 'ready', null, { timeout: 60_000 });
     results[name] = await p.evaluate((names) => (window as unknown as { conformance(n: string[]): Promise<Conformance> }).conformance(names), NATIVE);
+    // What was measured, for the docs (the worst of each set).
+    const r = results[name];
+    const most = (set: { dqs: number; dqsNormals: number; cpu: number }[]) => ['dqs', 'dqsNormals', 'cpu'].map((k) => Math.max(...set.map((x) => x[k as 'dqs'])).toPrecision(2)).join(' / ');
+    console.log(`three-dqs through ${name} (worst m / rad / m of GPU positions / normals / CPU positions): exported ${most([r.exported])}, dqhand's poses ${most(r.native)}, random ${most(r.random)}, scaled ${most(r.scaled)}, limb ${most(r.limb.poses)}, generic hand ${most(r.outside.poses)}; unaligned ${r.random.map((x) => x.unaligned.toFixed(2)).join(' ')}${r.shadows ? `; shadow pixels differing (dqs, three) of shadowed ${r.shadows.map((x) => `${x.dqs}, ${x.three} of ${x.shadowed}`).join('; ')}; shared build ${JSON.stringify(r.sharedBuild)}` : ''}`);
     await p.close();
   }
 }, 240_000);
@@ -169,6 +174,12 @@ describe.each(Object.keys(RENDERERS))('three-dqs through %s against dqhand and a
       expect(result.backend).toBe(renderer.endsWith('WebGPU') ? 'webgpu' : 'webgl2');
     });
 
+    test('two meshes of one material, each with its own skeleton and pose, share one build and each is skinned by its own bones', () => {
+      expect(result.sharedBuild?.builds).toBe(1);
+      expect(result.sharedBuild?.worst.length).toBe(2);
+      for (const w of result.sharedBuild?.worst ?? []) expect(w).toBeLessThan(1e-4 * result.sharedBuild!.size);
+    });
+
     test('shadow maps draw the dual quaternion skin: its shadow is the reference\'s to the pixel, three.js\'s linear skin\'s is not', () => {
       expect(result.shadows?.length).toBe(2);
       for (const r of result.shadows ?? []) {
@@ -193,8 +204,8 @@ describe('the three-dqs example app installed from the package tarball', () => {
   const version = JSON.parse(readFileSync(path.join(PACKAGE, 'package.json'), 'utf8')).version as string;
   let app: string;
   let site: Awaited<ReturnType<typeof serveStatic>>;
-  const open = async (mode: string, renderer = 'webgl') => {
-    const p = await newPage(browser);
+  const open = async (mode: string, renderer = 'webgl', within = browser) => {
+    const p = await newPage(within);
     const errors: string[] = [];
     p.on('pageerror', (e) => errors.push(e.message));
     // (WebGPU reports a pipeline that fails to compile on the console.)
@@ -205,13 +216,14 @@ describe('the three-dqs example app installed from the package tarball', () => {
     return { p, state, errors };
   };
 
-  beforeAll(() => {
+  beforeAll(async () => {
     app = mkdtempSync(path.join(process.env.TMPDIR ?? tmpdir(), 'three-dqs-example-'));
     cpSync(path.join(PACKAGE, 'example'), app, { recursive: true });
     execFileSync('npm', ['install', '--no-audit', '--no-fund', path.join(root, 'target/npm', `three-dqs-${version}.tgz`)], { cwd: app, stdio: 'inherit' });
     mkdirSync(path.join(app, 'public'));
     copyFileSync(GENERIC_HAND, path.join(app, 'public/hand.glb'));
     execFileSync(path.join(app, 'node_modules/.bin/vite'), ['build', '--logLevel', 'warn'], { cwd: app, stdio: 'inherit' });
+    site = await serveStatic(path.join(app, 'dist'));
   }, 300_000);
 
   afterAll(async () => {
@@ -225,7 +237,6 @@ describe('the three-dqs example app installed from the package tarball', () => {
   });
 
   test('a glTF hand made elsewhere is drawn with dual quaternions, its shadow too, and differently from linear skinning where its fingers bend', async () => {
-    site = await serveStatic(path.join(app, 'dist'));
     const dqs = await open('dqs');
     const lbs = await open('lbs');
     try {
@@ -252,15 +263,23 @@ describe('the three-dqs example app installed from the package tarball', () => {
 
   test('with WebGPURenderer (three-dqs/webgpu from the same tarball) the same hand compiles, skin and shadow, and its CPU path gives the WebGL entry\'s box', async () => {
     const webgl = await open('dqs');
-    const webgpu = await open('dqs', 'webgpu');
+    const box = webgl.state.box;
+    await webgl.p.close();
+    const own = await launchBrowser(['--enable-unsafe-webgpu']);
     try {
-      expect(webgpu.errors).toEqual([]);
+      const webgpu = await open('dqs', 'webgpu', own);
+      // (WebGPU reports errors asynchronously: give the frame's work time to finish.)
+      await webgpu.p.evaluate(() => new Promise((done) => requestAnimationFrame(() => setTimeout(done, 500))));
+      // Headless Chromium 156 sometimes drops a page's WebGPU instance after its first frame,
+      // with or without this package ("A valid external Instance reference no longer exists",
+      // then three.js's error scopes fail): that loss is the browser's, not a shader error.
+      const dropped = /Instance dropped in popErrorScope|A valid external Instance reference no longer exists/;
+      expect(webgpu.errors.filter((e) => !dropped.test(e))).toEqual([]);
       expect(webgpu.state.renderer).toBe('webgpu');
       expect(webgpu.state.meshes).toBe(1);
-      for (let k = 0; k < 3; k++) expect(Math.abs(webgpu.state.box[k] - webgl.state.box[k])).toBeLessThan(1e-6);
+      for (let k = 0; k < 3; k++) expect(Math.abs(webgpu.state.box[k] - box[k])).toBeLessThan(1e-6);
     } finally {
-      await webgl.p.close();
-      await webgpu.p.close();
+      await own.close();
     }
   });
 });

@@ -33,61 +33,74 @@ export class BoneDualQuaternions {
   /** The same, as a float texture of {@link TEXELS_PER_BONE} texels per row, a row per bone. */
   readonly texture: DataTexture;
 
-  private readonly full = new Matrix4();
+  /** The bone matrices the data was last computed from: an update that finds them unchanged does nothing. */
+  private readonly last: Float32Array;
   private readonly rotation = new Matrix4();
   private readonly quaternion = new Quaternion();
+  // Scratch for one bone (column-major 3×3s), so a frame allocates nothing.
+  private readonly linear = new Float64Array(9);
+  private readonly polar = new Float64Array(9);
+  private readonly cofactors = new Float64Array(9);
 
   constructor(readonly boneCount: number) {
     this.data = new Float32Array(Math.max(boneCount, 1) * FLOATS_PER_BONE);
+    this.last = new Float32Array(16 * boneCount).fill(NaN);
     this.texture = new DataTexture(this.data, TEXELS_PER_BONE, Math.max(boneCount, 1), RGBAFormat, FloatType);
     this.texture.needsUpdate = true;
   }
 
-  /** Recomputes every bone's parts from `skeleton`'s `boneMatrices` (as its last `update` left them). */
+  /**
+   * Recomputes every bone's parts from `skeleton`'s `boneMatrices` (as its last `update` left
+   * them), unless they are what they were last time (a skeleton updated twice in a frame, by
+   * a shadow pass and the main one, or not moving).
+   */
   update(skeleton: Skeleton): void {
     const matrices = skeleton.boneMatrices;
-    if (!matrices) return;
-    for (let b = 0; b < this.boneCount; b++) {
-      this.full.fromArray(matrices, b * 16);
-      this.split(b);
-    }
+    if (!matrices || sameValues(matrices, this.last)) return;
+    this.last.set(matrices.subarray(0, this.last.length));
+    for (let b = 0; b < this.boneCount; b++) this.split(matrices, 16 * b, b);
     this.texture.needsUpdate = true;
   }
 
-  /** Splits `this.full` (an affine transform) into bone `b`'s dual quaternion and scale–shear. */
-  private split(b: number): void {
-    const e = this.full.elements;
-    const a = [e[0], e[1], e[2], e[4], e[5], e[6], e[8], e[9], e[10]];
+  /** Splits the affine transform at `m[o…o+15]` into bone `b`'s dual quaternion and scale–shear. */
+  private split(m: ArrayLike<number>, o: number, b: number): void {
+    const a = this.linear;
+    for (let c = 0; c < 3; c++) for (let r = 0; r < 3; r++) a[3 * c + r] = m[o + 4 * c + r];
     const det = determinant(a);
     // A bone scaled to nothing (glTF animations hide parts so) has no rotation to find: it is
     // all S. A mirroring bone (negative determinant) has no rotation either: its mirror goes
     // into S.
-    const r = Math.abs(det) < SINGULAR ? [1, 0, 0, 0, 1, 0, 0, 0, 1] : polarRotation(a.map((x) => (det < 0 ? -x : x)));
+    const r = this.polar;
+    if (Math.abs(det) < SINGULAR) r.set(IDENTITY);
+    else {
+      for (let i = 0; i < 9; i++) r[i] = det < 0 ? -a[i] : a[i];
+      polarRotation(r, this.cofactors);
+    }
     this.rotation.set(r[0], r[3], r[6], 0, r[1], r[4], r[7], 0, r[2], r[5], r[8], 0, 0, 0, 0, 1);
     const q = this.quaternion.setFromRotationMatrix(this.rotation);
-    const [tx, ty, tz] = [e[12], e[13], e[14]];
-    const o = b * FLOATS_PER_BONE;
+    const [tx, ty, tz] = [m[o + 12], m[o + 13], m[o + 14]];
+    const f = b * FLOATS_PER_BONE;
     const d = this.data;
-    d[o] = q.x;
-    d[o + 1] = q.y;
-    d[o + 2] = q.z;
-    d[o + 3] = q.w;
+    d[f] = q.x;
+    d[f + 1] = q.y;
+    d[f + 2] = q.z;
+    d[f + 3] = q.w;
     // The dual part ½ t q, t the translation as a pure quaternion.
-    d[o + 4] = 0.5 * (tx * q.w + ty * q.z - tz * q.y);
-    d[o + 5] = 0.5 * (-tx * q.z + ty * q.w + tz * q.x);
-    d[o + 6] = 0.5 * (tx * q.y - ty * q.x + tz * q.w);
-    d[o + 7] = -0.5 * (tx * q.x + ty * q.y + tz * q.z);
+    d[f + 4] = 0.5 * (tx * q.w + ty * q.z - tz * q.y);
+    d[f + 5] = 0.5 * (-tx * q.z + ty * q.w + tz * q.x);
+    d[f + 6] = 0.5 * (tx * q.y - ty * q.x + tz * q.w);
+    d[f + 7] = -0.5 * (tx * q.x + ty * q.y + tz * q.z);
     // S = Rᵀ A, column by column (column-major like three's matrices).
     let off = 0;
     for (let c = 0; c < 3; c++) {
       for (let row = 0; row < 3; row++) {
         const value = r[3 * row] * a[3 * c] + r[3 * row + 1] * a[3 * c + 1] + r[3 * row + 2] * a[3 * c + 2];
-        d[o + 8 + 4 * c + row] = value;
+        d[f + 8 + 4 * c + row] = value;
         off = Math.max(off, Math.abs(value - (row === c ? 1 : 0)));
       }
-      d[o + 8 + 4 * c + 3] = 0;
+      d[f + 8 + 4 * c + 3] = 0;
     }
-    d[o + 11] = off > RIGID ? 1 : 0;
+    d[f + 11] = off > RIGID ? 1 : 0;
   }
 
   dispose(): void {
@@ -95,33 +108,44 @@ export class BoneDualQuaternions {
   }
 }
 
+const IDENTITY = [1, 0, 0, 0, 1, 0, 0, 0, 1];
+
+/** Whether `a` starts with `b`'s values (NaN never equals: a fresh `b` always differs). */
+function sameValues(a: ArrayLike<number>, b: Float32Array): boolean {
+  for (let i = 0; i < b.length; i++) if (a[i] !== b[i]) return false;
+  return true;
+}
+
 /** The determinant of a column-major 3×3 matrix. */
-function determinant(m: number[]): number {
+function determinant(m: ArrayLike<number>): number {
   return m[0] * (m[4] * m[8] - m[7] * m[5]) - m[3] * (m[1] * m[8] - m[7] * m[2]) + m[6] * (m[1] * m[5] - m[4] * m[2]);
 }
 
 /**
- * The rotation of the polar decomposition `A = R S` of a column-major 3×3 matrix with a
- * positive determinant: Higham's iteration `X ← (X + X⁻ᵀ) / 2`, which converges quadratically
- * (a rigid bone's matrix, a rotation up to float rounding, stops after two steps).
+ * Turns `x`, a column-major 3×3 matrix with a positive determinant, into the rotation of its
+ * polar decomposition `A = R S`: Higham's iteration `X ← (X + X⁻ᵀ) / 2`, which converges
+ * quadratically (a rigid bone's matrix, a rotation up to float rounding, stops after two
+ * steps). `scratch` holds X⁻ᵀ.
  */
-function polarRotation(a: number[]): number[] {
-  let x = a.slice();
+function polarRotation(x: Float64Array, scratch: Float64Array): void {
   for (let k = 0; k < 32; k++) {
     // X⁻ᵀ = cofactor matrix / det.
     const det = determinant(x);
-    const inverseTranspose = [
-      (x[4] * x[8] - x[7] * x[5]) / det, (x[6] * x[5] - x[3] * x[8]) / det, (x[3] * x[7] - x[6] * x[4]) / det,
-      (x[7] * x[2] - x[1] * x[8]) / det, (x[0] * x[8] - x[6] * x[2]) / det, (x[6] * x[1] - x[0] * x[7]) / det,
-      (x[1] * x[5] - x[4] * x[2]) / det, (x[3] * x[2] - x[0] * x[5]) / det, (x[0] * x[4] - x[3] * x[1]) / det,
-    ];
+    scratch[0] = (x[4] * x[8] - x[7] * x[5]) / det;
+    scratch[1] = (x[6] * x[5] - x[3] * x[8]) / det;
+    scratch[2] = (x[3] * x[7] - x[6] * x[4]) / det;
+    scratch[3] = (x[7] * x[2] - x[1] * x[8]) / det;
+    scratch[4] = (x[0] * x[8] - x[6] * x[2]) / det;
+    scratch[5] = (x[6] * x[1] - x[0] * x[7]) / det;
+    scratch[6] = (x[1] * x[5] - x[4] * x[2]) / det;
+    scratch[7] = (x[3] * x[2] - x[0] * x[5]) / det;
+    scratch[8] = (x[0] * x[4] - x[3] * x[1]) / det;
     let change = 0;
-    x = x.map((v, i) => {
-      const next = 0.5 * (v + inverseTranspose[i]);
-      change = Math.max(change, Math.abs(next - v));
-      return next;
-    });
+    for (let i = 0; i < 9; i++) {
+      const next = 0.5 * (x[i] + scratch[i]);
+      change = Math.max(change, Math.abs(next - x[i]));
+      x[i] = next;
+    }
     if (change < 1e-12) break;
   }
-  return x;
 }

@@ -63,6 +63,9 @@ export class CpuSkinning {
     const length = Math.max(Math.hypot(this.real[0], this.real[1], this.real[2], this.real[3]), 1e-20);
     const q = [0, 1, 2, 3].map((k) => this.real[k] / length);
     const qd = [0, 1, 2, 3].map((k) => this.dual[k] / length);
+    // (The scale–shear divided by the weights' sum, as the dual quaternion is normalised.)
+    const total = Math.max(weights[0] + weights[1] + weights[2] + weights[3], 1e-20);
+    for (let i = 0; i < 9; i++) this.scale[i] /= total;
     const m = this.scale;
     const scaled = [0, 1, 2].map((r) => m[r] * x + m[3 + r] * y + m[6 + r] * z);
     const moved = rotate(q, scaled);

@@ -12,6 +12,8 @@ interface SkeletonState {
 }
 
 const skeletons = new WeakMap<Skeleton, SkeletonState>();
+/** Meshes skinned with dual quaternions now. */
+const attachedMeshes = new WeakSet<SkinnedMesh>();
 
 /** The dual quaternions of `skeleton`, if a mesh of it uses them. */
 export function bonesOf(skeleton: Skeleton): BoneDualQuaternions | undefined {
@@ -64,6 +66,8 @@ export function attach(mesh: SkinnedMesh, mode: SkinningMode): Attached {
   const name = mesh.name || 'mesh';
   if (!mesh.isSkinnedMesh || !mesh.skeleton) throw new Error(`${name}: not a SkinnedMesh with a skeleton`);
   if (mode === 'blend' && !mesh.geometry.attributes.dqsBlend) throw new Error(`${name}: mode 'blend' needs the vertex attribute dqsBlend`);
+  if (attachedMeshes.has(mesh)) throw new Error(`${name}: already skinned with dual quaternions (dispose that first)`);
+  attachedMeshes.add(mesh);
   const skeleton = mesh.skeleton;
   const state = share(skeleton);
   skeleton.update();
@@ -87,6 +91,7 @@ export function attach(mesh: SkinnedMesh, mode: SkinningMode): Attached {
     detach() {
       for (const method of [...refreshed, 'applyBoneTransform']) delete (mesh as unknown as Record<string, unknown>)[method];
       unshare(skeleton, state);
+      attachedMeshes.delete(mesh);
     },
   };
 }

@@ -73,12 +73,20 @@ export function useDualQuaternionSkinning(mesh: SkinnedMesh, options: DualQuater
   const attached = attach(mesh, mode);
   const original = { material: mesh.material, depth: mesh.customDepthMaterial, distance: mesh.customDistanceMaterial };
   const patch = (m: Material) => patchMaterial(m, mode, options.shareMaterials ?? false);
-  mesh.material = Array.isArray(original.material) ? original.material.map(patch) : patch(original.material);
-  // Shadow maps draw the mesh with their own depth materials, which would read the dual
-  // quaternions as three.js's matrices: the mesh gets patched ones (three.js's defaults for a
-  // shadow's depth, or copies of its own).
-  mesh.customDepthMaterial = patchMaterial(original.depth ?? new MeshDepthMaterial({ depthPacking: RGBADepthPacking }), mode, !original.depth);
-  mesh.customDistanceMaterial = patchMaterial(original.distance ?? new MeshDistanceMaterial(), mode, !original.distance);
+  try {
+    mesh.material = Array.isArray(original.material) ? original.material.map(patch) : patch(original.material);
+    // Shadow maps draw the mesh with their own depth materials, which would read the dual
+    // quaternions as three.js's matrices: the mesh gets patched ones (three.js's defaults for a
+    // shadow's depth, or copies of its own).
+    mesh.customDepthMaterial = patchMaterial(original.depth ?? new MeshDepthMaterial({ depthPacking: RGBADepthPacking }), mode, !original.depth);
+    mesh.customDistanceMaterial = patchMaterial(original.distance ?? new MeshDistanceMaterial(), mode, !original.distance);
+  } catch (error) {
+    mesh.material = original.material;
+    mesh.customDepthMaterial = original.depth;
+    mesh.customDistanceMaterial = original.distance;
+    attached.detach();
+    throw error;
+  }
   return {
     bones: attached.bones,
     dispose() {

@@ -68,7 +68,9 @@ export const skinbaseVertex = /* glsl */ `
 	mat3 dqsScale = mat3( 1.0 );
 	mat3 dqsNormalScale = mat3( 1.0 );
 	if ( dqsScaled ) {
-		dqsScale = skinWeight.x * dqsScale0 + skinWeight.y * dqsScale1 + skinWeight.z * dqsScale2 + skinWeight.w * dqsScale3;
+		// (Divided by the weights' sum, as the dual quaternion is normalised: weights that do not
+		// add up to 1 scale neither part.)
+		dqsScale = ( skinWeight.x * dqsScale0 + skinWeight.y * dqsScale1 + skinWeight.z * dqsScale2 + skinWeight.w * dqsScale3 ) / max( dot( skinWeight, vec4( 1.0 ) ), 1e-20 );
 		// Normals: the blended scale–shear's inverse transpose (its cofactors, up to the determinant).
 		// The determinant's sign keeps a mirrored normal pointing out.
 		dqsNormalScale = sign( determinant( dqsScale ) ) * mat3( cross( dqsScale[ 1 ], dqsScale[ 2 ] ), cross( dqsScale[ 2 ], dqsScale[ 0 ] ), cross( dqsScale[ 0 ], dqsScale[ 1 ] ) );

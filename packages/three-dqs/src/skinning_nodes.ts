@@ -27,8 +27,8 @@ interface Influence {
 const updated = new WeakMap<Skeleton, number>();
 
 /**
- * The bone texture node, following the drawn object's skeleton (one build serves every mesh
- * drawn with it), and each skeleton updated once a frame, as three.js's own skinning node
+ * The bone texture node, following the drawn object's skeleton (a build may serve every mesh
+ * of the same material copy and geometry layout), and each skeleton updated once a frame, as three.js's own skinning node
  * does (which this one replaces, so nothing else updates it).
  */
 function boneTextureNode(first: Texture): N {
@@ -102,7 +102,10 @@ function blend(all: Influence[], alignSigns: boolean): Blend {
   }
   // (A vertex with no weight at all keeps a zero transform rather than a division by zero.)
   const norm = max(length(real), float(1e-20)).toVar();
-  const scale = [0, 1, 2].map((k) => all.reduce((sum: N, i) => sum.add(i.scale[k].mul(i.weight)), vec3(0)).toVar());
+  // (Divided by the weights' sum, as the dual quaternion is normalised: weights that do not add
+  // up to 1 scale neither part.)
+  const total = max(all.reduce((sum: N, i) => sum.add(i.weight), float(0)), float(1e-20)).toVar();
+  const scale = [0, 1, 2].map((k) => all.reduce((sum: N, i) => sum.add(i.scale[k].mul(i.weight)), vec3(0)).div(total).toVar());
   // Normals: the blended scale–shear's inverse transpose (its cofactors, up to the
   // determinant); the determinant's sign keeps a mirrored normal pointing out.
   const cofactors = [cross(scale[1], scale[2]), cross(scale[2], scale[0]), cross(scale[0], scale[1])];
@@ -147,7 +150,7 @@ const objectReference = (name: string): N => (reference as N)(name, 'mat4');
 /** The vertex's inputs for `mode`, read once. */
 function vertexOf(mesh: SkinnedMesh, mode: SkinningMode, alignSigns: boolean): Vertex {
   const bones = bonesOf(mesh.skeleton);
-  if (!bones) throw new Error(`${mesh.name || 'mesh'}: its skeleton has no dual quaternions (useDualQuaternionSkinning first)`);
+  if (!bones) throw new Error(`${mesh.name || 'mesh'}: drawn with a material that skins with dual quaternions, but its skeleton has none (call useDualQuaternionSkinning on it)`);
   const all = influences(boneTextureNode(bones.texture));
   return { all, blended: blend(all, alignSigns), bindMatrix: objectReference('bindMatrix'), bindMatrixInverse: objectReference('bindMatrixInverse'), mode };
 }
@@ -159,11 +162,10 @@ function skinnedPosition(vertex: Vertex, position: N): N {
 }
 
 /**
- * Skins `positionLocal`, `normalLocal` and `tangentLocal` in place (where the geometry has
- * them): what three.js's `skinning(mesh)` does, with dual quaternions. Call it where that is
- * called, in a node material's `setupPosition`.
+ * {@link dualQuaternionSkinning} with the sign alignment optional: without it, the mistake (a
+ * vertex blending the long way round) that the conformance test injects to show it fails.
  */
-export const dualQuaternionSkinning = (mesh: SkinnedMesh, mode: SkinningMode = 'dqs', alignSigns = true): Node =>
+export const skinInPlace = (mesh: SkinnedMesh, mode: SkinningMode, alignSigns: boolean): Node =>
   Fn((_: unknown, builder: N) => {
     const vertex = vertexOf(mesh, mode, alignSigns);
     const { real, scale, normalScale } = vertex.blended;
@@ -175,8 +177,25 @@ export const dualQuaternionSkinning = (mesh: SkinnedMesh, mode: SkinningMode = '
   }, 'void')() as Node;
 
 /**
- * The skinned position of the geometry's own (unmorphed) positions, as a node: for
- * `castShadowPositionNode`, which shadow maps draw with in place of three.js's skinning.
+ * Skins `positionLocal`, `normalLocal` and `tangentLocal` in place (where the geometry has
+ * them): what three.js's `skinning(mesh)` does, with dual quaternions. Call it where that is
+ * called, in a node material's `setupPosition`.
  */
-export const dualQuaternionSkinnedPosition = (mesh: SkinnedMesh, mode: SkinningMode = 'dqs'): Node =>
-  Fn(() => skinnedPosition(vertexOf(mesh, mode, true), positionGeometry))() as Node;
+export const dualQuaternionSkinning = (mesh: SkinnedMesh, mode: SkinningMode = 'dqs'): Node => skinInPlace(mesh, mode, true);
+
+/** One node per mode: materials that share it can share their builds. */
+const shadowPositions = new Map<SkinningMode, Node>();
+
+/**
+ * The skinned position of the drawn mesh's geometry (its own positions: no morph targets,
+ * displacement or `positionNode`), as a node: for `castShadowPositionNode`, which shadow maps
+ * draw with in place of three.js's skinning. One node per mode, for every mesh.
+ */
+export function dualQuaternionSkinnedPosition(mode: SkinningMode = 'dqs'): Node {
+  let node = shadowPositions.get(mode);
+  if (!node) {
+    node = Fn((_: unknown, builder: N) => skinnedPosition(vertexOf(builder.object as SkinnedMesh, mode, true), positionGeometry))() as Node;
+    shadowPositions.set(mode, node);
+  }
+  return node;
+}

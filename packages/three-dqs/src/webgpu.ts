@@ -1,4 +1,4 @@
-import type { Material, SkinnedMesh } from 'three';
+import { MathUtils, type Material, type SkinnedMesh } from 'three';
 import {
   MeshBasicNodeMaterial,
   MeshLambertNodeMaterial,
@@ -50,23 +50,28 @@ function nodeMaterialOf(material: Material, name: string): NodeMaterial {
   const Class = NODE_MATERIALS[material.type];
   if (!Class) throw new Error(`${name}: material ${material.name || material.type} has no node material to skin with dual quaternions (use a node material)`);
   const converted = new Class();
-  // What WebGPURenderer's node library does with a classic material: every property carried over.
-  for (const key in material) (converted as unknown as Record<string, unknown>)[key] = (material as unknown as Record<string, unknown>)[key];
+  // What WebGPURenderer's node library does with a classic material: every property carried
+  // over; but the copy lives on, so it gets its own identity and its own listeners.
+  const fields = converted as unknown as Record<string, unknown>;
+  for (const key in material) fields[key] = (material as unknown as Record<string, unknown>)[key];
+  delete fields._listeners;
+  fields.uuid = MathUtils.generateUUID();
   return converted;
 }
 
 /**
- * `material` drawing `mesh` with dual quaternions: its `setupPosition` runs three.js's stages
- * in their order (morph targets, skinning, displacement, the material's `positionNode`) with
- * this package's skinning in place of three.js's; shadow maps draw the mesh's skinned geometry
- * through `castShadowPositionNode` (unless the material has its own).
+ * `material` drawing skinned meshes with dual quaternions: its `setupPosition` runs three.js's
+ * stages in their order (morph targets, skinning, displacement, the material's `positionNode`)
+ * with this package's skinning in place of three.js's; shadow maps draw the skinned geometry
+ * through `castShadowPositionNode` (unless the material has its own). Any skinned mesh drawn
+ * with it (a `mesh.clone()` shares it) must have dual quaternions: builds are shared.
  */
-function skinWith(material: NodeMaterial, mesh: SkinnedMesh, mode: SkinningMode): NodeMaterial {
+function skinWith(material: NodeMaterial, mode: SkinningMode): NodeMaterial {
   const own = material.setupPosition;
   material.setupPosition = function (this: NodeMaterial, builder: NodeBuilder) {
     const object = builder.object as SkinnedMesh;
     const geometry = builder.geometry;
-    if (object !== mesh) return own.call(this, builder);
+    if (!object.isSkinnedMesh) return own.call(this, builder);
     // Morph targets are offsets of the bind pose: they go before the skinning, as in three.js.
     const morphs = geometry.morphAttributes;
     if (morphs.position || morphs.normal || morphs.color) morphReference(object);
@@ -83,7 +88,7 @@ function skinWith(material: NodeMaterial, mesh: SkinnedMesh, mode: SkinningMode)
       flag.isSkinnedMesh = true;
     }
   };
-  if (!material.castShadowPositionNode) material.castShadowPositionNode = dualQuaternionSkinnedPosition(mesh, mode);
+  if (!material.castShadowPositionNode) material.castShadowPositionNode = dualQuaternionSkinnedPosition(mode);
   // Builds are shared between meshes of equal keys: this one's differs from three.js's skinning.
   const key = material.customProgramCacheKey;
   material.customProgramCacheKey = function (this: NodeMaterial) {
@@ -111,17 +116,19 @@ export function useDualQuaternionSkinning(mesh: SkinnedMesh, options: DualQuater
   const name = mesh.name || 'mesh';
   const attached = attach(mesh, mode);
   const original = mesh.material;
-  const skinned = (m: Material) => skinWith(nodeMaterialOf(m, name), mesh, mode);
+  const skinned = (m: Material) => skinWith(nodeMaterialOf(m, name), mode);
+  let copies: NodeMaterial[];
   try {
-    mesh.material = Array.isArray(original) ? original.map(skinned) : skinned(original);
+    copies = [original].flat().map(skinned);
   } catch (error) {
     attached.detach();
     throw error;
   }
+  mesh.material = Array.isArray(original) ? copies : copies[0];
   return {
     bones: attached.bones,
     dispose() {
-      for (const m of [mesh.material].flat()) m.dispose();
+      for (const m of copies) m.dispose();
       mesh.material = original;
       attached.detach();
     },

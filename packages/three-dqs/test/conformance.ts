@@ -11,8 +11,8 @@ import { loadRig, type Rig } from './rig';
 
 /** A renderer's way of running the package: GPU read-back of every vertex, and the CPU path. */
 export interface Backend {
-  /** The mesh's skinned positions or normals as the GPU computes them, 3 floats per vertex (`'three'`: three.js's own skinning). */
-  readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 'three', output: 'position' | 'normal', breakAlignment?: boolean): Promise<Float32Array>;
+  /** The mesh's skinned positions or normals as the GPU computes them, 3 floats per vertex in the skeleton's space (`'three'`: three.js's own skinning; `unaligned`: the package's without its sign alignment). */
+  readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 'three', output: 'position' | 'normal', unaligned?: boolean): Promise<Float32Array>;
   /** The package's CPU path (applyBoneTransform) for every vertex. */
   cpuPositions(rig: Rig, matrices: ArrayLike<number>): Float32Array;
 }
@@ -89,4 +89,16 @@ export async function shadowConformance(pictures: (rig: Rig, matrices: ArrayLike
     out.push({ seed, ...(await pictures(rig, pose, reference(rig, pose).positions)) });
   }
   return out;
+}
+
+/**
+ * Two meshes of one material in two random poses, drawn in one frame through one shared build
+ * (`draw`: see webgpu_readback.ts): each one's positions against the reference of its own pose,
+ * and the number of builds made.
+ */
+export async function sharedBuildConformance(draw: (rig: Rig, a: ArrayLike<number>, b: ArrayLike<number>) => Promise<{ positions: Float32Array[]; builds: number }>) {
+  const rig = await loadRig();
+  const poses = [randomPose(rig, 7), randomPose(rig, 8)];
+  const { positions, builds } = await draw(rig, poses[0], poses[1]);
+  return { size: sizeOf(rig), builds, worst: positions.map((p, k) => worst(p, reference(rig, poses[k]).positions)) };
 }

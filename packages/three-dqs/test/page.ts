@@ -9,11 +9,16 @@ async function page(): Promise<object> {
     const { figure, handFigure } = await import('./figure');
     return { figure, handFigure };
   }
-  const { conformance, shadowConformance } = await import('./conformance');
+  const { conformance, shadowConformance, sharedBuildConformance } = await import('./conformance');
   if (query.has('webgpu')) {
     const backend = await (await import('./webgpu_readback')).webgpu(query.has('webgl'));
     return {
-      conformance: async (names: string[]) => ({ backend: backend.backend, ...(await conformance(backend, names)), shadows: await shadowConformance(backend.shadows) }),
+      conformance: async (names: string[]) => ({
+        backend: backend.backend,
+        ...(await conformance(backend, names)),
+        shadows: await shadowConformance(backend.shadows),
+        sharedBuild: await sharedBuildConformance(backend.twoMeshes),
+      }),
     };
   }
   const { webgl } = await import('./webgl_readback');

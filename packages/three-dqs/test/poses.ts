@@ -8,7 +8,7 @@ import type { Rig } from './rig';
 /**
  * The rig's vertices as the conformance pages draw them: each one three times, a tiny triangle
  * (`corner`, in pixels) over pixel `slot` of a float target, with its skinning attributes, and
- * with `blend` the attribute `dqsBlend`.
+ * with `blend` the attribute `dqsBlend`; in the space of a mesh bound by {@link bindAtRest}.
  */
 export function readbackGeometry(rig: Rig, blend?: (v: number) => number): THREE.BufferGeometry {
   const n = rig.vertices;
@@ -38,7 +38,7 @@ export function readbackGeometry(rig: Rig, blend?: (v: number) => number): THREE
   geometry.setAttribute('corner', new THREE.BufferAttribute(corner, 2));
   geometry.setAttribute('slot', new THREE.BufferAttribute(slot, 1));
   if (blend) geometry.setAttribute('dqsBlend', new THREE.BufferAttribute(slot.map(blend), 1));
-  return geometry;
+  return inMeshSpace(geometry);
 }
 
 /** What both renderers offer to draw into a render target. */
@@ -59,15 +59,48 @@ export function drawAlone<Target>(renderer: Drawer<Target>, target: Target, mesh
   renderer.render(scene, camera);
 }
 
-/** Bones whose skinning matrices are `matrices` (16 per joint, column-major): their world matrices, with identity inverses. */
-export function bonesOf(matrices: ArrayLike<number>, joints: number): THREE.Bone[] {
-  return Array.from({ length: joints }, (_, j) => {
+/**
+ * The bind matrix of the meshes the pages skin: not the identity (turned 40° and moved), so a
+ * skinning that swaps or forgets `bindMatrix` and `bindMatrixInverse` fails.
+ */
+export const BIND = new THREE.Matrix4().compose(new THREE.Vector3(0.3, -0.2, 0.1), new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 2, 3).normalize(), 0.7), new THREE.Vector3(1, 1, 1));
+
+/**
+ * `geometry`, given in the skeleton's space, carried into the mesh's (by BIND⁻¹, normals
+ * too), for a mesh bound by {@link bindAtRest}.
+ */
+export function inMeshSpace(geometry: THREE.BufferGeometry): THREE.BufferGeometry {
+  return geometry.applyMatrix4(BIND.clone().invert());
+}
+
+/**
+ * Binds `mesh` through BIND to `joints` bones at rest (identity skinning matrices), and returns
+ * what poses them: each bone's world matrix set to its skinning matrix (16 per joint,
+ * column-major; the inverses are identities).
+ */
+export function bindAtRest(mesh: THREE.SkinnedMesh, joints: number): (matrices: ArrayLike<number>) => void {
+  const bones = Array.from({ length: joints }, () => {
     const bone = new THREE.Bone();
     bone.matrixAutoUpdate = false;
     bone.matrixWorldAutoUpdate = false;
-    bone.matrixWorld.fromArray(Array.from(matrices).slice(16 * j, 16 * j + 16));
     return bone;
   });
+  mesh.bindMode = THREE.DetachedBindMode;
+  mesh.bind(new THREE.Skeleton(bones, bones.map(() => new THREE.Matrix4())), BIND);
+  return (matrices) => bones.forEach((bone, j) => bone.matrixWorld.fromArray(matrices, 16 * j));
+}
+
+/** Skinned values read back (3 a vertex, in the mesh's space) carried into the skeleton's by BIND, in place: points, or unit normals. */
+export function toSkeletonSpace(values: Float32Array, normals: boolean): Float32Array {
+  const v = new THREE.Vector3();
+  const turn = new THREE.Matrix3().getNormalMatrix(BIND);
+  for (let k = 0; k < values.length; k += 3) {
+    v.fromArray(values, k);
+    if (normals) v.applyMatrix3(turn).normalize();
+    else v.applyMatrix4(BIND);
+    v.toArray(values, k);
+  }
+  return values;
 }
 
 /** The `dqsBlend` of vertex `v` in mode 'blend': 0 (linear) for even vertices, 1 (dual quaternion) for odd ones. */

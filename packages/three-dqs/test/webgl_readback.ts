@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { useDualQuaternionSkinning, type SkinningMode } from '../src/index';
 import type { Backend } from './conformance';
-import { blendOf, bonesOf, drawAlone, readbackGeometry } from './poses';
+import { bindAtRest, blendOf, drawAlone, readbackGeometry, toSkeletonSpace } from './poses';
 import type { Rig } from './rig';
 
 const renderer = new THREE.WebGLRenderer();
@@ -15,7 +15,7 @@ const camera = new THREE.OrthographicCamera();
  * target: the fragment holds the skinned position (or normal), as the material's skinning
  * chunks computed it.
  */
-function readbackMesh(rig: Rig, bones: THREE.Bone[], width: number, output: 'position' | 'normal', blend?: (v: number) => number): THREE.SkinnedMesh {
+function readbackMesh(rig: Rig, width: number, output: 'position' | 'normal', blend?: (v: number) => number): { mesh: THREE.SkinnedMesh; pose: (matrices: ArrayLike<number>) => void } {
   const geometry = readbackGeometry(rig, blend);
   const n = rig.vertices;
   const material = new THREE.ShaderMaterial({
@@ -48,55 +48,58 @@ function readbackMesh(rig: Rig, bones: THREE.Bone[], width: number, output: 'pos
   });
   const mesh = new THREE.SkinnedMesh(geometry, material);
   mesh.frustumCulled = false;
-  mesh.bind(new THREE.Skeleton(bones, bones.map(() => new THREE.Matrix4())), new THREE.Matrix4());
-  return mesh;
+  return { mesh, pose: bindAtRest(mesh, rig.joints) };
 }
 
-/** The mesh's skinned positions or normals as the GPU computes them, 3 floats per vertex. */
-function readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 'three', output: 'position' | 'normal', breakAlignment = false): Float32Array {
+/**
+ * The mesh's skinned positions or normals as the GPU computes them, 3 floats per vertex, in the
+ * skeleton's space: drawn once at rest, then posed and drawn again (the bone data must follow).
+ */
+function readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 'three', output: 'position' | 'normal', unaligned = false): Float32Array {
   const width = 128;
   const height = Math.ceil(rig.vertices / width);
-  const mesh = readbackMesh(rig, bonesOf(matrices, rig.joints), width, output, mode === 'blend' ? blendOf : undefined);
-  if (mode !== 'three') {
-    useDualQuaternionSkinning(mesh, { mode });
-    if (breakAlignment) {
-      // The mistake this package avoids, injected: no sign alignment at all.
-      const material = mesh.material as THREE.ShaderMaterial;
-      const compile = material.onBeforeCompile;
-      material.onBeforeCompile = (shader, r) => {
-        compile.call(material, shader, r);
-        shader.vertexShader = shader.vertexShader.replace(/dot\( dqsReal\d, dqsPivot \) < 0\.0/g, 'false');
-      };
-      material.customProgramCacheKey = () => 'broken-alignment';
-    }
+  const { mesh, pose } = readbackMesh(rig, width, output, mode === 'blend' ? blendOf : undefined);
+  const skin = mode === 'three' ? null : useDualQuaternionSkinning(mesh, { mode });
+  if (unaligned) {
+    // The mistake this package avoids, injected: no sign alignment at all.
+    const material = mesh.material as THREE.ShaderMaterial;
+    const compile = material.onBeforeCompile;
+    material.onBeforeCompile = (shader, r) => {
+      compile.call(material, shader, r);
+      shader.vertexShader = shader.vertexShader.replace(/dot\( dqsReal\d, dqsPivot \) < 0\.0/g, 'false');
+    };
+    material.customProgramCacheKey = () => 'broken-alignment';
   }
   const target = new THREE.WebGLRenderTarget(width, height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+  drawAlone(renderer, target, mesh, camera);
+  pose(matrices);
   drawAlone(renderer, target, mesh, camera);
   const pixels = new Float32Array(4 * width * height);
   renderer.readRenderTargetPixels(target, 0, 0, width, height, pixels);
   renderer.setRenderTarget(null);
   target.dispose();
+  skin?.dispose();
   const out = new Float32Array(3 * rig.vertices);
   for (let v = 0; v < rig.vertices; v++) out.set(pixels.subarray(4 * v, 4 * v + 3), 3 * v);
-  return out;
+  return toSkeletonSpace(out, output === 'normal');
 }
 
 /** The package's CPU path (applyBoneTransform) for every vertex. */
 function cpuPositions(rig: Rig, matrices: ArrayLike<number>): Float32Array {
-  const mesh = readbackMesh(rig, bonesOf(matrices, rig.joints), 128, 'position');
-  useDualQuaternionSkinning(mesh);
+  const { mesh, pose } = readbackMesh(rig, 128, 'position');
+  const skin = useDualQuaternionSkinning(mesh);
+  pose(matrices);
+  mesh.skeleton.update();
   const out = new Float32Array(3 * rig.vertices);
   const p = new THREE.Vector3();
-  for (let v = 0; v < rig.vertices; v++) {
-    // Vertex 3v of the read-back geometry is vertex v of the rig.
-    mesh.getVertexPosition(3 * v, p);
-    out.set([p.x, p.y, p.z], 3 * v);
-  }
-  return out;
+  // Vertex 3v of the read-back geometry is vertex v of the rig.
+  for (let v = 0; v < rig.vertices; v++) mesh.getVertexPosition(3 * v, p).toArray(out, 3 * v);
+  skin.dispose();
+  return toSkeletonSpace(out, false);
 }
 
 
 export const webgl: Backend = {
-  readBack: async (rig, matrices, mode, output, breakAlignment) => readBack(rig, matrices, mode, output, breakAlignment),
+  readBack: async (rig, matrices, mode, output, unaligned) => readBack(rig, matrices, mode, output, unaligned),
   cpuPositions,
 };
