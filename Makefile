@@ -15,7 +15,7 @@ HAND_FILES := viewer/public/hands/right.glb viewer/public/hands/left.glb
 # The engine's web builds as the npm package and the page load them (make package-wasm).
 PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
-.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs
+.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs python
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -164,6 +164,7 @@ test: assets viewer chromium recordings package dqs-package
 	$(MAKE) features examples
 	node --test tests/
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/debug/dqhand CHROMIUM=$(CHROMIUM) npx vitest run
+	$(MAKE) python
 
 # docs/figures/*.png: the paper's Figures 5-7 and 9 on our hand, rendered by the real page
 # (Figure 9 makes its own scripted grasp recording with the release binary).
@@ -244,9 +245,28 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 	cd $(PEERS) && $(NPM) ci --no-audit --no-fund
 	touch $@
 
+# The Python package (crates/dqhand-py, `import dqhand`): maturin builds its abi3 wheel into
+# target/wheels; a virtual environment of its own (crates/dqhand-py/.venv, from
+# requirements-dev.txt) installs it and runs its pytest suite, which compares the skin with a
+# NumPy reference and with the command line's (the debug binary `cargo test` builds).
+PY_PKG := crates/dqhand-py
+PY_VENV := $(PY_PKG)/.venv/installed
+
+python: assets $(PY_VENV)
+	$(CARGO) build --locked -p dqhand-cli
+	$(PY_PKG)/.venv/bin/maturin build --release --locked --quiet -m $(PY_PKG)/Cargo.toml --interpreter $(PY_PKG)/.venv/bin/python --out target/wheels
+	$(PY_PKG)/.venv/bin/pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/wheels/dqhand-*-abi3-*.whl
+	DQHAND_BIN=$(CURDIR)/target/debug/dqhand $(PY_PKG)/.venv/bin/python -m pytest -q $(PY_PKG)/tests
+
+$(PY_VENV): $(PY_PKG)/requirements-dev.txt
+	rm -rf $(PY_PKG)/.venv
+	$(PYTHON) -m venv $(PY_PKG)/.venv
+	$(PY_PKG)/.venv/bin/pip install --quiet --disable-pip-version-check -r $<
+	touch $@
+
 clean:
 	$(CARGO) clean
-	rm -rf out third_party/node_modules viewer/node_modules viewer/dist viewer/public packages/dqhand/wasm packages/dqhand/dist packages/dqhand/node_modules $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules
+	rm -rf out third_party/node_modules viewer/node_modules viewer/dist viewer/public packages/dqhand/wasm packages/dqhand/dist packages/dqhand/node_modules $(RECORDINGS) $(PEERS)/.venv $(PEERS)/node_modules $(PY_PKG)/.venv
 
 # The built-in gesture classifier, trained on the tuning split of varied hands (deterministic;
 # `dqhand gesture-bench --outside third_party/node_modules` reports on the held-out split).

@@ -1,0 +1,248 @@
+"""dqhand's Python API, on the installed wheel.
+
+The skin is held to a reference written here from the definitions (Kavan et al. 2008: dual
+quaternions aligned with the heaviest influence, blended, normalised; linear blending of the
+matrices), in double precision with NumPy, sharing no code with the library; and to the Rust
+command line's output of the same poses (`dqhand skin`, the binary in $DQHAND_BIN). The WebXR
+generic hand, a glTF made elsewhere, is skinned and held to the same reference.
+"""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dqhand
+
+ROOT = Path(__file__).resolve().parents[3]
+GENERIC_HAND = ROOT / "third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return dqhand.Hand.builtin()
+
+
+@pytest.fixture(scope="module")
+def generic():
+    if not GENERIC_HAND.exists():
+        pytest.fail(f"{GENERIC_HAND} is missing: `make assets` installs it")
+    return dqhand.Hand.load(GENERIC_HAND)
+
+
+def random_angles(hand, count, seed, spread=1.0):
+    """Angles within each joint's range (``spread`` > 1 reaches beyond it), radians."""
+    rng = np.random.default_rng(seed)
+    low, high = hand.limits[:, 0], hand.limits[:, 1]
+    middle, half = (low + high) / 2, (high - low) / 2 * spread
+    return (middle + half * rng.uniform(-1, 1, size=(count, len(low)))).astype(np.float64)
+
+
+def random_wrists(count, seed):
+    """Rigid transforms: turned up to 180° about a random axis, moved up to half a metre."""
+    rng = np.random.default_rng(seed)
+    out = np.zeros((count, 4, 4))
+    for b in range(count):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        angle = rng.uniform(0, np.pi)
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        out[b, :3, :3] = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+        out[b, :3, 3] = rng.uniform(-0.5, 0.5, size=3)
+        out[b, 3, 3] = 1
+    return out
+
+
+# ---- The reference, from the definitions. ----
+
+
+def quaternion(r):
+    """The unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
+    trace = np.trace(r)
+    k = int(np.argmax([trace, r[0, 0], r[1, 1], r[2, 2]]))
+    if k == 0:
+        s = 2 * np.sqrt(1 + trace)
+        return np.array([s / 4, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s])
+    i, j, l = [(0, 1, 2), (1, 2, 0), (2, 0, 1)][k - 1]
+    s = 2 * np.sqrt(1 + r[i, i] - r[j, j] - r[l, l])
+    q = np.zeros(4)
+    q[0] = (r[l, j] - r[j, l]) / s
+    q[1 + i] = s / 4
+    q[1 + j] = (r[i, j] + r[j, i]) / s
+    q[1 + l] = (r[i, l] + r[l, i]) / s
+    return q
+
+
+def product(a, b):
+    """Hamilton products of quaternions (w, x, y, z), along the last axis."""
+    w1, v1 = a[..., :1], a[..., 1:]
+    w2, v2 = b[..., :1], b[..., 1:]
+    return np.concatenate([w1 * w2 - np.sum(v1 * v2, -1, keepdims=True), w1 * v2 + w2 * v1 + np.cross(v1, v2)], -1)
+
+
+def reference_skin(rest, joints, weights, transforms, method):
+    """Positions of ``rest`` (V, 3) skinned by ``transforms`` (J, 4, 4) with the influences."""
+    transforms = transforms.astype(np.float64)
+    if method == "lb":
+        homogeneous = np.concatenate([rest, np.ones((len(rest), 1))], 1)
+        blended = np.einsum("vk,vkij->vij", weights, transforms[joints])
+        return np.einsum("vij,vj->vi", blended, homogeneous)[:, :3]
+    real = np.array([quaternion(t[:3, :3]) for t in transforms])
+    translation = np.concatenate([np.zeros((len(transforms), 1)), transforms[:, :3, 3]], 1)
+    dual = 0.5 * product(translation, real)
+    # Influences come heaviest first: the first is the pivot the others' signs align with.
+    r, d = real[joints], dual[joints]
+    signs = np.where(np.sum(r * r[:, :1], -1) < 0, -1.0, 1.0)
+    w = (weights * signs)[..., None]
+    r, d = np.sum(w * r, 1), np.sum(w * d, 1)
+    length = np.linalg.norm(r, axis=1, keepdims=True)
+    r, d = r / length, d / length
+    conjugate = r * np.array([1, -1, -1, -1])
+    point = np.concatenate([np.zeros((len(rest), 1)), rest], 1)
+    moved = product(product(r, point), conjugate)[:, 1:]
+    return moved + 2 * product(d, conjugate)[:, 1:]
+
+
+def check_against_reference(hand, angles, wrists, method):
+    joints, weights = hand.influences
+    skinned = hand.skin(angles, wrists, method=method)
+    transforms = hand.skinning_transforms(angles, wrists)
+    size = np.ptp(hand.rest_vertices, axis=0).max()
+    worst = max(np.abs(skinned[b] - reference_skin(hand.rest_vertices.astype(np.float64), joints, weights, transforms[b], method)).max() for b in range(len(angles)))
+    assert worst < 1e-5 * size / 0.2, f"{method}: {worst} m from the reference"
+    return worst
+
+
+# ---- The tests. ----
+
+
+def test_the_builtin_hand_has_its_mesh_joints_and_angles(hand):
+    v = len(hand.rest_vertices)
+    assert hand.rest_vertices.shape == (v, 3) and hand.rest_vertices.dtype == np.float32
+    assert hand.faces.shape[1] == 3 and hand.faces.max() < v
+    assert sorted(hand.joint_names) == sorted(dqhand.WEBXR_JOINTS)
+    assert len(hand.dof_names) == 23 and hand.limits.shape == (23, 2)
+    assert np.all(hand.limits[:, 0] <= hand.limits[:, 1])
+    joints, weights = hand.influences
+    assert joints.shape == weights.shape and joints.shape[0] == v
+    np.testing.assert_allclose(weights.sum(1), 1, atol=1e-5)
+    # The hand is metres-sized: 19 cm from the wrist crease to the middle fingertip.
+    assert 0.15 < np.ptp(hand.rest_vertices, axis=0).max() < 0.3
+    assert "Hand" in repr(hand)
+
+
+@pytest.mark.parametrize("method", ["dqb", "lb"])
+def test_the_skin_matches_a_reference_from_the_definitions(hand, method):
+    angles = random_angles(hand, 6, seed=1)
+    check_against_reference(hand, angles, random_wrists(6, seed=2), method)
+
+
+def test_a_hand_made_elsewhere_loads_and_matches_the_reference(generic):
+    """The WebXR input profiles' generic hand (glTF): its own mesh, weights and joint frames."""
+    assert len(generic.rest_vertices) > 1000
+    angles = random_angles(generic, 4, seed=3)
+    check_against_reference(generic, angles, random_wrists(4, seed=4), "dqb")
+    # A bent finger moves its tip and not the wrist.
+    bent = np.zeros((1, len(generic.dof_names)))
+    bent[0, generic.dof_names.index("index-finger-phalanx-intermediate.flex")] = np.radians(90)
+    rest, moved = generic.joints(np.zeros_like(bent)), generic.joints(bent)
+    tip = dqhand.WEBXR_JOINTS.index("index-finger-tip")
+    assert np.linalg.norm(moved[0, tip] - rest[0, tip]) > 0.01
+    assert np.linalg.norm(moved[0, 0] - rest[0, 0]) < 1e-6
+
+
+def read_ply(path):
+    """Positions of a binary PLY that `dqhand skin` writes (x y z nx ny nz per vertex)."""
+    data = Path(path).read_bytes()
+    header, body = data.split(b"end_header\n", 1)
+    count = int(next(line.split()[2] for line in header.decode().splitlines() if line.startswith("element vertex")))
+    return np.frombuffer(body[: 24 * count], dtype="<f4").reshape(count, 6)[:, :3]
+
+
+def test_the_same_poses_give_the_command_lines_vertices(hand, tmp_path):
+    binary = os.environ.get("DQHAND_BIN")
+    if not binary:
+        pytest.fail("DQHAND_BIN must name the dqhand binary (make test sets it)")
+    angles = random_angles(hand, 3, seed=5)
+    wrists = random_wrists(3, seed=6)
+    skinned = hand.skin(angles, wrists)
+    for b in range(3):
+        rotation = quaternion(wrists[b, :3, :3])
+        pose = {
+            "model": "full",
+            "wrist": {"translation": wrists[b, :3, 3].tolist(), "rotation": [*rotation[1:], rotation[0]]},
+            "angles_deg": dict(zip(hand.dof_names, np.degrees(angles[b]).tolist())),
+        }
+        (tmp_path / "pose.json").write_text(json.dumps(pose))
+        subprocess.run([binary, "skin", "--pose", str(tmp_path / "pose.json"), "--method", "dqb", "--out", str(tmp_path / "posed.ply")], check=True, capture_output=True)
+        np.testing.assert_allclose(skinned[b], read_ply(tmp_path / "posed.ply"), atol=2e-6)
+
+
+def test_normals_are_unit_and_keypoints_are_mediapipes_joints(hand):
+    angles = random_angles(hand, 2, seed=7)
+    positions, normals = hand.skin(angles, normals=True)
+    assert positions.shape == normals.shape == (2, len(hand.rest_vertices), 3)
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=2), 1, atol=1e-4)
+    np.testing.assert_array_equal(positions, hand.skin(angles))
+    joints, keypoints = hand.joints(angles), hand.keypoints(angles)
+    assert joints.shape == (2, 25, 3) and keypoints.shape == (2, 21, 3)
+    order = [dqhand.WEBXR_JOINTS.index(n) for n in ["wrist", "thumb-metacarpal", "thumb-phalanx-proximal", "thumb-phalanx-distal", "thumb-tip"]]
+    np.testing.assert_array_equal(keypoints[:, :5], joints[:, order])
+    assert dqhand.MEDIAPIPE_KEYPOINTS[8] == "INDEX_FINGER_TIP"
+    np.testing.assert_array_equal(keypoints[:, 8], joints[:, dqhand.WEBXR_JOINTS.index("index-finger-tip")])
+
+
+def test_limits_clamp_unless_switched_off(hand):
+    beyond = random_angles(hand, 2, seed=8, spread=3.0)
+    clamped = np.clip(beyond, hand.limits[:, 0], hand.limits[:, 1])
+    np.testing.assert_allclose(hand.skin(beyond), hand.skin(clamped), atol=1e-6)
+    assert np.abs(hand.skin(beyond, limits=False) - hand.skin(clamped)).max() > 1e-3
+
+
+def test_float32_float64_and_lists_give_the_same_skin(hand):
+    angles = random_angles(hand, 2, seed=9)
+    np.testing.assert_array_equal(hand.skin(angles), hand.skin(angles.astype(np.float32)))
+    np.testing.assert_array_equal(hand.skin(angles), hand.skin(angles.tolist()))
+
+
+def test_a_left_hand_is_built_as_a_left_hand():
+    left = dqhand.Hand.builtin(side="left", vertices=3000)
+    right = dqhand.Hand.builtin(side="right", vertices=3000)
+    thumb = dqhand.WEBXR_JOINTS.index("thumb-tip")
+    rest = np.zeros((1, 23))
+    # Palm down, fingers along -Z: the left thumb on +X, the right one on -X.
+    assert left.joints(rest)[0, thumb, 0] > 0 > right.joints(rest)[0, thumb, 0]
+
+
+@pytest.mark.parametrize(
+    "call, error, words",
+    [
+        (lambda h: h.skin(np.zeros((2, 5))), ValueError, ["angles", "(B, 23)", "(2, 5)"]),
+        (lambda h: h.skin(np.zeros(23)), ValueError, ["angles", "(B, 23)"]),
+        (lambda h: h.skin([["a"] * 23]), ValueError, ["angles"]),
+        (lambda h: h.skin(np.full((1, 23), np.nan)), ValueError, ["angles", "not finite"]),
+        (lambda h: h.skin(np.zeros((1, 23)), method="cubic"), ValueError, ["cubic", "lb, qb, dqb"]),
+        (lambda h: h.skin(np.zeros((2, 23)), wrist=np.zeros((1, 4, 4))), ValueError, ["wrist", "(2, 4, 4)"]),
+        (lambda h: h.skin(np.zeros((1, 23)), wrist=np.eye(4)[None] * 2), ValueError, ["wrist[0]", "rigid"]),
+        (lambda h: dqhand.Hand.builtin(side="middle"), ValueError, ["side", "middle"]),
+        (lambda h: dqhand.Hand.builtin(model="hooves"), ValueError, ["hooves"]),
+        (lambda h: dqhand.Hand.load("no/such/hand.glb"), FileNotFoundError, ["no/such/hand.glb"]),
+    ],
+)
+def test_bad_arguments_raise_one_line_errors_naming_them(hand, call, error, words):
+    with pytest.raises(error) as raised:
+        call(hand)
+    message = str(raised.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+def test_a_file_that_is_not_gltf_is_a_value_error_naming_it(tmp_path):
+    bad = tmp_path / "hand.glb"
+    bad.write_bytes(b"not a glTF file")
+    with pytest.raises(ValueError, match="hand.glb"):
+        dqhand.Hand.load(bad)
