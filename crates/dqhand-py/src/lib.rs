@@ -8,93 +8,143 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use dqhand::glam::{Mat4, Vec3};
+use dqhand::glam::{DMat3, DVec3, Quat, Vec3};
 use dqhand::hand::{build, HandParams};
 use dqhand::input::mediapipe::WEBXR_INDEX;
 use dqhand::kinematics::{webxr::JOINT_NAMES, HandKinematics, JointModel, Limits, Pose, Side};
 use dqhand::math::DualQuat;
 use dqhand::model::Model;
 use dqhand::skin::{Deformer, Method, VertexBuffers};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArray4, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
+use numpy::{Element, PyArray, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-/// A library error as the Python exception for it, with the library's one-line message.
+/// A library error as the Python exception for it, with the library's one-line message: an
+/// operating system's refusal as the matching `OSError`, anything else as `ValueError`.
 fn to_py(error: dqhand::Error) -> PyErr {
+    let message = error.to_string();
     match &error {
-        dqhand::Error::Io { reason, .. } if reason.kind() == std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(error.to_string()),
-        _ => PyValueError::new_err(error.to_string()),
+        dqhand::Error::Io { reason, .. } => match reason.kind() {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+            std::io::ErrorKind::IsADirectory => PyIsADirectoryError::new_err(message),
+            _ => PyOSError::new_err(message),
+        },
+        _ => PyValueError::new_err(message),
     }
 }
 
-/// `array` as float32 values, row-major, checked to be 2-D with `columns` columns: the
-/// message names `argument` and the shape it must have.
-fn rows(array: &Bound<'_, PyAny>, argument: &str, columns: usize, what: &str) -> PyResult<(usize, Vec<f32>)> {
-    let shape_error = |got: String| PyValueError::new_err(format!("{argument}: expected an array of shape (B, {columns}) ({what}), got {got}"));
-    // Anything else array-like (lists, other dtypes) as NumPy would read it.
-    let converted;
-    let array = if array.extract::<PyReadonlyArray2<'_, f32>>().is_ok() || array.extract::<PyReadonlyArray2<'_, f64>>().is_ok() {
-        array
-    } else {
-        converted = array.py().import("numpy")?.call_method1("asarray", (array, "float64")).map_err(|e| PyValueError::new_err(format!("{argument}: not an array of numbers ({e})")))?;
-        &converted
-    };
-    let (shape, values): (Vec<usize>, Vec<f32>) = if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f32>>() {
-        (a.shape().to_vec(), a.as_array().iter().copied().collect())
-    } else if let Ok(a) = array.extract::<PyReadonlyArray2<'_, f64>>() {
-        (a.shape().to_vec(), a.as_array().iter().map(|&x| x as f32).collect())
-    } else {
-        let got = match array.getattr("shape") {
-            Ok(shape) => format!("shape {shape} of dtype {}", array.getattr("dtype").map(|d| d.to_string()).unwrap_or_default()),
-            Err(_) => format!("a {}", array.get_type().name()?),
-        };
-        return Err(shape_error(got));
-    };
-    if shape[1] != columns {
-        return Err(shape_error(format!("shape ({}, {})", shape[0], shape[1])));
+/// `array` read by NumPy as a contiguous float64 array (`numpy.ascontiguousarray`: any
+/// array-like, any numeric dtype, any layout), checked to have the shape `shape` (`None` for
+/// the batch) and finite values. Messages name `argument` and the shape it must have.
+fn numbers<'py>(array: &Bound<'py, PyAny>, argument: &str, shape: &[Option<usize>], what: &str) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    let wanted = shape.iter().map(|s| s.map_or("B".to_owned(), |n| n.to_string())).collect::<Vec<_>>().join(", ");
+    let numpy = array.py().import("numpy")?;
+    let converted = numpy.call_method1("ascontiguousarray", (array, "float64")).map_err(|e| PyValueError::new_err(format!("{argument}: expected numbers of shape ({wanted}) ({what}): {e}")))?;
+    let converted = converted.cast_into::<PyArrayDyn<f64>>().map_err(PyErr::from)?.readonly();
+    let got = converted.shape().to_vec();
+    if got.len() != shape.len() || got.iter().zip(shape).any(|(g, s)| s.is_some_and(|s| s != *g)) {
+        let got = got.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ");
+        return Err(PyValueError::new_err(format!("{argument}: expected an array of shape ({wanted}) ({what}), got shape ({got})")));
     }
+    let values = converted.as_slice().expect("ascontiguousarray's result is contiguous");
     if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!("{argument}: value {} (row {}, column {}) is not finite", values[i], i / columns, i % columns)));
+        let per_pose = got[1..].iter().product::<usize>().max(1);
+        return Err(PyValueError::new_err(format!("{argument}: value {} of pose {} is not finite", values[i], i / per_pose)));
     }
-    Ok((shape[0], values))
+    Ok(converted)
 }
 
-/// The wrist of each pose: `wrist` as (B, 4, 4) rigid transforms (rotation and translation,
-/// the last row 0 0 0 1), or the rest wrist for every pose.
+/// The wrist of each of `poses` poses: `wrist` as (B, 4, 4) rigid transforms (a rotation, a
+/// translation, the last row 0 0 0 1), or the rest wrist for every pose.
 fn wrists(wrist: Option<&Bound<'_, PyAny>>, poses: usize) -> PyResult<Vec<Option<DualQuat>>> {
     let Some(wrist) = wrist.filter(|w| !w.is_none()) else { return Ok(vec![None; poses]) };
-    let values: Vec<f64> = if let Ok(a) = wrist.extract::<PyReadonlyArray3<'_, f64>>() {
-        check_wrist_shape(a.shape(), poses)?;
-        a.as_array().iter().copied().collect()
-    } else if let Ok(a) = wrist.extract::<PyReadonlyArray3<'_, f32>>() {
-        check_wrist_shape(a.shape(), poses)?;
-        a.as_array().iter().map(|&x| f64::from(x)).collect()
-    } else {
-        return Err(PyValueError::new_err(format!("wrist: expected a float array of shape ({poses}, 4, 4) or None")));
-    };
+    let values = numbers(wrist, "wrist", &[Some(poses), Some(4), Some(4)], "one rigid transform per pose, or None")?;
     values
+        .as_slice()
+        .expect("contiguous")
         .chunks(16)
         .enumerate()
         .map(|(b, m)| {
-            // NumPy's rows read as columns, transposed: the matrix itself.
-            let matrix = Mat4::from_cols_array(&std::array::from_fn(|k| m[k] as f32)).transpose();
-            let (scale, rotation, translation) = matrix.to_scale_rotation_translation();
+            // NumPy's rows: m[4 r + c].
+            let r = DMat3::from_cols(DVec3::new(m[0], m[4], m[8]), DVec3::new(m[1], m[5], m[9]), DVec3::new(m[2], m[6], m[10]));
+            let orthonormal = (r.transpose() * r - DMat3::IDENTITY).to_cols_array().iter().all(|x| x.abs() < 1e-4);
             let last_row = m[12..16].iter().zip([0.0, 0.0, 0.0, 1.0]).all(|(x, y)| (x - y).abs() < 1e-6);
-            let rigid = last_row && (scale - Vec3::ONE).abs().max_element() < 1e-3 && rotation.is_finite() && translation.is_finite();
-            if !rigid {
-                return Err(PyValueError::new_err(format!("wrist[{b}]: not a rigid transform (a rotation, a translation and the last row 0 0 0 1)")));
+            if !(orthonormal && r.determinant() > 0.0 && last_row) {
+                return Err(PyValueError::new_err(format!("wrist[{b}]: not a rigid transform (a rotation, no scale, shear or mirror; a translation; the last row 0 0 0 1)")));
             }
-            Ok(Some(DualQuat::from_rotation_translation(rotation.normalize(), translation)))
+            let rotation = Quat::from_mat3(&r.as_mat3()).normalize();
+            Ok(Some(DualQuat::from_rotation_translation(rotation, Vec3::new(m[3] as f32, m[7] as f32, m[11] as f32))))
         })
         .collect()
 }
 
-fn check_wrist_shape(shape: &[usize], poses: usize) -> PyResult<()> {
-    if shape != [poses, 4, 4] {
-        return Err(PyValueError::new_err(format!("wrist: expected shape ({poses}, 4, 4), one rigid transform per pose, got {shape:?}")));
+/// `outputs` (1 or 2) new float32 arrays of `shape` made by NumPy (so a batch too large for
+/// memory is its `MemoryError`), written pose by pose on every core with the GIL released:
+/// `fill` gets each pose's slice of the first (the first axis) and of the second, if asked.
+fn batch<'py, D: numpy::ndarray::Dimension, S: Send + Sync + Clone>(
+    py: Python<'py>,
+    shape: &[usize],
+    outputs: usize,
+    start: S,
+    fill: impl Fn(&mut S, usize, &mut [f32], Option<&mut [f32]>) + Sync,
+) -> PyResult<Vec<Bound<'py, PyArray<f32, D>>>> {
+    let numpy = py.import("numpy")?;
+    let arrays = (0..outputs)
+        .map(|_| numpy.call_method1("zeros", (shape.to_vec(), "float32"))?.cast_into::<PyArray<f32, D>>().map_err(PyErr::from))
+        .collect::<PyResult<Vec<_>>>()?;
+    let per_pose = shape[1..].iter().product::<usize>();
+    if per_pose > 0 {
+        let mut writable: Vec<_> = arrays.iter().map(|a| a.readwrite()).collect();
+        let mut slices: Vec<&mut [f32]> = writable.iter_mut().map(|w| w.as_slice_mut().expect("NumPy's zeros are contiguous")).collect();
+        let second = (slices.len() > 1).then(|| slices.pop()).flatten();
+        let first = slices.pop().expect("one array at least");
+        py.detach(|| match second {
+            Some(second) => first.par_chunks_mut(per_pose).zip(second.par_chunks_mut(per_pose)).enumerate().for_each_init(|| start.clone(), |s, (b, (p, n))| fill(s, b, p, Some(n))),
+            None => first.par_chunks_mut(per_pose).enumerate().for_each_init(|| start.clone(), |s, (b, p)| fill(s, b, p, None)),
+        });
     }
-    Ok(())
+    Ok(arrays)
+}
+
+/// [`batch`] of one array.
+fn batch_one<'py, D: numpy::ndarray::Dimension, S: Send + Sync + Clone>(py: Python<'py>, shape: &[usize], start: S, fill: impl Fn(&mut S, usize, &mut [f32]) + Sync) -> PyResult<Bound<'py, PyArray<f32, D>>> {
+    Ok(batch(py, shape, 1, start, |s, b, out, _| fill(s, b, out))?.remove(0))
+}
+
+/// A checked batch of poses: the angles as NumPy holds them, and each pose's wrist.
+struct Poses<'py> {
+    angles: PyReadonlyArrayDyn<'py, f64>,
+    wrists: Vec<Option<DualQuat>>,
+    dofs: usize,
+    count: usize,
+}
+
+impl Poses<'_> {
+    /// What the threads read the poses from.
+    fn source(&self) -> PoseSource<'_> {
+        PoseSource { values: self.angles.as_slice().expect("contiguous"), wrists: &self.wrists, dofs: self.dofs }
+    }
+}
+
+/// A batch's angles (pose after pose) and wrists, shared by the threads that skin it.
+#[derive(Clone, Copy)]
+struct PoseSource<'a> {
+    values: &'a [f64],
+    wrists: &'a [Option<DualQuat>],
+    dofs: usize,
+}
+
+impl PoseSource<'_> {
+    /// Pose `b` written into `pose` (whose buffer is reused: nothing allocated per pose).
+    fn read<'p>(&self, b: usize, pose: &'p mut Pose) -> &'p Pose {
+        for (a, &x) in pose.angles.iter_mut().zip(&self.values[b * self.dofs..(b + 1) * self.dofs]) {
+            *a = x as f32;
+        }
+        pose.wrist = self.wrists[b];
+        pose
+    }
 }
 
 /// A hand: a skinned mesh on a skeleton with WebXR joints, posed by joint angles.
@@ -104,37 +154,57 @@ struct Hand {
     joint_model: JointModel,
     /// Posed per call (each thread its own copy).
     kinematics: HandKinematics,
-    /// The skeleton index of each of the 25 WebXR joints.
-    webxr: Vec<usize>,
+    /// The skeleton index of each of the 25 WebXR joints the skeleton has.
+    webxr: Vec<Option<usize>>,
 }
 
 impl Hand {
-    fn new(model: Model, joint_model: &str) -> PyResult<Self> {
-        let joint_model: JointModel = joint_model.parse().map_err(to_py)?;
+    fn new(model: Model, joint_model: JointModel, path: Option<&PathBuf>) -> PyResult<Self> {
         let model = Arc::new(model);
-        let kinematics = model.hand_kinematics(joint_model).map_err(to_py)?;
+        let kinematics = model.hand_kinematics(joint_model).map_err(|e| to_py(if let Some(path) = path { e.in_file(path) } else { e }))?;
         let names = kinematics.skeleton().joints();
-        let webxr = JOINT_NAMES
-            .iter()
-            .map(|name| names.iter().position(|j| j.name == *name).ok_or_else(|| PyValueError::new_err(format!("skeleton has no WebXR joint {name:?}"))))
-            .collect::<PyResult<_>>()?;
+        let webxr = JOINT_NAMES.iter().map(|name| names.iter().position(|j| j.name == *name)).collect();
         Ok(Self { model, joint_model, kinematics, webxr })
     }
 
-    /// The poses of `angles` (B × D) with their wrists.
-    fn poses(&self, angles: &Bound<'_, PyAny>, wrist: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Pose>> {
+    /// The batch of poses of `angles` (B × D) and `wrist`, checked: their angles stay in the
+    /// NumPy array, read pose by pose while the output is written.
+    fn batch_of<'py>(&self, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>) -> PyResult<Poses<'py>> {
         let dofs = self.joint_model.dof_count();
-        let (count, values) = rows(angles, "angles", dofs, &format!("joint angles in radians, in the order of dof_names, {} model", self.joint_model))?;
-        let wrists = wrists(wrist, count)?;
-        Ok(values.chunks(dofs.max(1)).take(count).zip(wrists).map(|(a, wrist)| Pose { wrist, angles: a.to_vec() }).collect())
+        let angles = numbers(angles, "angles", &[None, Some(dofs)], &format!("joint angles in radians, in the order of dof_names, {} model", self.joint_model))?;
+        let count = angles.shape()[0];
+        Ok(Poses { wrists: wrists(wrist, count)?, angles, dofs, count })
     }
 
-    /// The kinematics every thread starts from: these limits.
-    fn kinematics(&self, limits: bool) -> HandKinematics {
+    /// The kinematics every thread starts from (these limits) and the pose it fills in.
+    fn kinematics(&self, limits: bool) -> (HandKinematics, Pose) {
         let mut k = self.kinematics.clone();
         k.set_limits(if limits { Limits::Anatomical } else { Limits::Off });
-        k
+        (k, Pose::rest(self.joint_model.dof_count()))
     }
+
+    /// World positions of the WebXR joints `joints` (indices into `JOINT_NAMES`) in each pose,
+    /// (B, #joints, 3).
+    fn positions_of<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool, joints: &[usize]) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix3>>> {
+        let joints: Vec<usize> = joints
+            .iter()
+            .map(|&i| self.webxr[i].ok_or_else(|| PyValueError::new_err(format!("this hand's skeleton has no WebXR joint {:?}", JOINT_NAMES[i]))))
+            .collect::<PyResult<_>>()?;
+        let poses = self.batch_of(angles, wrist)?;
+        let source = poses.source();
+        batch_one(py, &[poses.count, joints.len(), 3], self.kinematics(limits), |(k, pose), b, out| {
+            k.pose(source.read(b, pose));
+            for (&j, out) in joints.iter().zip(out.chunks_mut(3)) {
+                out.copy_from_slice(&Vec3::from(k.world()[j].translation).to_array());
+            }
+        })
+    }
+}
+
+/// A NumPy array of the rows `rows` (each `N` long).
+fn array_of<'py, T: Element + Copy, const N: usize>(py: Python<'py>, rows: impl ExactSizeIterator<Item = [T; N]>) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let count = rows.len();
+    numpy::PyArray1::from_iter(py, rows.flatten()).reshape([count, N])
 }
 
 #[pymethods]
@@ -146,36 +216,36 @@ impl Hand {
     #[staticmethod]
     #[pyo3(signature = (length = 0.19, breadth = 0.085, side = "right", vertices = None, model = "full"))]
     fn builtin(py: Python<'_>, length: f32, breadth: f32, side: &str, vertices: Option<usize>, model: &str) -> PyResult<Self> {
-        let side = match side {
+        let joint_model: JointModel = model.parse().map_err(to_py)?;
+        let side = match side.to_ascii_lowercase().as_str() {
             "right" => Side::Right,
             "left" => Side::Left,
-            other => return Err(PyValueError::new_err(format!("side: {other:?} is not a side; use \"right\" or \"left\""))),
+            _ => return Err(PyValueError::new_err(format!("side: {side:?} is not a side; use \"right\" or \"left\""))),
         };
         let params = HandParams { length, breadth, side, vertices: vertices.unwrap_or(HandParams::default().vertices) };
         let built = py.detach(|| build(&params)).map_err(to_py)?;
-        Self::new(built, model)
+        Self::new(built, joint_model, None)
     }
 
-    /// A skinned hand from a glTF 2.0 file (.glb or .gltf) whose skeleton has the WebXR hand
-    /// joints.
+    /// A skinned hand from a glTF 2.0 file (.glb or .gltf) whose joints carry the WebXR names.
     #[staticmethod]
     #[pyo3(signature = (path, model = "full"))]
     fn load(py: Python<'_>, path: PathBuf, model: &str) -> PyResult<Self> {
+        let joint_model: JointModel = model.parse().map_err(to_py)?;
         let loaded = py.detach(|| dqhand::io::load_gltf(&path)).map_err(to_py)?;
-        Self::new(loaded, model)
+        Self::new(loaded, joint_model, Some(&path))
     }
 
     /// Triangles, (F, 3) vertex indices.
     #[getter]
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u32>>> {
-        let indices = self.model.mesh.indices();
-        PyArray1::from_slice(py, indices).reshape([indices.len() / 3, 3])
+        array_of(py, self.model.mesh.indices().chunks_exact(3).map(|t| [t[0], t[1], t[2]]))
     }
 
     /// Rest vertex positions (the bind pose), (V, 3), m.
     #[getter]
-    fn rest_vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
-        PyArray2::from_vec2(py, &self.model.mesh.positions().iter().map(|p| p.to_vec()).collect::<Vec<_>>()).expect("rows of 3")
+    fn rest_vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        array_of(py, self.model.mesh.positions().into_iter())
     }
 
     /// The skeleton's joint names (the 25 WebXR hand joints, for the built-in hand).
@@ -192,56 +262,47 @@ impl Hand {
 
     /// Each angle's anatomical range, (D, 2), radians.
     #[getter]
-    fn limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
-        let rows: Vec<Vec<f32>> = self.joint_model.dofs().map(|d| vec![d.min_deg.to_radians(), d.max_deg.to_radians()]).collect();
-        PyArray2::from_vec2(py, &rows).expect("rows of 2")
+    fn limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let ranges: Vec<[f32; 2]> = self.joint_model.dofs().map(|d| [d.min_deg.to_radians(), d.max_deg.to_radians()]).collect();
+        array_of(py, ranges.into_iter())
     }
 
     /// The skin's influences: joint indices (into `joint_names`) and weights, each (V, K),
     /// heaviest first, unused slots (0, 0).
     #[getter]
-    fn influences<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<u32>>, Bound<'py, PyArray2<f32>>) {
+    fn influences<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray2<u32>>, Bound<'py, PyArray2<f32>>)> {
         let mesh = &self.model.mesh;
         let k = mesh.max_influences().max(1);
-        let (mut joints, mut weights) = (vec![vec![0u32; k]; mesh.vertex_count()], vec![vec![0f32; k]; mesh.vertex_count()]);
+        let (mut joints, mut weights) = (vec![0u32; k * mesh.vertex_count()], vec![0f32; k * mesh.vertex_count()]);
         for v in 0..mesh.vertex_count() {
             for (slot, (j, w)) in mesh.influences(v).enumerate() {
-                joints[v][slot] = j as u32;
-                weights[v][slot] = w;
+                joints[k * v + slot] = j as u32;
+                weights[k * v + slot] = w;
             }
         }
-        (PyArray2::from_vec2(py, &joints).expect("rows of k"), PyArray2::from_vec2(py, &weights).expect("rows of k"))
+        let shape = [mesh.vertex_count(), k];
+        Ok((numpy::PyArray1::from_vec(py, joints).reshape(shape)?, numpy::PyArray1::from_vec(py, weights).reshape(shape)?))
     }
 
     /// The posed hands' skin: `angles` (B, D) radians, `wrist` (B, 4, 4) rigid transforms or
     /// None (the rest wrist), `method` "dqb", "qb" or "lb", `limits` whether angles are clamped
     /// to their anatomical ranges. Returns the positions (B, V, 3), m, or with `normals` the
     /// positions and the unit normals.
-    #[pyo3(signature = (angles, wrist = None, method = "dqb", normals = false, limits = true))]
+    #[pyo3(signature = (angles, wrist = None, method = "dqb", *, normals = false, limits = true))]
     fn skin<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, method: &str, normals: bool, limits: bool) -> PyResult<Bound<'py, PyAny>> {
         let method: Method = method.parse().map_err(to_py)?;
-        let poses = self.poses(angles, wrist)?;
+        let poses = self.batch_of(angles, wrist)?;
+        let source = poses.source();
         let mesh = &self.model.mesh;
         let v = mesh.vertex_count();
-        let positions = PyArray3::<f32>::zeros(py, [poses.len(), v, 3], false);
-        let normal_array = normals.then(|| PyArray3::<f32>::zeros(py, [poses.len(), v, 3], false));
-        {
-            let mut p = positions.readwrite();
-            let mut n = normal_array.as_ref().map(|a| a.readwrite());
-            let p = p.as_slice_mut().expect("a new array is contiguous");
-            let n = n.as_mut().map(|n| n.as_slice_mut().expect("a new array is contiguous"));
-            let start = (self.kinematics(limits), Deformer::new(method, mesh));
-            let skin_one = |(k, d): &mut (HandKinematics, Deformer), pose: &Pose, p: &mut [f32], n: Option<&mut [f32]>| {
-                k.pose(pose);
-                d.deform_into(mesh, k.layer(), VertexBuffers::Separate { positions: p, normals: n });
-            };
-            py.detach(|| match n {
-                Some(n) => poses.par_iter().zip(p.par_chunks_mut(3 * v)).zip(n.par_chunks_mut(3 * v)).for_each_init(|| start.clone(), |s, ((pose, p), n)| skin_one(s, pose, p, Some(n))),
-                None => poses.par_iter().zip(p.par_chunks_mut(3 * v)).for_each_init(|| start.clone(), |s, (pose, p)| skin_one(s, pose, p, None)),
-            });
-        }
-        Ok(match normal_array {
-            Some(n) => (positions, n).into_pyobject(py)?.into_any(),
+        let start = (self.kinematics(limits), Deformer::new(method, mesh));
+        let mut skinned = batch::<numpy::Ix3, _>(py, &[poses.count, v, 3], if normals { 2 } else { 1 }, start, |((k, pose), d), b, positions, normals| {
+            k.pose(source.read(b, pose));
+            d.deform_into(mesh, k.layer(), VertexBuffers::Separate { positions, normals });
+        })?;
+        let positions = skinned.remove(0);
+        Ok(match skinned.pop() {
+            Some(normals) => (positions, normals).into_pyobject(py)?.into_any(),
             None => positions.into_any(),
         })
     }
@@ -249,73 +310,36 @@ impl Hand {
     /// The 25 WebXR joints' world positions of each pose, (B, 25, 3), m (as `skin`'s `angles`,
     /// `wrist`, `limits`).
     #[pyo3(signature = (angles, wrist = None, limits = true))]
-    fn joints<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray3<f32>>> {
-        self.positions_of(py, angles, wrist, limits, &self.webxr)
+    fn joints<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix3>>> {
+        self.positions_of(py, angles, wrist, limits, &(0..JOINT_NAMES.len()).collect::<Vec<_>>())
     }
 
     /// MediaPipe Hands' 21 keypoints of each pose, in its order (the wrist, then each finger
     /// from its base to its tip), (B, 21, 3), m.
     #[pyo3(signature = (angles, wrist = None, limits = true))]
-    fn keypoints<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray3<f32>>> {
-        let joints: Vec<usize> = WEBXR_INDEX.iter().map(|&i| self.webxr[i]).collect();
-        self.positions_of(py, angles, wrist, limits, &joints)
+    fn keypoints<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix3>>> {
+        self.positions_of(py, angles, wrist, limits, &WEBXR_INDEX)
     }
 
     /// Each joint's skinning transform (its world transform times its inverse bind matrix) of
     /// each pose, (B, J, 4, 4), row-major as NumPy multiplies them: what the skin blends.
     #[pyo3(signature = (angles, wrist = None, limits = true))]
-    fn skinning_transforms<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray4<f32>>> {
-        let poses = self.poses(angles, wrist)?;
+    fn skinning_transforms<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix4>>> {
+        let poses = self.batch_of(angles, wrist)?;
+        let source = poses.source();
         let joints = self.model.mesh.inverse_bind().len();
-        let out = PyArray4::<f32>::zeros(py, [poses.len(), joints, 4, 4], false);
-        {
-            let mut w = out.readwrite();
-            let w = w.as_slice_mut().expect("a new array is contiguous");
-            let start = self.kinematics(limits);
-            py.detach(|| {
-                poses.par_iter().zip(w.par_chunks_mut(16 * joints)).for_each_init(
-                    || start.clone(),
-                    |k, (pose, w)| {
-                        k.pose(pose);
-                        for (m, w) in k.skinning().iter().zip(w.chunks_mut(16)) {
-                            // Row-major: Mat4's columns written as the rows of the transpose.
-                            w.copy_from_slice(&Mat4::from(*m).transpose().to_cols_array());
-                        }
-                    },
-                )
-            });
-        }
-        Ok(out)
+        batch_one(py, &[poses.count, joints, 4, 4], self.kinematics(limits), |(k, pose), b, out| {
+            k.pose(source.read(b, pose));
+            for (m, out) in k.skinning().iter().zip(out.chunks_mut(16)) {
+                // Row-major: the transpose's columns are the matrix's rows.
+                out.copy_from_slice(&dqhand::glam::Mat4::from(*m).transpose().to_cols_array());
+            }
+        })
     }
 
     fn __repr__(&self) -> String {
         let (vertices, joints, angles) = (self.model.mesh.vertex_count(), self.kinematics.skeleton().joints().len(), self.joint_model.dof_count());
         format!("<dqhand.Hand of {vertices} vertices, {joints} joints, {angles} angles ({} model): {}>", self.joint_model, self.model.description)
-    }
-}
-
-impl Hand {
-    /// World positions of `joints` (skeleton indices) in each pose, (B, #joints, 3).
-    fn positions_of<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, limits: bool, joints: &[usize]) -> PyResult<Bound<'py, PyArray3<f32>>> {
-        let poses = self.poses(angles, wrist)?;
-        let out = PyArray3::<f32>::zeros(py, [poses.len(), joints.len(), 3], false);
-        {
-            let mut w = out.readwrite();
-            let w = w.as_slice_mut().expect("a new array is contiguous");
-            let start = self.kinematics(limits);
-            py.detach(|| {
-                poses.par_iter().zip(w.par_chunks_mut(3 * joints.len())).for_each_init(
-                    || start.clone(),
-                    |k, (pose, w)| {
-                        k.pose(pose);
-                        for (&j, w) in joints.iter().zip(w.chunks_mut(3)) {
-                            w.copy_from_slice(&Vec3::from(k.world()[j].translation).to_array());
-                        }
-                    },
-                )
-            });
-        }
-        Ok(out)
     }
 }
 

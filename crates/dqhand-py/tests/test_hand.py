@@ -140,6 +140,33 @@ def test_the_skin_matches_a_reference_from_the_definitions(hand, method):
     check_against_reference(hand, angles, random_wrists(6, seed=2), method)
 
 
+def test_the_references_tell_dqb_from_lb(hand):
+    """The two references differ by millimetres on these poses: the comparisons above can fail."""
+    angles, wrists = random_angles(hand, 2, seed=1), random_wrists(2, seed=2)
+    joints, weights = hand.influences
+    transforms = hand.skinning_transforms(angles, wrists)
+    rest = hand.rest_vertices.astype(np.float64)
+    gap = np.abs(reference_skin(rest, joints, weights, transforms[0], "dqb") - reference_skin(rest, joints, weights, transforms[0], "lb")).max()
+    assert gap > 1e-3, gap
+
+
+def test_a_wrist_turned_almost_180_degrees_still_matches(hand):
+    """Near 180° the joints' quaternions sit near the w = 0 equator, where their signs come out
+    either way: only the alignment with the heaviest influence keeps the blend right."""
+    wrists = np.tile(np.eye(4), (3, 1, 1))
+    for b, axis in enumerate(np.eye(3)):
+        angle = np.radians(179.9)
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        wrists[b, :3, :3] = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    check_against_reference(hand, random_angles(hand, 3, seed=10), wrists, "dqb")
+
+
+def test_the_papers_joint_model_has_18_angles_and_matches_the_reference():
+    paper = dqhand.Hand.builtin(vertices=3000, model="paper")
+    assert len(paper.dof_names) == 18 and paper.limits.shape == (18, 2)
+    check_against_reference(paper, random_angles(paper, 3, seed=11), random_wrists(3, seed=12), "dqb")
+
+
 def test_a_hand_made_elsewhere_loads_and_matches_the_reference(generic):
     """The WebXR input profiles' generic hand (glTF): its own mesh, weights and joint frames."""
     assert len(generic.rest_vertices) > 1000
@@ -189,10 +216,13 @@ def test_normals_are_unit_and_keypoints_are_mediapipes_joints(hand):
     np.testing.assert_array_equal(positions, hand.skin(angles))
     joints, keypoints = hand.joints(angles), hand.keypoints(angles)
     assert joints.shape == (2, 25, 3) and keypoints.shape == (2, 21, 3)
-    order = [dqhand.WEBXR_JOINTS.index(n) for n in ["wrist", "thumb-metacarpal", "thumb-phalanx-proximal", "thumb-phalanx-distal", "thumb-tip"]]
-    np.testing.assert_array_equal(keypoints[:, :5], joints[:, order])
-    assert dqhand.MEDIAPIPE_KEYPOINTS[8] == "INDEX_FINGER_TIP"
-    np.testing.assert_array_equal(keypoints[:, 8], joints[:, dqhand.WEBXR_JOINTS.index("index-finger-tip")])
+    # MediaPipe's landmarks at the WebXR joints: the thumb's CMC, MCP and IP at the bases of
+    # its metacarpal, proximal and distal bones; a finger's MCP, PIP and DIP at its phalanges'.
+    thumb = ["thumb-metacarpal", "thumb-phalanx-proximal", "thumb-phalanx-distal", "thumb-tip"]
+    fingers = [[f"{f}-finger-phalanx-{p}" for p in ["proximal", "intermediate", "distal"]] + [f"{f}-finger-tip"] for f in ["index", "middle", "ring", "pinky"]]
+    names = ["wrist", *thumb, *sum(fingers, [])]
+    assert dqhand.MEDIAPIPE_KEYPOINTS[8] == "INDEX_FINGER_TIP" and names[8] == "index-finger-tip"
+    np.testing.assert_array_equal(keypoints, joints[:, [dqhand.WEBXR_JOINTS.index(n) for n in names]])
 
 
 def test_limits_clamp_unless_switched_off(hand):
@@ -202,10 +232,15 @@ def test_limits_clamp_unless_switched_off(hand):
     assert np.abs(hand.skin(beyond, limits=False) - hand.skin(clamped)).max() > 1e-3
 
 
-def test_float32_float64_and_lists_give_the_same_skin(hand):
+def test_float32_float64_lists_and_any_layout_give_the_same_skin(hand):
     angles = random_angles(hand, 2, seed=9)
-    np.testing.assert_array_equal(hand.skin(angles), hand.skin(angles.astype(np.float32)))
-    np.testing.assert_array_equal(hand.skin(angles), hand.skin(angles.tolist()))
+    wrists = random_wrists(2, seed=9)
+    expected = hand.skin(angles, wrists)
+    np.testing.assert_array_equal(expected, hand.skin(angles.tolist(), wrists.tolist()))
+    np.testing.assert_allclose(expected, hand.skin(np.asfortranarray(angles), wrists.astype(np.float32)), atol=1e-6)
+    np.testing.assert_array_equal(expected, hand.skin(np.repeat(angles, 2, axis=1)[:, ::2], wrists))
+    np.testing.assert_allclose(expected, hand.skin(angles.astype(np.float32), wrists), atol=1e-6)
+    assert hand.skin(np.zeros((0, 23))).shape == (0, len(hand.rest_vertices), 3)
 
 
 def test_a_left_hand_is_built_as_a_left_hand():
@@ -225,8 +260,15 @@ def test_a_left_hand_is_built_as_a_left_hand():
         (lambda h: h.skin([["a"] * 23]), ValueError, ["angles"]),
         (lambda h: h.skin(np.full((1, 23), np.nan)), ValueError, ["angles", "not finite"]),
         (lambda h: h.skin(np.zeros((1, 23)), method="cubic"), ValueError, ["cubic", "lb, qb, dqb"]),
-        (lambda h: h.skin(np.zeros((2, 23)), wrist=np.zeros((1, 4, 4))), ValueError, ["wrist", "(2, 4, 4)"]),
+        (lambda h: h.skin(np.zeros((2, 23)), wrist=np.zeros((1, 4, 4))), ValueError, ["wrist", "(2, 4, 4)", "(1, 4, 4)"]),
+        (lambda h: h.skin(np.zeros((1, 23)), wrist=np.eye(4)), ValueError, ["wrist", "(1, 4, 4)", "got shape (4, 4)"]),
         (lambda h: h.skin(np.zeros((1, 23)), wrist=np.eye(4)[None] * 2), ValueError, ["wrist[0]", "rigid"]),
+        (lambda h: h.skin(np.zeros((1, 23)), wrist=np.diag([2.0, 2.0, 2.0, 1.0])[None]), ValueError, ["wrist[0]", "rigid"]),
+        (lambda h: h.skin(np.zeros((1, 23)), wrist=np.diag([-1.0, 1.0, 1.0, 1.0])[None]), ValueError, ["wrist[0]", "mirror"]),
+        (lambda h: h.skin(np.zeros((1, 23)), wrist=np.array([[[1, 0.6, 0, 0], [0, 0.8, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]])), ValueError, ["wrist[0]", "shear"]),
+        (lambda h: h.skin(np.full((1, 23), np.inf)), ValueError, ["angles", "inf", "not finite"]),
+        (lambda h: h.skin(np.zeros((1, 23)), normals=None), TypeError, []),
+        (lambda h: h.skin(np.zeros((1, 23)), "dqb", "dqb", True), TypeError, []),
         (lambda h: dqhand.Hand.builtin(side="middle"), ValueError, ["side", "middle"]),
         (lambda h: dqhand.Hand.builtin(model="hooves"), ValueError, ["hooves"]),
         (lambda h: dqhand.Hand.load("no/such/hand.glb"), FileNotFoundError, ["no/such/hand.glb"]),
@@ -241,8 +283,30 @@ def test_bad_arguments_raise_one_line_errors_naming_them(hand, call, error, word
         assert word in message, message
 
 
-def test_a_file_that_is_not_gltf_is_a_value_error_naming_it(tmp_path):
+def test_files_that_are_not_hands_raise_errors_naming_them(tmp_path):
     bad = tmp_path / "hand.glb"
     bad.write_bytes(b"not a glTF file")
     with pytest.raises(ValueError, match="hand.glb"):
         dqhand.Hand.load(bad)
+    with pytest.raises(OSError, match=str(tmp_path)):
+        dqhand.Hand.load(tmp_path)
+    # The generic hand with a joint the joint model moves renamed: the file and the joint named.
+    renamed = tmp_path / "renamed.glb"
+    renamed.write_bytes(glb_with_renamed_node(GENERIC_HAND.read_bytes(), "index-finger-phalanx-intermediate", "index-middle"))
+    with pytest.raises(ValueError) as raised:
+        dqhand.Hand.load(renamed)
+    assert "renamed.glb" in str(raised.value) and "index-finger-phalanx-intermediate" in str(raised.value), raised.value
+
+
+def glb_with_renamed_node(glb, old, new):
+    """A binary glTF with the node named ``old`` renamed ``new`` (its JSON chunk rewritten)."""
+    length = int.from_bytes(glb[12:16], "little")
+    document = json.loads(glb[20 : 20 + length])
+    for node in document["nodes"]:
+        if node.get("name") == old:
+            node["name"] = new
+    text = json.dumps(document).encode()
+    text += b" " * (-len(text) % 4)
+    rest = glb[20 + length :]
+    body = len(text).to_bytes(4, "little") + b"JSON" + text + rest
+    return glb[:4] + glb[4:8] + (12 + len(body)).to_bytes(4, "little") + body

@@ -9,7 +9,7 @@ import numpy.typing as npt
 WEBXR_JOINTS: List[str]
 MEDIAPIPE_KEYPOINTS: List[str]
 
-_Angles = npt.ArrayLike  # (B, D) float32 or float64, radians
+_Angles = npt.ArrayLike  # (B, D) numbers, radians
 _Wrist = Optional[npt.ArrayLike]  # (B, 4, 4) rigid transforms, or None for the rest wrist
 
 class Hand:
@@ -39,12 +39,16 @@ class Hand:
     def influences(self) -> Tuple[npt.NDArray[np.uint32], npt.NDArray[np.float32]]: ...
     @overload
     def skin(
-        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", normals: Literal[False] = False, limits: bool = True
+        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: Literal[False] = False, limits: bool = True
     ) -> npt.NDArray[np.float32]: ...
     @overload
     def skin(
         self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: Literal[True], limits: bool = True
     ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+    @overload
+    def skin(
+        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: bool, limits: bool = True
+    ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]: ...
     def joints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
     def keypoints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
     def skinning_transforms(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
