@@ -113,6 +113,9 @@ fn batch_one<'py, D: numpy::ndarray::Dimension, S: Send + Sync + Clone>(py: Pyth
     Ok(batch(py, shape, 1, start, |s, b, out, _| fill(s, b, out))?.remove(0))
 }
 
+/// The skin's joint indices and weights, each (V, K).
+type Influences<'py> = (Bound<'py, PyArray2<u32>>, Bound<'py, PyArray2<f32>>);
+
 /// A checked batch of poses: the angles as NumPy holds them, and each pose's wrist.
 struct Poses<'py> {
     angles: PyReadonlyArrayDyn<'py, f64>,
@@ -270,7 +273,7 @@ impl Hand {
     /// The skin's influences: joint indices (into `joint_names`) and weights, each (V, K),
     /// heaviest first, unused slots (0, 0).
     #[getter]
-    fn influences<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray2<u32>>, Bound<'py, PyArray2<f32>>)> {
+    fn influences<'py>(&self, py: Python<'py>) -> PyResult<Influences<'py>> {
         let mesh = &self.model.mesh;
         let k = mesh.max_influences().max(1);
         let (mut joints, mut weights) = (vec![0u32; k * mesh.vertex_count()], vec![0f32; k * mesh.vertex_count()]);
