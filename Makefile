@@ -248,7 +248,8 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 # The Python package (crates/dqhand-py, `import dqhand`): maturin builds its abi3 wheel into
 # target/wheels; a virtual environment of its own (crates/dqhand-py/.venv, from
 # requirements-dev.txt) installs it and runs its pytest suite, which compares the skin with a
-# NumPy reference and with the command line's (the debug binary `cargo test` builds).
+# NumPy reference and with the command line's (the debug binary `cargo test` builds); then a
+# fresh environment installs the wheel alone (NumPy from PyPI) and skins a hand.
 PY_PKG := crates/dqhand-py
 PY_VENV := $(PY_PKG)/.venv/installed
 
@@ -257,6 +258,10 @@ python: assets $(PY_VENV)
 	$(PY_PKG)/.venv/bin/maturin build --release --locked --quiet -m $(PY_PKG)/Cargo.toml --interpreter $(PY_PKG)/.venv/bin/python --out target/wheels
 	$(PY_PKG)/.venv/bin/pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/wheels/dqhand-*-abi3-*.whl
 	DQHAND_BIN=$(CURDIR)/target/debug/dqhand $(PY_PKG)/.venv/bin/python -m pytest -q $(PY_PKG)/tests
+	# The wheel as a user installs it: a fresh environment, its dependencies from PyPI.
+	rm -rf target/tmp/fresh-venv && $(PYTHON) -m venv target/tmp/fresh-venv
+	target/tmp/fresh-venv/bin/pip install --quiet --disable-pip-version-check target/wheels/dqhand-*-abi3-*.whl
+	cd target/tmp && fresh-venv/bin/python -c 'import dqhand, numpy; h = dqhand.Hand.builtin(vertices=2000); v = h.skin(numpy.zeros((2, len(h.dof_names)))); assert v.shape == (2, len(h.rest_vertices), 3), v.shape; print("fresh environment:", h)'
 
 $(PY_VENV): $(PY_PKG)/requirements-dev.txt
 	rm -rf $(PY_PKG)/.venv
