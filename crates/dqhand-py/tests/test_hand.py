@@ -10,6 +10,7 @@ generic hand, a glTF made elsewhere, is skinned and held to the same reference.
 import json
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -310,3 +311,17 @@ def glb_with_renamed_node(glb, old, new):
     rest = glb[20 + length :]
     body = len(text).to_bytes(4, "little") + b"JSON" + text + rest
     return glb[:4] + glb[4:8] + (12 + len(body)).to_bytes(4, "little") + body
+
+
+def test_the_bench_measures_every_row_in_one_run():
+    binary = os.environ.get("DQHAND_BIN")
+    if not binary:
+        pytest.fail("DQHAND_BIN must name the dqhand binary (make test sets it)")
+    run = subprocess.run([sys.executable, "-m", "dqhand.bench", "--poses", "4", "--repeats", "1", "--json", "--dqhand", binary], check=True, capture_output=True, text=True)
+    report = json.loads(run.stdout)
+    names = [r["what"] for r in report["rows"]]
+    assert any(n.startswith("Python API, DQB") for n in names) and any(n.startswith("NumPy LB") for n in names)
+    assert any(n.startswith("dqhand skin --poses") for n in names) and any(n.startswith("dqhand bench") for n in names)
+    assert all(r["us_per_pose"] > 0 for r in report["rows"]) and report["python_over_rust_kernel"] > 0 and report["skipped"] is None
+    bad = subprocess.run([sys.executable, "-m", "dqhand.bench", "--poses", "0"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--poses and --repeats must be at least 1" in bad.stderr
