@@ -395,6 +395,10 @@ describe('the Camera button on a video of our own hand', () => {
     expect(path.dirname(file)).toBe(path.join(dir, 'recordings'));
     await page.click('#record');
     await waitState(page, 's.recordings.length === 2');
+    // The engine may still be judging the last records recorded when the file closes (their
+    // events then reach the log a moment later): gather it until the engine has taken two more.
+    const taken = (await read<{ input: { accepted: number } }>()).input.accepted;
+    await waitState(page, `s.input !== null && s.input.accepted > ${taken + 2}`, 60_000);
     await log.stop();
     const state = await read<{ recordings: { on: boolean; path: string; records: number }[] }>();
     expect(state.recordings[1]).toMatchObject({ on: false, path: file });
