@@ -257,3 +257,17 @@ export function twistedLimb(seed: number): Float32Array {
   out.set(whole.clone().multiply(twist).elements, 16);
   return out;
 }
+
+/**
+ * The positions the CPU path gives (`getVertexPosition`, which `applyBoneTransform` serves) for
+ * each rig vertex of a read-back `mesh` (vertex 3v of it is vertex v of the rig) posed by
+ * `matrices` through `pose`, in the skeleton's space.
+ */
+export function cpuSkinned(mesh: THREE.SkinnedMesh, pose: (matrices: ArrayLike<number>) => void, matrices: ArrayLike<number>, vertices: number): Float32Array {
+  pose(matrices);
+  mesh.skeleton.update();
+  const out = new Float32Array(3 * vertices);
+  const p = new THREE.Vector3();
+  for (let v = 0; v < vertices; v++) mesh.getVertexPosition(3 * v, p).toArray(out, 3 * v);
+  return toSkeletonSpace(out, false);
+}

@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { useDualQuaternionSkinning, type SkinningMode } from '../src/index';
 import type { Backend } from './conformance';
-import { bindAtRest, blendOf, drawAlone, readbackGeometry, toSkeletonSpace } from './poses';
+import { bindAtRest, blendOf, cpuSkinned, drawAlone, readbackGeometry, toSkeletonSpace } from './poses';
 import type { Rig } from './rig';
 
 const renderer = new THREE.WebGLRenderer();
@@ -88,14 +88,9 @@ function readBack(rig: Rig, matrices: ArrayLike<number>, mode: SkinningMode | 't
 function cpuPositions(rig: Rig, matrices: ArrayLike<number>): Float32Array {
   const { mesh, pose } = readbackMesh(rig, 128, 'position');
   const skin = useDualQuaternionSkinning(mesh);
-  pose(matrices);
-  mesh.skeleton.update();
-  const out = new Float32Array(3 * rig.vertices);
-  const p = new THREE.Vector3();
-  // Vertex 3v of the read-back geometry is vertex v of the rig.
-  for (let v = 0; v < rig.vertices; v++) mesh.getVertexPosition(3 * v, p).toArray(out, 3 * v);
+  const out = cpuSkinned(mesh, pose, matrices, rig.vertices);
   skin.dispose();
-  return toSkeletonSpace(out, false);
+  return out;
 }
 
 

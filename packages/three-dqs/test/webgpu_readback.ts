@@ -8,7 +8,7 @@ import type { SkinningMode } from '../src/index';
 import { skinInPlace } from '../src/skinning_nodes';
 import { useDualQuaternionSkinning } from '../src/webgpu';
 import type { Backend } from './conformance';
-import { BIND, bindAtRest, blendOf, drawAlone, inMeshSpace, readbackGeometry, toSkeletonSpace } from './poses';
+import { BIND, bindAtRest, blendOf, cpuSkinned, drawAlone, inMeshSpace, readbackGeometry, toSkeletonSpace } from './poses';
 import type { Rig } from './rig';
 
 const WIDTH = 128;
@@ -122,14 +122,9 @@ export async function webgpu(forceWebGL: boolean): Promise<
   const cpuPositions = (rig: Rig, matrices: ArrayLike<number>) => {
     const { mesh, pose } = meshOf(rig, 'position', false);
     const skin = useDualQuaternionSkinning(mesh);
-    pose(matrices);
-    mesh.skeleton.update();
-    const out = new Float32Array(3 * rig.vertices);
-    const p = new THREE.Vector3();
-    // Vertex 3v of the read-back geometry is vertex v of the rig.
-    for (let v = 0; v < rig.vertices; v++) mesh.getVertexPosition(3 * v, p).toArray(out, 3 * v);
+    const out = cpuSkinned(mesh, pose, matrices, rig.vertices);
     skin.dispose();
-    return toSkeletonSpace(out, false);
+    return out;
   };
   const shadows = (rig: Rig, matrices: ArrayLike<number>, positions: ArrayLike<number>) => shadowPictures(renderer, rig, matrices, positions);
   return { readBack, cpuPositions, shadows, twoMeshes, backend: (renderer.backend as { isWebGPUBackend?: boolean }).isWebGPUBackend ? 'webgpu' : 'webgl2' };
