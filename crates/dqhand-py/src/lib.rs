@@ -20,6 +20,13 @@ use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPe
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
+mod export;
+mod fit;
+mod gestures;
+mod metrics;
+mod raster;
+mod recording;
+
 /// A library error as the Python exception for it, with the library's one-line message: an
 /// operating system's refusal as the matching `OSError`, anything else as `ValueError`.
 fn to_py(error: dqhand::Error) -> PyErr {
@@ -340,6 +347,107 @@ impl Hand {
         })
     }
 
+    /// Retargeting: this hand's joint angles (B, D) radians and wrists (B, 4, 4) from tracked
+    /// `points` of any hand, m: `kind` "mediapipe", (B, 21, 3) landmarks in MediaPipe's order,
+    /// or "webxr", (B, 25, 3) WebXR joints; `side` the tracked hand's (default this hand's; the
+    /// other side is mirrored). The engine's retargeter, which the viewer runs on webcam and
+    /// WebXR input: bone directions only (any hand size gives the same angles), each angle in
+    /// its range, a thumb touching a fingertip kept touching.
+    #[pyo3(signature = (points, kind = "mediapipe", *, side = None))]
+    fn fit<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>, kind: &str, side: Option<&str>) -> PyResult<fit::Fitted<'py>> {
+        fit::fit(self, py, points, kind, side)
+    }
+
+    /// Gesture events, (t, "start" | "end", gesture), of a recording (JSON lines) played
+    /// through the gesture loop with this hand, as `dqhand replay --gestures` prints them:
+    /// `side` for records that do not say, `gestures` a definitions file (else the built-in
+    /// ones), `config` an input configuration file, `glove_table` the glove of glove records.
+    #[pyo3(signature = (path, *, side = "right", gestures = None, config = None, glove_table = "5dt-14"))]
+    fn recognize_recording(&self, py: Python<'_>, path: PathBuf, side: &str, gestures: Option<PathBuf>, config: Option<PathBuf>, glove_table: &str) -> PyResult<Vec<gestures::Event>> {
+        gestures::of_recording(self, py, path, side, gestures, config, glove_table)
+    }
+
+    /// Gesture events, (t, "start" | "end", gesture), of a sequence at `times` (T,) s: tracked
+    /// `landmarks` (T, 21, 3) or `joints` (T, 25, 3), m, through the gesture loop as a recording
+    /// of them would go (`side` one or one per record, default this hand's; `config` as there);
+    /// or this hand's `angles` (T, D) and `wrist` (T, 4, 4) straight to the recogniser (nothing
+    /// tracked, so nothing to retarget or filter).
+    #[pyo3(signature = (times, angles = None, wrist = None, *, landmarks = None, joints = None, side = None, gestures = None, config = None, limits = true))]
+    #[allow(clippy::too_many_arguments)]
+    fn recognize<'py>(
+        &self,
+        py: Python<'py>,
+        times: &Bound<'py, PyAny>,
+        angles: Option<&Bound<'py, PyAny>>,
+        wrist: Option<&Bound<'py, PyAny>>,
+        landmarks: Option<&Bound<'py, PyAny>>,
+        joints: Option<&Bound<'py, PyAny>>,
+        side: Option<&Bound<'py, PyAny>>,
+        gestures: Option<PathBuf>,
+        config: Option<PathBuf>,
+        limits: bool,
+    ) -> PyResult<Vec<gestures::Event>> {
+        gestures::of_arrays(self, py, &gestures::RecognizeArgs { times, angles, wrist, landmarks, joints, side, gestures, config, limits })
+    }
+
+    /// The realism measures of `dqhand metrics`, for each pose under `method` (as `skin`'s
+    /// arguments): name → (B,): `volume` against rest (NaN for an open mesh), `min_distance`
+    /// and `max_distance` skin-to-bone against bind around `joint` (< 1 collapse, > 1 bulge),
+    /// `section_radius` there (< 1 the candy wrapper), `distortion_mean`/`_max` of its edges'
+    /// lengths, and with `self_intersections` the crossing triangle pairs.
+    #[pyo3(signature = (angles, wrist = None, method = "dqb", *, joint = "index-finger-phalanx-intermediate", next = None, self_intersections = false, limits = true))]
+    #[allow(clippy::too_many_arguments)]
+    fn realism<'py>(
+        &self,
+        py: Python<'py>,
+        angles: &Bound<'py, PyAny>,
+        wrist: Option<&Bound<'py, PyAny>>,
+        method: &str,
+        joint: &str,
+        next: Option<&str>,
+        self_intersections: bool,
+        limits: bool,
+    ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        metrics::realism(self, py, &metrics::RealismArgs { angles, wrist, method, joint, next, self_intersections, limits })
+    }
+
+    /// The skin `realism` measures around `joint`: `vertices` (N,), `joints` (parent, joint,
+    /// next) into `joint_names`, the skin's `radius` there and its smallest, m (bind pose).
+    #[pyo3(signature = (joint, next = None))]
+    fn joint_region<'py>(&self, py: Python<'py>, joint: &str, next: Option<&str>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        metrics::joint_region(self, py, joint, next)
+    }
+
+    /// `dqhand metrics --json` of this hand: LB, QB and DQB on the sweeps, self-intersections
+    /// in gestures and the headline numbers, as dicts and lists.
+    fn realism_report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        metrics::report(self, py)
+    }
+
+    /// Writes this hand as the rigged, skinned GLB `dqhand hand` writes (rest pose; joints,
+    /// inverse bind matrices, weights, collision proxies), which `Hand.load` reads back.
+    fn export_gltf(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        export::gltf(self, py, path)
+    }
+
+    /// Writes one posed mesh with normals as `dqhand skin` does, by the name's extension
+    /// (.ply, .obj or a static .glb): `angles` (D,) radians, `wrist` (4, 4) or None.
+    #[pyo3(signature = (path, angles, wrist = None, method = "dqb", *, limits = true))]
+    fn export_posed(&self, py: Python<'_>, path: PathBuf, angles: &Bound<'_, PyAny>, wrist: Option<&Bound<'_, PyAny>>, method: &str, limits: bool) -> PyResult<()> {
+        export::posed(self, py, path, angles, wrist, method, limits)
+    }
+
+    /// The gesture library's shapes (the paper's Figure 7 and common VR gestures) as this
+    /// hand's joint angles: name → (D,) radians, the wrist at rest. DOFs the joint model lacks
+    /// stay at rest.
+    fn gesture_poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let poses = pyo3::types::PyDict::new(py);
+        for g in &dqhand::gesture::GESTURES {
+            poses.set_item(g.name, numpy::PyArray1::from_vec(py, g.pose(self.joint_model).angles))?;
+        }
+        Ok(poses)
+    }
+
     fn __repr__(&self) -> String {
         let (vertices, joints, angles) = (self.model.mesh.vertex_count(), self.kinematics.skeleton().joints().len(), self.joint_model.dof_count());
         format!("<dqhand.Hand of {vertices} vertices, {joints} joints, {angles} angles ({} model): {}>", self.joint_model, self.model.description)
@@ -350,6 +458,10 @@ impl Hand {
 #[pymodule]
 fn _dqhand(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Hand>()?;
+    m.add_function(wrap_pyfunction!(raster::render_depth, m)?)?;
+    m.add_function(wrap_pyfunction!(recording::read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(recording::write_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(gestures::gesture_names, m)?)?;
     m.add("WEBXR_JOINTS", JOINT_NAMES.to_vec())?;
     m.add("MEDIAPIPE_KEYPOINTS", dqhand::input::mediapipe::LANDMARK_NAMES.to_vec())?;
     Ok(())

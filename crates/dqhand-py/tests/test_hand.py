@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import dqhand
+from wrists import random_wrists
 
 ROOT = Path(__file__).resolve().parents[3]
 GENERIC_HAND = ROOT / "third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"
@@ -40,21 +41,6 @@ def random_angles(hand, count, seed, spread=1.0):
     low, high = hand.limits[:, 0], hand.limits[:, 1]
     middle, half = (low + high) / 2, (high - low) / 2 * spread
     return (middle + half * rng.uniform(-1, 1, size=(count, len(low)))).astype(np.float64)
-
-
-def random_wrists(count, seed):
-    """Rigid transforms: turned up to 180° about a random axis, moved up to half a metre."""
-    rng = np.random.default_rng(seed)
-    out = np.zeros((count, 4, 4))
-    for b in range(count):
-        axis = rng.normal(size=3)
-        axis /= np.linalg.norm(axis)
-        angle = rng.uniform(0, np.pi)
-        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        out[b, :3, :3] = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
-        out[b, :3, 3] = rng.uniform(-0.5, 0.5, size=3)
-        out[b, 3, 3] = 1
-    return out
 
 
 # ---- The reference, from the definitions. ----

@@ -12,6 +12,7 @@ SI units throughout (metres, radians), the batch dimension first::
     joints = hand.joints(angles)                     # (4, 25, 3), WebXR joint order
 """
 
-from ._dqhand import MEDIAPIPE_KEYPOINTS, WEBXR_JOINTS, Hand
+from ._dqhand import MEDIAPIPE_KEYPOINTS, WEBXR_JOINTS, Hand, render_depth
+from ._dqhand import gesture_names, read_recording, write_recording
 
-__all__ = ["Hand", "WEBXR_JOINTS", "MEDIAPIPE_KEYPOINTS"]
+__all__ = ["Hand", "WEBXR_JOINTS", "MEDIAPIPE_KEYPOINTS", "render_depth", "gesture_names", "read_recording", "write_recording"]
