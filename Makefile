@@ -15,7 +15,7 @@ HAND_FILES := viewer/public/hands/right.glb viewer/public/hands/left.glb
 # The engine's web builds as the npm package and the page load them (make package-wasm).
 PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
-.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs python
+.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs python synth-figure
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -168,8 +168,12 @@ test: assets viewer chromium recordings package dqs-package
 
 # docs/figures/*.png: the paper's Figures 5-7 and 9 on our hand, rendered by the real page
 # (Figure 9 makes its own scripted grasp recording with the release binary).
-figures: build viewer chromium dqs-package
+figures: build viewer chromium dqs-package synth-figure
 	cd viewer && DQHAND_BIN=$(CURDIR)/target/release/dqhand CHROMIUM=$(CHROMIUM) node scripts/figures.mjs
+
+# docs/figures/synth-samples.png: 12 samples of a synthetic data set, read back (docs/datasets.md).
+synth-figure: python
+	$(PY_PKG)/.venv/bin/python $(PY_PKG)/tools/synth_figure.py docs/figures/synth-samples.png
 
 # Coverage-guided fuzzing of every parser (nightly toolchain + cargo-fuzz), FUZZ_SECONDS each:
 # the stream's frame and topology readers, viewer commands on a live session, pose files, glTF
@@ -247,9 +251,11 @@ $(PEERS_DEPS): $(PEERS)/package.json $(PEERS)/package-lock.json
 
 # The Python package (crates/dqhand-py, `import dqhand`): maturin builds its abi3 wheel into
 # target/wheels; a virtual environment of its own (crates/dqhand-py/.venv, from
-# requirements-dev.txt) installs it and runs its pytest suite, which compares the skin with a
-# NumPy reference and with the command line's (the debug binary `cargo test` builds); then a
-# fresh environment installs the wheel alone (NumPy from PyPI) and skins a hand.
+# requirements-dev.txt, with Ray Data and pyarrow for the data sets) installs it and runs its
+# pytest suite, which compares the skin with a NumPy reference and with the command line's (the
+# debug binary `cargo test` builds) and makes a 20,000-sample data set on a local Ray with 2
+# CPUs (docs/datasets.md); then a fresh environment installs the wheel alone (NumPy from PyPI)
+# and skins a hand.
 PY_PKG := crates/dqhand-py
 PY_VENV := $(PY_PKG)/.venv/installed
 

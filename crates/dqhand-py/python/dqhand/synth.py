@@ -179,20 +179,27 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
             "intrinsics": intrinsics.astype(np.float32).reshape(count, 9),
             "extrinsics": extrinsics.astype(np.float32).reshape(count, 16),
             "mask": np.packbits(depth > 0, axis=-1).reshape(count, -1),
-            "depth": depth.astype(np.float16).reshape(count, -1),
+            "depth": depth.astype("<f2").reshape(count, -1).view(np.uint8),
         }
         if settings.meshes:
-            columns["vertices"] = vertices.reshape(count, -1)
+            columns["vertices"] = vertices.astype("<f4").reshape(count, -1).view(np.uint8)
         yield columns
 
 
+# Columns stored as one fixed-size binary value a sample (little-endian bytes): Parquet writes a
+# list column with levels for each of its values, which for images costs more than the rest.
+BYTES = {"mask", "depth", "vertices"}
+
+
 def _table(columns: Dict[str, np.ndarray]):
-    """The columns as an Arrow table: per-sample arrays as fixed-size lists."""
+    """The columns as an Arrow table: per-sample arrays as fixed-size lists, images bytes."""
     import pyarrow as pa
 
     arrays = {}
     for name, values in columns.items():
-        if values.ndim == 1:
+        if name in BYTES:
+            arrays[name] = pa.array([row.tobytes() for row in values], type=pa.binary(values.shape[1]))
+        elif values.ndim == 1:
             arrays[name] = pa.array(values)
         else:
             arrays[name] = pa.FixedSizeListArray.from_arrays(pa.array(values.reshape(-1)), values.shape[1])
@@ -213,7 +220,7 @@ def write_shard(settings: Settings, out: Path, shard: int) -> Dict[str, float]:
         for chunk in make_shard(settings, shard):
             table = _table(chunk)
             if writer is None:
-                writer = pq.ParquetWriter(partial, table.schema.with_metadata(metadata), compression="zstd")
+                writer = pq.ParquetWriter(partial, table.schema.with_metadata(metadata), compression="zstd", use_dictionary=["side", "gesture_from", "gesture_to"])
             writer.write_table(table)
         writer.close()
         os.replace(partial, final)
@@ -324,15 +331,26 @@ def read(out: Union[str, os.PathLike]):
     return pq.read_table(shards).sort_by("sample")
 
 
+def _bytes_of(column, dtype) -> np.ndarray:
+    """A fixed-size binary column's values, one row each, as `dtype` (rows, values)."""
+    values = column.combine_chunks()
+    width = values.type.byte_width
+    data = np.frombuffer(values.buffers()[1], dtype=np.uint8)[values.offset * width : (values.offset + len(values)) * width]
+    return data.view(dtype).reshape(len(values), -1)
+
+
 def images(table) -> tuple:
     """The masks (N, S, S) bool and depth maps (N, S, S) float32 (m, 0 off the hand) of a
     table's rows."""
     size = json.loads(table.schema.metadata[b"dqhand.settings"])["image_size"]
-    count = table.num_rows
-    packed = table["mask"].combine_chunks().flatten().to_numpy().reshape(count, size, -1)
-    masks = np.unpackbits(packed, axis=-1, count=size).astype(bool)
-    depth = table["depth"].combine_chunks().flatten().to_numpy().reshape(count, size, size).astype(np.float32)
+    masks = np.unpackbits(_bytes_of(table["mask"], np.uint8).reshape(-1, size, (size + 7) // 8), axis=-1, count=size).astype(bool)
+    depth = _bytes_of(table["depth"], "<f2").reshape(-1, size, size).astype(np.float32)
     return masks, depth
+
+
+def meshes(table) -> np.ndarray:
+    """The skinned vertices (N, V, 3), m, of a table's rows (a data set made with `meshes`)."""
+    return _bytes_of(table["vertices"], "<f4").reshape(table.num_rows, -1, 3)
 
 
 def main(argv: Optional[List[str]] = None) -> int:
