@@ -24,6 +24,7 @@ mod export;
 mod fit;
 mod gestures;
 mod metrics;
+mod grasp;
 mod raster;
 mod recording;
 
@@ -435,6 +436,14 @@ impl Hand {
     #[pyo3(signature = (path, angles, wrist = None, method = "dqb", *, limits = true))]
     fn export_posed(&self, py: Python<'_>, path: PathBuf, angles: &Bound<'_, PyAny>, wrist: Option<&Bound<'_, PyAny>>, method: &str, limits: bool) -> PyResult<()> {
         export::posed(self, py, path, angles, wrist, method, limits)
+    }
+
+    /// The hand, its wrist at rest, closing from open towards `angles` (B, D) radians on a
+    /// ball at `centres` (B, 3), m, of `radii` (B,), m: the rendered angles (B, D) of the
+    /// engine's contact-constrained hand, each finger stopped where it touches the ball.
+    #[pyo3(signature = (angles, centres, radii, *, limits = true))]
+    fn close_on_ball<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, centres: &Bound<'py, PyAny>, radii: &Bound<'py, PyAny>, limits: bool) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix2>>> {
+        grasp::close_on_ball(self, py, angles, centres, radii, limits)
     }
 
     /// The gesture library's shapes (the paper's Figure 7 and common VR gestures) as this

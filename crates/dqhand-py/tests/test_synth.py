@@ -95,7 +95,7 @@ def one_process_shard(settings, shard):
 
 def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     out = tmp_path / "set"
-    summary = synth.synth(20_000, out, seed=7, image_size=64, shard_size=2_000)
+    summary = synth.synth(20_000, out, seed=7, image_size=64, shard_size=2_000, ball_share=0.25)
     assert summary["samples"] == 20_000 and summary["shards"] == 10
     assert sorted(p.name for p in out.iterdir()) == ["dataset.json"] + [f"shard-{i:05d}.parquet" for i in range(10)]
     assert json.loads((out / "dataset.json").read_text())["settings"]["seed"] == 7
@@ -107,9 +107,10 @@ def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     widths = {"angles": 23, "joints": 75, "keypoints_3d": 63, "keypoints_camera": 63, "keypoints_2d": 42, "visible": 21, "intrinsics": 9, "extrinsics": 16}
     for name, width in widths.items():
         assert table.schema.field(name).type.list_size == width, name
-    assert table.schema.field("mask").type == pa.binary(64 * 64 // 8)  # a bit a pixel
+    assert table.schema.field("ball_centre").type.list_size == 3
+    assert table.schema.field("mask").type == table.schema.field("object_mask").type == pa.binary(64 * 64 // 8)  # a bit a pixel
     assert table.schema.field("depth").type == pa.binary(64 * 64 * 2)  # float16
-    assert set(table.column_names) == set(widths) | {"sample", "shard", "side", "hand_length", "hand_breadth", "gesture_from", "gesture_to", "blend", "mask", "depth"}
+    assert set(table.column_names) == set(widths) | {"sample", "shard", "side", "hand_length", "hand_breadth", "gesture_from", "gesture_to", "blend", "ball_radius", "ball_centre", "mask", "object_mask", "depth"}
     for name in widths:
         if name != "visible":
             assert np.isfinite(column(table, name, widths[name]).astype(np.float64)).all(), name
@@ -117,18 +118,23 @@ def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     lengths = column(table, "hand_length")
     assert synth.LENGTH_M[0] <= lengths.min() and lengths.max() <= synth.LENGTH_M[1]
     assert len(np.unique(lengths)) == 10  # a hand a shard
-    assert set(column(table, "gesture_from")) == {"rest", *dqhand.Hand.builtin(vertices=1000).gesture_poses()}
+    assert set(column(table, "gesture_from")) == {"rest", "hold_ball", *dqhand.Hand.builtin(vertices=1000).gesture_poses()}
+    held = column(table, "ball_radius") > 0
+    assert 0.23 < held.mean() < 0.27
+    assert (column(table, "gesture_from")[held] == "hold_ball").all()
 
     # The same as one process makes it, whatever the workers: the first and last shards.
-    settings = synth.Settings(samples=20_000, seed=7, image_size=64, shard_size=2_000)
+    settings = synth.Settings(samples=20_000, seed=7, image_size=64, shard_size=2_000, ball_share=0.25)
     for shard in (0, 9):
         alone = one_process_shard(settings, shard)
         assert alone.equals(table.slice(shard * 2_000, alone.num_rows).select(alone.column_names)), shard
 
-    # Every keypoint in the image lies on the hand's mask (a joint is inside the hand, so it
-    # projects into its silhouette), give or take a pixel for the fingertips on its outline.
-    masks, depth = synth.images(table)
-    assert np.isfinite(depth).all() and ((depth > 0) == masks).all()
+    # Every keypoint in the image lies on the hand or its ball (a joint is inside the hand, so
+    # it projects into its silhouette), give or take a pixel for the fingertips on its outline.
+    hands, balls, depth = synth.images(table)
+    assert np.isfinite(depth).all() and ((depth > 0) == (hands | balls)).all() and not (hands & balls).any()
+    assert balls[held].any(axis=(1, 2)).mean() > 0.6 and not balls[~held].any()
+    masks = hands | balls
     pixels = np.rint(column(table, "keypoints_2d", 42).reshape(-1, 21, 2)).astype(int)
     inside = ((pixels >= 0) & (pixels < 64)).all(axis=-1)
     assert inside.mean() > 0.99
@@ -140,6 +146,8 @@ def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     assert on[inside].all()
     visible = column(table, "visible", 21)
     assert 0.3 < visible.mean() < 0.95
+    # A visible keypoint shows the hand, never the ball in front of it.
+    assert not (visible & balls[rows, pixels[..., 1].clip(0, 63), pixels[..., 0].clip(0, 63)]).any()
     # A visible keypoint's pixel shows the skin over it: joint centres lie a few millimetres
     # under the skin (a finger is 15-20 mm thick), so the depth map there is a little nearer.
     camera = column(table, "keypoints_camera", 63).reshape(-1, 21, 3)
@@ -152,6 +160,28 @@ def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     hand = dqhand.Hand.builtin(length=float(column(row, "hand_length")[0]), breadth=float(column(row, "hand_breadth")[0]), side=column(row, "side")[0], vertices=settings.vertices)
     keypoints = hand.keypoints(column(row, "angles", 23).astype(np.float64))
     np.testing.assert_allclose(keypoints.reshape(1, -1), column(row, "keypoints_3d", 63), atol=1e-5)
+
+
+def test_held_balls_are_touched_without_sinking_in(tmp_path):
+    summary = synth.synth(240, tmp_path / "set", seed=5, image_size=64, shard_size=120, ball_share=1.0, meshes=True, use_ray=False)
+    table = synth.read(tmp_path / "set")
+    radius, centre = column(table, "ball_radius"), column(table, "ball_centre", 3)
+    assert summary["samples"] == 240 and (radius > 0).all()
+    skin = synth.meshes(table)
+    # The skin's gap to the analytic ball (no rasterizer involved), per sample.
+    gap = (np.linalg.norm(skin - centre[:, None], axis=2) - radius[:, None]).min(axis=1)
+    # The tracked grasp itself (the fist the hand closes towards) would sink in: what the
+    # contact-constrained hand prevents, so this check can fail.
+    hand = dqhand.Hand.builtin(length=float(column(table, "hand_length")[0]), breadth=float(column(table, "hand_breadth")[0]), side=column(table, "side")[0], vertices=synth.Settings(1).vertices)
+    fist = hand.skin(np.repeat(hand.gesture_poses()["fist"][None], 120, axis=0))
+    sunk = (np.linalg.norm(fist - centre[:120, None], axis=2) - radius[:120, None]).min(axis=1)
+    print(f"held balls: skin gap median {np.median(gap) * 1e3:.1f} mm, least {gap.min() * 1e3:.2f} mm, within 3 mm in {np.mean(gap < 0.003):.0%}; the fist unconstrained sinks in by a median {-np.median(sunk) * 1e3:.0f} mm")
+    assert np.median(sunk) < -0.005
+    assert gap.min() > 0
+    assert np.median(gap) < 0.005
+    # The ball is in sight unless the hand hides it (the camera behind the hand).
+    _, balls, _ = synth.images(table)
+    assert balls.any(axis=(1, 2)).mean() > 0.6
 
 
 def ray_worker_running(task):

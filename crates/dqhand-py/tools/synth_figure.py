@@ -1,8 +1,9 @@
 """docs/figures/synth-samples.png: samples of a `dqhand.synth` data set as a user reads them
-back (`synth.read`, `synth.images`): each depth map shaded over its mask, the 2D keypoints
-and MediaPipe's skeleton drawn on, visible keypoints filled, hidden ones hollow.
+back (`synth.read`, `synth.images`): each depth map shaded over its masks (the hand lilac, a
+held ball amber), the 2D keypoints and MediaPipe's skeleton drawn on, visible keypoints
+filled, hidden ones hollow.
 
-    python tools/synth_figure.py OUT.png   (makes 12 samples in a temporary folder, no Ray)
+    python tools/synth_figure.py OUT.png   (makes 12 samples, half holding a ball, no Ray)
 """
 
 import sys
@@ -22,13 +23,15 @@ def colour(keypoint):
     return (255, 255, 255) if keypoint == 0 else FINGER_COLOURS[(keypoint - 1) // 4]
 
 
-def tile(mask, depth, pixels, visible):
+def tile(hand, ball, depth, pixels, visible):
     """One sample: near surfaces light, far dark, the background black."""
+    seen = hand | ball
     shade = np.zeros(depth.shape)
-    if mask.any():
-        near, far = depth[mask].min(), depth[mask].max()
-        shade[mask] = 0.35 + 0.65 * (far - depth[mask]) / max(far - near, 1e-6)
-    image = Image.fromarray((np.stack([shade * 0.85, shade * 0.8, shade], axis=-1) * 255).astype(np.uint8)).resize((2 * depth.shape[1], 2 * depth.shape[0]), Image.NEAREST)
+    if seen.any():
+        near, far = depth[seen].min(), depth[seen].max()
+        shade[seen] = 0.35 + 0.65 * (far - depth[seen]) / max(far - near, 1e-6)
+    tint = np.where(ball[..., None], [1.0, 0.7, 0.3], [0.85, 0.8, 1.0])
+    image = Image.fromarray((shade[..., None] * tint * 255).astype(np.uint8)).resize((2 * depth.shape[1], 2 * depth.shape[0]), Image.NEAREST)
     draw = ImageDraw.Draw(image)
     points = 2 * pixels + 1  # pixel (i, j), centred on image point (i, j), is 2i..2i+2 scaled
     for a, b in BONES:
@@ -41,12 +44,12 @@ def tile(mask, depth, pixels, visible):
 
 def main(path):
     with tempfile.TemporaryDirectory() as folder:
-        synth.synth(12, f"{folder}/set", seed=2026, image_size=192, shard_size=3, use_ray=False)
+        synth.synth(12, f"{folder}/set", seed=2026, image_size=192, shard_size=3, ball_share=0.5, use_ray=False)
         table = synth.read(f"{folder}/set")
-    masks, depth = synth.images(table)
+    hands, balls, depth = synth.images(table)
     pixels = table["keypoints_2d"].combine_chunks().flatten().to_numpy().reshape(-1, 21, 2)
     visible = table["visible"].combine_chunks().flatten().to_numpy(zero_copy_only=False).reshape(-1, 21)
-    tiles = [tile(masks[i], depth[i], pixels[i], visible[i]) for i in range(table.num_rows)]
+    tiles = [tile(hands[i], balls[i], depth[i], pixels[i], visible[i]) for i in range(table.num_rows)]
     side = tiles[0].width
     sheet = Image.new("RGB", (6 * side + 5 * 4, 2 * side + 4), (255, 255, 255))
     for i, t in enumerate(tiles):

@@ -45,6 +45,16 @@ FILL = (0.45, 0.9)
 VISIBLE_DEPTH_M = 0.02
 # Samples rendered at a time within a shard (a Parquet row group): bounds a worker's memory.
 CHUNK = 100
+# A held ball's radius (m): a golf ball to a large orange.
+BALL_RADIUS_M = (0.02, 0.045)
+# How a held ball is placed: from the palm's centre, this far towards the fingers (m), in a
+# direction spread by this much (a normal spread of the unit palm normal), just clear of the
+# open hand by this gap (m); the hand then closes on it from open.
+BALL_ALONG_M = (-0.01, 0.03)
+BALL_TILT = 0.15
+BALL_GAP_M = (0.002, 0.006)
+# The grasp the hand closes towards on a ball: the fist, each angle spread by this (radians).
+GRASP_NOISE_RAD = math.radians(5.0)
 
 
 class SynthError(ValueError):
@@ -61,6 +71,7 @@ class Settings:
     shard_size: int = 2000
     vertices: int = 4000
     meshes: bool = False
+    ball_share: float = 0.0
 
     def check(self) -> None:
         for name, low, high in (("samples", 1, 10**10), ("image_size", 16, 4096), ("shard_size", 1, 10**6), ("vertices", 1000, 60_000)):
@@ -69,6 +80,8 @@ class Settings:
                 raise SynthError(f"{name}: {value!r} is not a whole number from {low} to {high}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise SynthError(f"seed: {self.seed!r} is not a whole number ≥ 0")
+        if isinstance(self.ball_share, bool) or not isinstance(self.ball_share, (int, float)) or not 0 <= self.ball_share <= 1:
+            raise SynthError(f"ball_share: {self.ball_share!r} is not a share from 0 to 1")
 
     @property
     def shards(self) -> int:
@@ -116,6 +129,63 @@ def _poses(rng: np.random.Generator, templates: np.ndarray, names: List[str], li
     return angles, [names[i] for i in start], [names[i] for i in end], blend
 
 
+def icosphere(subdivisions: int = 2):
+    """A unit sphere's vertices (V, 3) and triangles (F, 3): an icosahedron whose triangles are
+    split in four `subdivisions` times, its vertices pushed onto the sphere."""
+    t = (1 + 5**0.5) / 2
+    vertices = [np.array(v, dtype=np.float64) for v in [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(subdivisions):
+        middles: Dict[tuple, int] = {}
+
+        def middle(a: int, b: int) -> int:
+            key = (min(a, b), max(a, b))
+            if key not in middles:
+                middles[key] = len(vertices)
+                vertices.append((vertices[a] + vertices[b]) / 2)
+            return middles[key]
+
+        split = []
+        for a, b, c in faces:
+            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
+            split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = split
+    points = np.array(vertices)
+    return points / np.linalg.norm(points, axis=1, keepdims=True), np.array(faces, dtype=np.int64)
+
+
+def _palm(hand: Hand, fist: np.ndarray):
+    """The open hand's palm centre, its axis towards the fingers and its normal (the side the
+    fingers close to), world, from the rest joints and the fist's fingertips."""
+    names = MEDIAPIPE_KEYPOINTS
+    rest = hand.keypoints(np.zeros((1, len(hand.dof_names))))[0].astype(np.float64)
+    knuckles = rest[[names.index(n) for n in ("INDEX_FINGER_MCP", "MIDDLE_FINGER_MCP", "RING_FINGER_MCP", "PINKY_MCP")]].mean(axis=0)
+    centre = (rest[0] + knuckles) / 2
+    axis = (knuckles - rest[0]) / np.linalg.norm(knuckles - rest[0])
+    tips = hand.keypoints(fist[None])[0][[names.index(n) for n in ("INDEX_FINGER_TIP", "MIDDLE_FINGER_TIP", "RING_FINGER_TIP", "PINKY_TIP")]].mean(axis=0)
+    normal = tips - centre
+    normal -= normal.dot(axis) * axis
+    return centre, axis, normal / np.linalg.norm(normal)
+
+
+def _ball_centres(rng: np.random.Generator, open_skin: np.ndarray, palm, radii: np.ndarray) -> np.ndarray:
+    """Centres of balls of `radii` in front of the palm, each just clear of the open hand's
+    skin: moved out along its direction past every skin vertex nearer than its radius and gap."""
+    centre, axis, normal = palm
+    count = len(radii)
+    start = centre + rng.uniform(*BALL_ALONG_M, size=count)[:, None] * axis
+    direction = normal + rng.normal(scale=BALL_TILT, size=(count, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    reach = radii + rng.uniform(*BALL_GAP_M, size=count)
+    # Along the ray start + t·direction, vertex v is nearer than `reach` for t within
+    # w·d ± sqrt((w·d)² − |w|² + reach²), w = v − start: the ball goes past the last of those.
+    w = open_skin[None] - start[:, None]
+    along = np.einsum("bvk,bk->bv", w, direction)
+    room = along**2 - np.sum(w * w, axis=2) + reach[:, None] ** 2
+    out = np.where(room > 0, along + np.sqrt(np.maximum(room, 0)), 0).max(axis=1)
+    return start + np.maximum(out, 0)[:, None] * direction
+
+
 def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]]:
     """The samples of shard `shard`, CHUNK at a time as columns: a pure function of
     `settings` and `shard` (its random numbers come from the seed sequence (seed, shard))."""
@@ -128,19 +198,37 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
     names = ["rest", *gestures]
     templates = np.stack([np.zeros(len(hand.dof_names)), *gestures.values()])
     limits = hand.limits.astype(np.float64)
-    faces = hand.faces
+    faces = hand.faces.astype(np.int64)
+    fist = gestures["fist"].astype(np.float64)
+    palm = _palm(hand, fist)
+    open_skin = hand.skin(np.zeros((1, len(hand.dof_names))))[0].astype(np.float64)
+    sphere, sphere_faces = icosphere()
     size = settings.image_size
     numbers = settings.shard_samples(shard)
     for first in range(numbers.start, numbers.stop, CHUNK):
         count = min(CHUNK, numbers.stop - first)
         angles, start, end, blend = _poses(rng, templates, names, limits, count)
+        # Some hands hold a ball instead: closed from open towards a fist until each finger
+        # touches it (the contact-constrained hand), so nothing sinks into it.
+        holds = rng.random(count) < settings.ball_share
+        ball_radius = np.where(holds, rng.uniform(*BALL_RADIUS_M, size=count), 0.0)
+        ball_centre = np.zeros((count, 3))
+        if holds.any():
+            held = np.flatnonzero(holds)
+            grasp = np.clip(fist + rng.normal(scale=GRASP_NOISE_RAD, size=(len(held), len(fist))), limits[:, 0], limits[:, 1])
+            ball_centre[held] = _ball_centres(rng, open_skin, palm, ball_radius[held])
+            angles[held] = hand.close_on_ball(grasp, ball_centre[held], ball_radius[held])
+            for i in held:
+                start[i] = end[i] = "hold_ball"
+            blend[held] = 0.0
         vertices = hand.skin(angles)
         joints = hand.joints(angles)
         keypoints = hand.keypoints(angles)
 
-        low, high = vertices.min(axis=1), vertices.max(axis=1)
+        low = np.minimum(vertices.min(axis=1), np.where(holds[:, None], ball_centre - ball_radius[:, None], np.inf))
+        high = np.maximum(vertices.max(axis=1), np.where(holds[:, None], ball_centre + ball_radius[:, None], -np.inf))
         centre = (low + high) / 2
-        radius = np.linalg.norm(vertices - centre[:, None], axis=2).max(axis=1)
+        radius = np.maximum(np.linalg.norm(vertices - centre[:, None], axis=2).max(axis=1), np.linalg.norm(ball_centre - centre, axis=1) + ball_radius)
         fov = np.radians(rng.uniform(*FOV_DEG, size=count))
         focal = (size / 2) / np.tan(fov / 2)
         distance = radius / np.sin(rng.uniform(*FILL, size=count) * fov / 2)
@@ -153,13 +241,21 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
         intrinsics[:, 2, 2] = 1
 
         depth = render_depth(vertices, faces, intrinsics, extrinsics, size, size)
+        hand_mask = depth > 0
+        if holds.any():
+            # The hand with its ball: the hand's mask is where the hand is the nearest surface.
+            scene = np.concatenate([vertices[held], ball_centre[held, None] + ball_radius[held, None, None] * sphere[None]], axis=1)
+            both = render_depth(scene, np.concatenate([faces, sphere_faces + vertices.shape[1]]), intrinsics[held], extrinsics[held], size, size)
+            hand_mask[held] &= depth[held] <= both
+            depth[held] = both
+        object_mask = (depth > 0) & ~hand_mask
         camera = np.einsum("bij,bkj->bki", extrinsics[:, :3, :3], keypoints) + extrinsics[:, None, :3, 3]
         pixels = np.einsum("bij,bkj->bki", intrinsics, camera)
         pixels = pixels[..., :2] / pixels[..., 2:]
         column, row = np.rint(pixels[..., 0]).astype(int), np.rint(pixels[..., 1]).astype(int)
         inside = (column >= 0) & (column < size) & (row >= 0) & (row < size)
-        surface = depth[np.arange(count)[:, None], row.clip(0, size - 1), column.clip(0, size - 1)]
-        visible = inside & (surface > 0) & (camera[..., 2] - surface <= VISIBLE_DEPTH_M)
+        at = (np.arange(count)[:, None], row.clip(0, size - 1), column.clip(0, size - 1))
+        visible = inside & hand_mask[at] & (camera[..., 2] - depth[at] <= VISIBLE_DEPTH_M)
 
         columns = {
             "sample": np.arange(first, first + count, dtype=np.int64),
@@ -178,7 +274,10 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
             "visible": visible,
             "intrinsics": intrinsics.astype(np.float32).reshape(count, 9),
             "extrinsics": extrinsics.astype(np.float32).reshape(count, 16),
-            "mask": np.packbits(depth > 0, axis=-1).reshape(count, -1),
+            "ball_radius": ball_radius.astype(np.float32),
+            "ball_centre": ball_centre.astype(np.float32),
+            "mask": np.packbits(hand_mask, axis=-1).reshape(count, -1),
+            "object_mask": np.packbits(object_mask, axis=-1).reshape(count, -1),
             "depth": depth.astype("<f2").reshape(count, -1).view(np.uint8),
         }
         if settings.meshes:
@@ -188,7 +287,7 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
 
 # Columns stored as one fixed-size binary value a sample (little-endian bytes): Parquet writes a
 # list column with levels for each of its values, which for images costs more than the rest.
-BYTES = {"mask", "depth", "vertices"}
+BYTES = {"mask", "object_mask", "depth", "vertices"}
 
 
 def _table(columns: Dict[str, np.ndarray]):
@@ -277,6 +376,7 @@ def synth(
     shard_size: int = 2000,
     vertices: int = 4000,
     meshes: bool = False,
+    ball_share: float = 0.0,
     address: Optional[str] = None,
     num_cpus: Optional[int] = None,
     use_ray: bool = True,
@@ -286,7 +386,7 @@ def synth(
     all by default, or the cluster at `address`; an already started Ray is used as it is), or
     with `use_ray=False` in this process, shard after shard. Returns what `dataset.json`
     holds: the settings, the counts, the time and the samples a second a core."""
-    settings = Settings(samples=samples, seed=seed, image_size=image_size, shard_size=shard_size, vertices=vertices, meshes=meshes)
+    settings = Settings(samples=samples, seed=seed, image_size=image_size, shard_size=shard_size, vertices=vertices, meshes=meshes, ball_share=ball_share)
     out = _prepare(out, settings)
     began = time.perf_counter()
     if use_ray:
@@ -340,12 +440,15 @@ def _bytes_of(column, dtype) -> np.ndarray:
 
 
 def images(table) -> tuple:
-    """The masks (N, S, S) bool and depth maps (N, S, S) float32 (m, 0 off the hand) of a
-    table's rows."""
+    """The hand masks (N, S, S) bool, the held objects' masks (N, S, S) bool and the depth maps
+    (N, S, S) float32 (m, 0 where there is nothing) of a table's rows."""
     size = json.loads(table.schema.metadata[b"dqhand.settings"])["image_size"]
-    masks = np.unpackbits(_bytes_of(table["mask"], np.uint8).reshape(-1, size, (size + 7) // 8), axis=-1, count=size).astype(bool)
+
+    def unpack(name):
+        return np.unpackbits(_bytes_of(table[name], np.uint8).reshape(-1, size, (size + 7) // 8), axis=-1, count=size).astype(bool)
+
     depth = _bytes_of(table["depth"], "<f2").reshape(-1, size, size).astype(np.float32)
-    return masks, depth
+    return unpack("mask"), unpack("object_mask"), depth
 
 
 def meshes(table) -> np.ndarray:
@@ -362,6 +465,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--shard-size", type=int, default=2000, help="samples a shard, a Ray task (default 2000)")
     parser.add_argument("--vertices", type=int, default=4000, help="the hand mesh's vertices (default 4000)")
     parser.add_argument("--meshes", action="store_true", help="also store each sample's skinned vertices")
+    parser.add_argument("--ball-share", type=float, default=0.0, help="the share of samples whose hand holds a ball (default 0)")
     parser.add_argument("--address", help="an existing Ray cluster (ray.init's address); by default a local Ray")
     parser.add_argument("--num-cpus", type=int, help="the local Ray's cores (default all)")
     parser.add_argument("--no-ray", action="store_true", help="make the shards in this process, one after another")
@@ -369,7 +473,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     try:
         summary = synth(
             args.samples, args.out, seed=args.seed, image_size=args.image_size, shard_size=args.shard_size, vertices=args.vertices,
-            meshes=args.meshes, address=args.address, num_cpus=args.num_cpus, use_ray=not args.no_ray,
+            meshes=args.meshes, ball_share=args.ball_share, address=args.address, num_cpus=args.num_cpus, use_ray=not args.no_ray,
         )
     except (SynthError, OSError) as error:
         print(f"dqhand.synth: {error}", file=sys.stderr)
