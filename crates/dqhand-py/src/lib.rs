@@ -57,9 +57,11 @@ fn numbers<'py>(array: &Bound<'py, PyAny>, argument: &str, shape: &[Option<usize
         return Err(PyValueError::new_err(format!("{argument}: expected an array of shape ({wanted}) ({what}), got shape ({got})")));
     }
     let values = converted.as_slice().expect("ascontiguousarray's result is contiguous");
-    if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-        let per_pose = got[1..].iter().product::<usize>().max(1);
-        return Err(PyValueError::new_err(format!("{argument}: value {} of pose {} is not finite", values[i], i / per_pose)));
+    // The library computes in float32: a finite float64 beyond its range would become infinite.
+    if let Some(i) = values.iter().position(|x| !x.is_finite() || x.abs() > f64::from(f32::MAX)) {
+        let per_item = got[1..].iter().product::<usize>().max(1);
+        let problem = if values[i].is_finite() { "does not fit float32" } else { "is not finite" };
+        return Err(PyValueError::new_err(format!("{argument}: value {} of item {} {problem}", values[i], i / per_item)));
     }
     Ok(converted)
 }
@@ -440,9 +442,11 @@ impl Hand {
 
     /// The hand, its wrist at rest, closing from open towards `angles` (B, D) radians on a
     /// ball at `centres` (B, 3), m, of `radii` (B,), m: the rendered angles (B, D) of the
-    /// engine's contact-constrained hand, each finger stopped where it touches the ball.
+    /// engine's contact-constrained hand, each finger stopped where it touches the ball, and
+    /// (B,) whether the open hand was clear of the ball (else a finger touching it open
+    /// cannot close on it).
     #[pyo3(signature = (angles, centres, radii, *, limits = true))]
-    fn close_on_ball<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, centres: &Bound<'py, PyAny>, radii: &Bound<'py, PyAny>, limits: bool) -> PyResult<Bound<'py, PyArray<f32, numpy::Ix2>>> {
+    fn close_on_ball<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, centres: &Bound<'py, PyAny>, radii: &Bound<'py, PyAny>, limits: bool) -> PyResult<grasp::Grasps<'py>> {
         grasp::close_on_ball(self, py, angles, centres, radii, limits)
     }
 

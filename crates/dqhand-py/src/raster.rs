@@ -20,6 +20,11 @@ const MAX_SIDE: usize = 8192;
 /// `faces` as triangles of vertex indices, each checked to name one of `vertices` vertices.
 fn triangles(faces: &Bound<'_, PyAny>, vertices: usize) -> PyResult<Vec<[usize; 3]>> {
     let numpy = faces.py().import("numpy")?;
+    // Integers only: a float index would be truncated to another vertex without a word.
+    let dtype = numpy.call_method1("asarray", (faces,))?.getattr("dtype")?;
+    if !numpy.call_method1("issubdtype", (&dtype, numpy.getattr("integer")?))?.is_truthy()? {
+        return Err(PyValueError::new_err(format!("faces: expected integers of shape (F, 3) (vertex indices), got {dtype}")));
+    }
     let converted = numpy
         .call_method1("ascontiguousarray", (faces, "int64"))
         .map_err(|e| PyValueError::new_err(format!("faces: expected integers of shape (F, 3) (vertex indices): {e}")))?;
@@ -112,7 +117,7 @@ impl Camera<'_> {
             return [0.0, 0.0, 0.0];
         }
         let (x, y) = (x / z, y / z);
-        [k[0] * x + k[1] * y + k[2], k[4] * y + k[5], 1.0 / z]
+        [k[0] * x + k[1] * y + k[2], k[3] * x + k[4] * y + k[5], 1.0 / z]
     }
 }
 

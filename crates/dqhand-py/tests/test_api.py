@@ -146,7 +146,7 @@ def test_bad_points_are_refused_naming_the_argument(hand):
     assert one_line(e).startswith("points[2]: landmarks: ")
     nan = points.copy()
     nan[1, 4, 0] = np.nan
-    with pytest.raises(ValueError, match="^points: value NaN of pose 1 is not finite$"):
+    with pytest.raises(ValueError, match="^points: value NaN of item 1 is not finite$"):
         hand.fit(nan)
     assert [a.shape for a in hand.fit(np.zeros((0, 21, 3)))] == [(0, len(hand.dof_names)), (0, 4, 4)]
 
@@ -488,10 +488,10 @@ def test_bad_metric_arguments_are_refused(hand):
     angles = np.zeros((1, len(hand.dof_names)))
     with pytest.raises(ValueError) as e:
         hand.realism(angles, joint="index-knuckle")
-    assert one_line(e).startswith('unknown joint "index-knuckle"') or "index-knuckle" in str(e.value)
+    assert one_line(e).startswith('unknown joint "index-knuckle"; valid: wrist, ')
     with pytest.raises(ValueError, match='^next: joint "wrist" has 5 children'):
         hand.realism(angles, joint="wrist")
-    with pytest.raises(ValueError, match="^method|unknown"):
+    with pytest.raises(ValueError, match='^unknown skinning method "xyz"; valid: lb, qb, dqb$'):
         hand.realism(angles, method="xyz")
     with pytest.raises(ValueError, match=r"^angles: expected an array of shape \(B, 23\)"):
         hand.realism(np.zeros((1, 5)))

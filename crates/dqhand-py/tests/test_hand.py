@@ -254,6 +254,7 @@ def test_a_left_hand_is_built_as_a_left_hand():
         (lambda h: h.skin(np.zeros((1, 23)), wrist=np.diag([-1.0, 1.0, 1.0, 1.0])[None]), ValueError, ["wrist[0]", "mirror"]),
         (lambda h: h.skin(np.zeros((1, 23)), wrist=np.array([[[1, 0.6, 0, 0], [0, 0.8, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]]])), ValueError, ["wrist[0]", "shear"]),
         (lambda h: h.skin(np.full((1, 23), np.inf)), ValueError, ["angles", "inf", "not finite"]),
+        (lambda h: h.skin(np.full((1, 23), 1e39)), ValueError, ["angles", "of item 0", "does not fit float32"]),
         (lambda h: h.skin(np.zeros((1, 23)), normals=None), TypeError, []),
         (lambda h: h.skin(np.zeros((1, 23)), "dqb", "dqb", True), TypeError, []),
         (lambda h: dqhand.Hand.builtin(side="middle"), ValueError, ["side", "middle"]),

@@ -48,7 +48,7 @@ def test_render_depth_matches_ray_casting():
     angles = rng.uniform(hand.limits[:, 0], hand.limits[:, 1], size=(4, len(hand.dof_names)))
     vertices = hand.skin(angles).astype(np.float64)
     size = 40
-    k = np.array([[48.0, 0, 19.5], [0, 52.0, 20.1], [0, 0, 1]])
+    k = np.array([[48.0, 1.5, 19.5], [0.8, 52.0, 20.1], [0, 0, 1]])  # skewed, every term used
     poses = synth._look_at(rng, vertices.mean(axis=1), np.full(4, 0.3))
     depth = dqhand.render_depth(vertices, hand.faces, np.tile(k, (4, 1, 1)), poses, size, size)
     assert depth.shape == (4, size, size) and depth.dtype == np.float32
@@ -70,6 +70,8 @@ def test_render_depth_bad_arguments():
         dqhand.render_depth(v, [[0, 1, 2]], np.eye(3), pose, 8, 8)
     with pytest.raises(ValueError, match=r"^width: 0 pixels is not an image side"):
         dqhand.render_depth(v, [[0, 1, 2]], k, pose, 0, 8)
+    with pytest.raises(ValueError, match=r"^faces: expected integers of shape \(F, 3\) \(vertex indices\), got float64$"):
+        dqhand.render_depth(v, [[0.0, 1.0, 2.0]], k, pose, 8, 8)
     with pytest.raises(ValueError, match=r"^extrinsics\[0\]: not a rigid or affine transform"):
         dqhand.render_depth(v, [[0, 1, 2]], k, np.ones((1, 4, 4)), 8, 8)
 
@@ -162,23 +164,53 @@ def test_twenty_thousand_samples_on_ray(local_ray, tmp_path):
     np.testing.assert_allclose(keypoints.reshape(1, -1), column(row, "keypoints_3d", 63), atol=1e-5)
 
 
-def test_held_balls_are_touched_without_sinking_in(tmp_path):
+def test_close_on_ball_says_whether_the_open_hand_was_clear():
+    hand = dqhand.Hand.builtin(vertices=1000)
+    fist = hand.gesture_poses()["fist"].astype(np.float64)
+    # A ball in the palm, and one a metre away.
+    angles, clear = hand.close_on_ball(np.stack([fist, fist]), [[0, 0, -0.04], [0, -1.0, 0]], [0.03, 0.03])
+    assert clear.dtype == np.bool_ and clear.tolist() == [False, True]
+    np.testing.assert_allclose(angles[1], fist, atol=1e-6)  # nothing in the way: the fist
+    with pytest.raises(ValueError, match=r"^radii\[0\]: 0.5 m is not a ball's radius \(0.005 to 0.2 m\)$"):
+        hand.close_on_ball(fist[None], [[0, 0, 0]], [0.5])
+    with pytest.raises(ValueError, match=r"^centres: expected an array of shape \(1, 3\)"):
+        hand.close_on_ball(fist[None], [0, 0, 0], [0.03])
+
+
+def test_held_balls_are_wrapped_without_sinking_in(tmp_path):
     summary = synth.synth(240, tmp_path / "set", seed=5, image_size=64, shard_size=120, ball_share=1.0, meshes=True, use_ray=False)
     table = synth.read(tmp_path / "set")
     radius, centre = column(table, "ball_radius"), column(table, "ball_centre", 3)
     assert summary["samples"] == 240 and (radius > 0).all()
     skin = synth.meshes(table)
-    # The skin's gap to the analytic ball (no rasterizer involved), per sample.
-    gap = (np.linalg.norm(skin - centre[:, None], axis=2) - radius[:, None]).min(axis=1)
-    # The tracked grasp itself (the fist the hand closes towards) would sink in: what the
-    # contact-constrained hand prevents, so this check can fail.
-    hand = dqhand.Hand.builtin(length=float(column(table, "hand_length")[0]), breadth=float(column(table, "hand_breadth")[0]), side=column(table, "side")[0], vertices=synth.Settings(1).vertices)
-    fist = hand.skin(np.repeat(hand.gesture_poses()["fist"][None], 120, axis=0))
-    sunk = (np.linalg.norm(fist - centre[:120, None], axis=2) - radius[:120, None]).min(axis=1)
-    print(f"held balls: skin gap median {np.median(gap) * 1e3:.1f} mm, least {gap.min() * 1e3:.2f} mm, within 3 mm in {np.mean(gap < 0.003):.0%}; the fist unconstrained sinks in by a median {-np.median(sunk) * 1e3:.0f} mm")
-    assert np.median(sunk) < -0.005
+    # The skin against the analytic ball (no rasterizer involved), per sample: never inside.
+    distance = np.linalg.norm(skin - centre[:, None], axis=2) - radius[:, None]
+    gap = distance.min(axis=1)
     assert gap.min() > 0
-    assert np.median(gap) < 0.005
+    # Every finger closed on it: each finger's flexion against the fist's it closed towards
+    # (an open hand, 0, fails this).
+    hand = dqhand.Hand.builtin(length=float(column(table, "hand_length")[0]), breadth=float(column(table, "hand_breadth")[0]), side=column(table, "side")[0], vertices=synth.Settings(1).vertices)
+    fist = hand.gesture_poses()["fist"]
+    angles = column(table, "angles", 23)
+    shares = {}
+    for finger in ("thumb", "index", "middle", "ring", "pinky"):
+        flex = [i for i, n in enumerate(hand.dof_names) if n.startswith(finger) and n.endswith(".flex")]
+        shares[finger] = angles[:, flex].sum(axis=1) / fist[flex].sum()
+        assert np.mean(shares[finger] > 0.25) > 0.9, finger
+    # Wrapped: more skin near the ball (within 10 mm) than the open hand has there.
+    open_skin = hand.skin(np.zeros((1, 23)))[0]
+    near_open = (np.linalg.norm(open_skin[None] - centre[:120, None], axis=2) - radius[:120, None] < 0.01).sum(axis=1)
+    near = (distance[:120] < 0.01).sum(axis=1)
+    assert np.median(near) > 2 * np.median(near_open)
+    # The grasp tracked (the fist itself) would sink in: what the contact-constrained hand
+    # prevents.
+    sunk = (np.linalg.norm(hand.skin(np.repeat(fist[None], 120, axis=0)) - centre[:120, None], axis=2) - radius[:120, None]).min(axis=1)
+    assert np.median(sunk) < -0.005
+    print(
+        f"held balls: skin gap median {np.median(gap) * 1e3:.1f} mm (least {gap.min() * 1e3:.2f}, within 3 mm in {np.mean(gap < 0.003):.0%}); "
+        f"closure of the fist's, median: {', '.join(f'{k} {np.median(v):.2f}' for k, v in shares.items())}; "
+        f"skin vertices within 10 mm, median {np.median(near):.0f} (open hand {np.median(near_open):.0f}); the fist unconstrained sinks in by {-np.median(sunk) * 1e3:.0f} mm"
+    )
     # The ball is in sight unless the hand hides it (the camera behind the hand).
     _, balls, _ = synth.images(table)
     assert balls.any(axis=(1, 2)).mean() > 0.6
@@ -216,7 +248,7 @@ def test_a_killed_worker_shard_is_made_again(local_ray, tmp_path):
 
     killer = threading.Thread(target=kill_one)
     killer.start()
-    summary = synth.synth(3_000, out, seed=11, image_size=64, shard_size=500)
+    summary = synth.synth(3_000, out, seed=11, image_size=64, shard_size=500, vertices=1000)
     killer.join()
     assert len(killed) == 1, "no worker was running a shard to kill"
     assert not Path(f"/proc/{killed[0]}").exists()
@@ -225,6 +257,35 @@ def test_a_killed_worker_shard_is_made_again(local_ray, tmp_path):
     table = synth.read(out)
     np.testing.assert_array_equal(column(table, "sample"), np.arange(3_000))
     np.testing.assert_array_equal(np.bincount(column(table, "shard")), [500] * 6)
+    # The shard made again is the one it would have been: every shard as one process makes it.
+    settings = synth.Settings(samples=3_000, seed=11, image_size=64, shard_size=500, vertices=1000)
+    for shard in range(6):
+        alone = one_process_shard(settings, shard)
+        assert alone.equals(table.slice(shard * 500, 500).select(alone.column_names)), shard
+
+
+def test_a_shard_is_written_whole_or_not_at_all(tmp_path):
+    # A worker killed after the shard's first row group: no shard file, only its partial one.
+    code = f"""
+import os
+import pyarrow.parquet as pq
+from pathlib import Path
+from dqhand import synth
+write = pq.ParquetWriter.write_table
+def write_then_die(self, table, *args, **kwargs):
+    write(self, table, *args, **kwargs)
+    os._exit(9)
+pq.ParquetWriter.write_table = write_then_die
+synth.write_shard(synth.Settings(samples=300, image_size=16, vertices=1000), Path({str(tmp_path)!r}), 0)
+"""
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 9, run.stderr
+    names = [p.name for p in tmp_path.iterdir()]
+    assert not any(n.startswith("shard-") for n in names), names
+    assert len([n for n in names if n.startswith(".shard-00000.parquet.") and n.endswith(".partial")]) == 1, names
+    # Written to the end, the same call leaves the shard and nothing else.
+    synth.write_shard(synth.Settings(samples=300, image_size=16, vertices=1000), tmp_path, 0)
+    assert (tmp_path / "shard-00000.parquet").is_file()
 
 
 def test_bad_arguments(tmp_path):

@@ -52,11 +52,14 @@ class Hand:
     def joints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
     def keypoints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
     def skinning_transforms(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
-    def close_on_ball(self, angles: _Angles, centres: npt.ArrayLike, radii: npt.ArrayLike, *, limits: bool = True) -> npt.NDArray[np.float32]:
+    def close_on_ball(
+        self, angles: _Angles, centres: npt.ArrayLike, radii: npt.ArrayLike, *, limits: bool = True
+    ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.bool_]]:
         """The hand (wrist at rest) closing from open towards ``angles`` (B, D) on balls at ``centres`` (B, 3) of ``radii`` (B,), m.
 
-        The rendered angles (B, D) of the engine's contact-constrained hand: each finger stops
-        where its collision proxies touch the ball; nothing passes through it.
+        Returns the rendered angles (B, D) of the engine's contact-constrained hand (each finger
+        stops where its collision proxies touch the ball) and (B,) whether the open hand was
+        clear of the ball; where it was not, a finger touching it open does not close on it.
         """
     def gesture_poses(self) -> Dict[str, npt.NDArray[np.float32]]:
         """The gesture library's shapes as this hand's angles: name -> (D,) radians, the wrist at rest."""

@@ -30,6 +30,8 @@ import numpy as np
 from . import Hand, MEDIAPIPE_KEYPOINTS, render_depth
 
 FORMAT = "dqhand-synth/1"
+# Each Ray task has one core: rayon (the skinning and rasterizer threads) keeps to it.
+ONE_THREAD = {"env_vars": {"RAYON_NUM_THREADS": "1"}}
 # Adult hand lengths (wrist crease to middle fingertip, m) and breadth / length ratios, roughly
 # the 5th to 95th percentiles of women and men together (ANSUR II).
 LENGTH_M = (0.165, 0.210)
@@ -43,8 +45,10 @@ FILL = (0.45, 0.9)
 # A keypoint (a joint centre, inside the finger) counts as visible where the surface drawn at its
 # pixel is at most this far in front of it: about a finger's thickness, less than two fingers'.
 VISIBLE_DEPTH_M = 0.02
-# Samples rendered at a time within a shard (a Parquet row group): bounds a worker's memory.
+# Samples rendered at a time within a shard (a Parquet row group), fewer for large images: bounds
+# a worker's memory (a 256 px chunk peaks near 200 MB).
 CHUNK = 100
+CHUNK_PIXELS = 6_500_000
 # A held ball's radius (m): a golf ball to a large orange.
 BALL_RADIUS_M = (0.02, 0.045)
 # How a held ball is placed: from the palm's centre, this far towards the fingers (m), in a
@@ -53,6 +57,10 @@ BALL_RADIUS_M = (0.02, 0.045)
 BALL_ALONG_M = (-0.01, 0.03)
 BALL_TILT = 0.15
 BALL_GAP_M = (0.002, 0.006)
+# A ball still touching the open hand's collision proxies is moved out this far, up to this
+# many times.
+BALL_STEP_M = 0.003
+BALL_RETRIES = 8
 # The grasp the hand closes towards on a ball: the fist, each angle spread by this (radians).
 GRASP_NOISE_RAD = math.radians(5.0)
 
@@ -168,9 +176,10 @@ def _palm(hand: Hand, fist: np.ndarray):
     return centre, axis, normal / np.linalg.norm(normal)
 
 
-def _ball_centres(rng: np.random.Generator, open_skin: np.ndarray, palm, radii: np.ndarray) -> np.ndarray:
-    """Centres of balls of `radii` in front of the palm, each just clear of the open hand's
-    skin: moved out along its direction past every skin vertex nearer than its radius and gap."""
+def _ball_centres(rng: np.random.Generator, open_skin: np.ndarray, palm, radii: np.ndarray):
+    """Centres of balls of `radii` in front of the palm, each clear of the open hand's skin
+    (moved out along its direction past every skin vertex nearer than its radius and gap),
+    and those directions."""
     centre, axis, normal = palm
     count = len(radii)
     start = centre + rng.uniform(*BALL_ALONG_M, size=count)[:, None] * axis
@@ -183,7 +192,7 @@ def _ball_centres(rng: np.random.Generator, open_skin: np.ndarray, palm, radii: 
     along = np.einsum("bvk,bk->bv", w, direction)
     room = along**2 - np.sum(w * w, axis=2) + reach[:, None] ** 2
     out = np.where(room > 0, along + np.sqrt(np.maximum(room, 0)), 0).max(axis=1)
-    return start + np.maximum(out, 0)[:, None] * direction
+    return start + np.maximum(out, 0)[:, None] * direction, direction
 
 
 def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]]:
@@ -205,19 +214,32 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
     sphere, sphere_faces = icosphere()
     size = settings.image_size
     numbers = settings.shard_samples(shard)
-    for first in range(numbers.start, numbers.stop, CHUNK):
-        count = min(CHUNK, numbers.stop - first)
+    # The balls' own random stream: a data set without balls is the same whatever ball_share's
+    # draws would have been.
+    ball_rng = np.random.default_rng([settings.seed, shard, 1])
+    chunk = max(1, min(CHUNK, CHUNK_PIXELS // size**2))
+    for first in range(numbers.start, numbers.stop, chunk):
+        count = min(chunk, numbers.stop - first)
         angles, start, end, blend = _poses(rng, templates, names, limits, count)
         # Some hands hold a ball instead: closed from open towards a fist until each finger
         # touches it (the contact-constrained hand), so nothing sinks into it.
-        holds = rng.random(count) < settings.ball_share
-        ball_radius = np.where(holds, rng.uniform(*BALL_RADIUS_M, size=count), 0.0)
+        holds = ball_rng.random(count) < settings.ball_share
+        ball_radius = np.where(holds, ball_rng.uniform(*BALL_RADIUS_M, size=count), 0.0)
         ball_centre = np.zeros((count, 3))
         if holds.any():
             held = np.flatnonzero(holds)
-            grasp = np.clip(fist + rng.normal(scale=GRASP_NOISE_RAD, size=(len(held), len(fist))), limits[:, 0], limits[:, 1])
-            ball_centre[held] = _ball_centres(rng, open_skin, palm, ball_radius[held])
-            angles[held] = hand.close_on_ball(grasp, ball_centre[held], ball_radius[held])
+            grasp = np.clip(fist + ball_rng.normal(scale=GRASP_NOISE_RAD, size=(len(held), len(fist))), limits[:, 0], limits[:, 1])
+            centres, away = _ball_centres(ball_rng, open_skin, palm, ball_radius[held])
+            closed, clear = hand.close_on_ball(grasp, centres, ball_radius[held])
+            # A ball the open hand's proxies touch (they stand off the skin, most at the thumb)
+            # would keep that finger open: moved out until the open hand is clear.
+            for _ in range(BALL_RETRIES):
+                if clear.all():
+                    break
+                redo = ~clear
+                centres[redo] += BALL_STEP_M * away[redo]
+                closed[redo], clear[redo] = hand.close_on_ball(grasp[redo], centres[redo], ball_radius[held][redo])
+            ball_centre[held], angles[held] = centres, closed
             for i in held:
                 start[i] = end[i] = "hold_ball"
             blend[held] = 0.0
@@ -228,7 +250,8 @@ def make_shard(settings: Settings, shard: int) -> Iterator[Dict[str, np.ndarray]
         low = np.minimum(vertices.min(axis=1), np.where(holds[:, None], ball_centre - ball_radius[:, None], np.inf))
         high = np.maximum(vertices.max(axis=1), np.where(holds[:, None], ball_centre + ball_radius[:, None], -np.inf))
         centre = (low + high) / 2
-        radius = np.maximum(np.linalg.norm(vertices - centre[:, None], axis=2).max(axis=1), np.linalg.norm(ball_centre - centre, axis=1) + ball_radius)
+        radius = np.linalg.norm(vertices - centre[:, None], axis=2).max(axis=1)
+        radius = np.where(holds, np.maximum(radius, np.linalg.norm(ball_centre - centre, axis=1) + ball_radius), radius)
         fov = np.radians(rng.uniform(*FOV_DEG, size=count))
         focal = (size / 2) / np.tan(fov / 2)
         distance = radius / np.sin(rng.uniform(*FILL, size=count) * fov / 2)
@@ -322,8 +345,14 @@ def write_shard(settings: Settings, out: Path, shard: int) -> Dict[str, float]:
                 writer = pq.ParquetWriter(partial, table.schema.with_metadata(metadata), compression="zstd", use_dictionary=["side", "gesture_from", "gesture_to"])
             writer.write_table(table)
         writer.close()
+        writer = None
+        # On disk before it is renamed: a machine that stops keeps the whole shard or none.
+        with open(partial, "rb") as written:
+            os.fsync(written.fileno())
         os.replace(partial, final)
     finally:
+        if writer is not None:
+            writer.close()
         partial.unlink(missing_ok=True)
     return {
         "shard": shard,
@@ -342,7 +371,8 @@ def shard_task(row: Dict[str, int], settings: Settings, out: Path) -> Dict[str, 
 
 def _prepare(out: Union[str, os.PathLike], settings: Settings) -> Path:
     settings.check()
-    out = Path(out)
+    # Absolute: Ray's workers do not share the driver's working folder.
+    out = Path(out).resolve()
     if out.exists() and not out.is_dir():
         raise SynthError(f"{out}: not a folder")
     if out.is_dir() and any(out.iterdir()):
@@ -357,10 +387,10 @@ def _on_ray(settings: Settings, out: Path, address: Optional[str], num_cpus: Opt
     started = not ray.is_initialized()
     if started:
         # One rayon thread a task: Ray gives each task a core, and rayon would take them all.
-        ray.init(address=address, num_cpus=num_cpus if address is None else None, include_dashboard=False, runtime_env={"env_vars": {"RAYON_NUM_THREADS": "1"}}, logging_level="warning")
+        ray.init(address=address, num_cpus=num_cpus if address is None else None, include_dashboard=False, runtime_env=ONE_THREAD, logging_level="warning")
     try:
         shards = ray.data.range(settings.shards, override_num_blocks=settings.shards)
-        done = shards.map(shard_task, fn_kwargs={"settings": settings, "out": out}, num_cpus=1)
+        done = shards.map(shard_task, fn_kwargs={"settings": settings, "out": out}, num_cpus=1, runtime_env=ONE_THREAD)
         return done.take_all()
     finally:
         if started:
@@ -478,6 +508,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except (SynthError, OSError) as error:
         print(f"dqhand.synth: {error}", file=sys.stderr)
         return 2
+    except Exception as error:  # a failed Ray task or cluster: its first line, not a traceback
+        print(f"dqhand.synth: {type(error).__name__}: {str(error).strip().splitlines()[0] if str(error).strip() else 'failed'}", file=sys.stderr)
+        return 1
     print(
         f"dqhand.synth: {summary['samples']} samples in {summary['shards']} shards, {summary['bytes'] / 1e6:.1f} MB, {summary['seconds']:.1f} s; "
         f"{summary['samples_per_core_second']:.0f} samples a core-second, peak memory a worker {summary['peak_rss_mb_per_worker']:.0f} MB"
