@@ -5,25 +5,16 @@
 
 use dqhand::glam::Vec3;
 use dqhand::input::{Retargeter, JOINT_COUNT, LANDMARK_COUNT};
-use dqhand::kinematics::{Pose, Side};
+use dqhand::kinematics::Pose;
 use numpy::{PyArray, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::{numbers, to_py, Hand};
+use crate::{numbers, side_of, to_py, Hand};
 
 /// What `Hand.fit` returns: the angles (B, D) and the wrists (B, 4, 4).
 pub(crate) type Fitted<'py> = (Bound<'py, PyArray<f32, numpy::Ix2>>, Bound<'py, PyArray<f32, numpy::Ix3>>);
-
-/// `"left"` or `"right"` (any case) as a side; the message names `argument`.
-pub(crate) fn side_of(side: &str, argument: &str) -> PyResult<Side> {
-    match side.to_ascii_lowercase().as_str() {
-        "right" => Ok(Side::Right),
-        "left" => Ok(Side::Left),
-        _ => Err(PyValueError::new_err(format!("{argument}: {side:?} is not a side; use \"right\" or \"left\""))),
-    }
-}
 
 /// A pose's wrist as a row-major 4 × 4 rigid transform (the rest wrist where it has none).
 pub(crate) fn wrist_matrix(pose: &Pose, rest: dqhand::math::DualQuat) -> [f32; 16] {

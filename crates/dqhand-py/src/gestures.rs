@@ -16,7 +16,7 @@ use numpy::PyReadonlyArrayDyn;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::fit::side_of;
+use crate::side_of;
 use crate::recording::{glove_table, read_records, sensors, sides};
 use crate::{numbers, to_py, Hand, PoseSource};
 

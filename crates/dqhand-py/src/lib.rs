@@ -43,6 +43,15 @@ fn to_py(error: dqhand::Error) -> PyErr {
     }
 }
 
+/// `"left"` or `"right"` (any case) as a side; the message names `argument`.
+pub(crate) fn side_of(side: &str, argument: &str) -> PyResult<Side> {
+    match side.to_ascii_lowercase().as_str() {
+        "right" => Ok(Side::Right),
+        "left" => Ok(Side::Left),
+        _ => Err(PyValueError::new_err(format!("{argument}: {side:?} is not a side; use \"right\" or \"left\""))),
+    }
+}
+
 /// `array` read by NumPy as a contiguous float64 array (`numpy.ascontiguousarray`: any
 /// array-like, any numeric dtype, any layout), checked to have the shape `shape` (`None` for
 /// the batch) and finite values. Messages name `argument` and the shape it must have.
@@ -230,11 +239,7 @@ impl Hand {
     #[pyo3(signature = (length = 0.19, breadth = 0.085, side = "right", vertices = None, model = "full"))]
     fn builtin(py: Python<'_>, length: f32, breadth: f32, side: &str, vertices: Option<usize>, model: &str) -> PyResult<Self> {
         let joint_model: JointModel = model.parse().map_err(to_py)?;
-        let side = match side.to_ascii_lowercase().as_str() {
-            "right" => Side::Right,
-            "left" => Side::Left,
-            _ => return Err(PyValueError::new_err(format!("side: {side:?} is not a side; use \"right\" or \"left\""))),
-        };
+        let side = side_of(side, "side")?;
         let params = HandParams { length, breadth, side, vertices: vertices.unwrap_or(HandParams::default().vertices) };
         let built = py.detach(|| build(&params)).map_err(to_py)?;
         Self::new(built, joint_model, None)

@@ -17,7 +17,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use crate::fit::side_of;
+use crate::side_of;
 use crate::{numbers, to_py};
 
 /// A glove's mapping table as the command line names it: a built-in name or a JSON file.
