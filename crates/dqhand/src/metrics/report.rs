@@ -7,9 +7,9 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 use serde_json::{json, Value};
 
-use super::{count_self_intersections, edge_distortion, JointRegion};
+use super::{count_self_intersections, edge_distortion, self_contact, JointRegion, SelfContact};
 use crate::geometry::{check_closed, edges, enclosed_volume};
-use crate::gesture::gesture;
+use crate::gesture::{gesture, GESTURES};
 use crate::kinematics::{HandRig, JointModel, KinematicsLayer, Limits, Pose, Transform};
 use crate::model::Model;
 use crate::skin::{Method, MethodSet, SkinLayer};
@@ -103,9 +103,29 @@ pub struct Report {
     pub rest_intersections: usize,
     /// Intersecting triangle pairs per gesture, per method (in [`Method::ALL`] order).
     pub intersections: Vec<(&'static str, [usize; 3])>,
+    /// Skin inside skin between the fingers and the palm at rest.
+    pub rest_self_contact: SelfContact,
+    /// The same in every gesture of the library, per method.
+    pub self_contact: Vec<(&'static str, [SelfContact; 3])>,
 }
 
-/// The gestures whose self-intersections are counted.
+/// Each vertex's part of the hand, for [`self_contact`]: its heaviest joint's finger (0 the
+/// thumb, its metacarpal included, which moves; to 4 the little finger), else 5, the palm (the
+/// wrist and the finger metacarpals).
+fn hand_parts(model: &Model) -> Vec<u8> {
+    const FINGERS: [&str; 5] = ["thumb-", "index-finger-", "middle-finger-", "ring-finger-", "pinky-finger-"];
+    let joints = model.skeleton.joints();
+    (0..model.mesh.vertex_count())
+        .map(|v| {
+            let name = model.mesh.influences(v).next().map_or("", |(j, _)| joints[j].name.as_str());
+            let moving = name.contains("phalanx") || name == "thumb-metacarpal";
+            FINGERS.iter().position(|f| moving && name.starts_with(f)).map_or(5, |f| f as u8)
+        })
+        .collect()
+}
+
+/// The gestures whose self-intersections are counted, and whose self-contact is in the
+/// headline (every gesture's is in the report).
 const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs_up"];
 
 /// Measures LB, QB and DQB on every sweep, each frame posed once by the kinematics layer
@@ -167,14 +187,20 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
     }
     let mut intersections = Vec::new();
-    for name in INTERSECTION_GESTURES {
-        hand.pose(&gesture(name)?.pose(JointModel::Full));
+    let mut contact = Vec::new();
+    let parts = hand_parts(&model);
+    for g in &GESTURES {
+        hand.pose(&g.pose(JointModel::Full));
         skin.deform(hand.layer());
-        let counts = Method::ALL.map(|m| count_self_intersections(skin.deformed(m).expect("every method is in the set").positions(), mesh.indices()));
-        intersections.push((name, counts));
+        let posed = |m: Method| skin.deformed(m).expect("every method is in the set").positions();
+        if INTERSECTION_GESTURES.contains(&g.name) {
+            intersections.push((g.name, Method::ALL.map(|m| count_self_intersections(posed(m), mesh.indices()))));
+        }
+        contact.push((g.name, Method::ALL.map(|m| self_contact(posed(m), mesh.indices(), &parts))));
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
-    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections })
+    let rest_self_contact = self_contact(&rest_positions, mesh.indices(), &parts);
+    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections, rest_self_contact, self_contact: contact })
 }
 
 /// Writes the local transforms of one sweep value.
@@ -245,6 +271,10 @@ impl Report {
                 "rest": self.rest_intersections,
                 "gestures": self.intersections.iter().map(|(g, c)| json!({ "gesture": g, "lb": c[0], "qb": c[1], "dqb": c[2] })).collect::<Vec<_>>(),
             },
+            "self_contact": {
+                "rest": contact_json(&self.rest_self_contact),
+                "gestures": self.self_contact.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]) })).collect::<Vec<_>>(),
+            },
             "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2] })).collect::<Vec<_>>(),
         })
     }
@@ -302,6 +332,11 @@ impl Report {
         rows.extend(self.intersections.iter().map(|(g, c)| {
             (format!("intersecting triangle pairs, {g} (rest: {})", self.rest_intersections), c.map(|n| Some(n as f32)))
         }));
+        for (g, c) in self.self_contact.iter().filter(|(g, _)| INTERSECTION_GESTURES.contains(g)) {
+            let rest = &self.rest_self_contact;
+            rows.push((format!("skin inside skin between parts, {g}: deepest (mm; rest {:.2})", rest.depth_m * 1000.0), c.map(|x| Some(x.depth_m * 1000.0))));
+            rows.push((format!("skin inside skin between parts, {g}: shared volume (mm³; rest {:.1})", rest.volume_m3 * 1e9), c.map(|x| Some((x.volume_m3 * 1e9) as f32))));
+        }
         rows
     }
 
@@ -316,6 +351,11 @@ impl Report {
     }
 }
 
+
+/// One [`SelfContact`] in the report's JSON, in millimetres.
+fn contact_json(x: &SelfContact) -> Value {
+    json!({ "depth_mm": x.depth_m * 1000.0, "volume_mm3": x.volume_m3 * 1e9, "vertices": x.vertices })
+}
 
 /// A headline value as printed: `undefined`, a count, or three decimals.
 #[must_use]
