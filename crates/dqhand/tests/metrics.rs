@@ -78,6 +78,15 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
     let fist = report.self_contact.iter().find(|(g, _)| *g == "fist").unwrap().1;
     assert!(fist.iter().all(|c| c.depth_m > 0.001 && c.volume_m3 > 1e-7), "{fist:?}");
     assert!(fist[1].volume_m3 > 2.0 * fist[2].volume_m3 && fist[1].depth_m > fist[2].depth_m, "QB: {:?}, DQB: {:?}", fist[1], fist[2]);
+    // Over the sweep from the open hand to the fist it starts at none and ends at the gesture's.
+    let sweep = report.sweep("fist").unwrap();
+    for (m, frames) in sweep.frames.iter().enumerate() {
+        let contact: Vec<_> = frames.iter().map(|f| f.self_contact.expect("measured over the fist sweep")).collect();
+        assert_eq!(contact[0].vertices, 0, "{m}: open hand {:?}", contact[0]);
+        let last = contact.last().unwrap();
+        assert!((last.depth_m - fist[m].depth_m).abs() < 1e-6 && (last.volume_m3 - fist[m].volume_m3).abs() < 1e-12, "{m}: {last:?} against {:?}", fist[m]);
+    }
+    assert!(report.sweep("index-pip").unwrap().frames[2].iter().all(|f| f.self_contact.is_none()));
     // At rest every method reproduces the mesh: ratios 1, no distortion, no jump.
     for s in &report.sweeps {
         for m in 0..3 {

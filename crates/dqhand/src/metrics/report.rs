@@ -35,16 +35,19 @@ struct SweepSpec {
     motion: Motion,
     joint: &'static str,
     next: &'static str,
+    /// Whether each frame's [`self_contact`] is measured (where parts of the hand meet: it costs
+    /// some 60 ms a frame and method).
+    contact: bool,
 }
 
 fn specs() -> Vec<SweepSpec> {
     let range = |max: f32, step: f32| (0..=(max / step).round() as usize).map(|i| i as f32 * step).collect::<Vec<_>>();
     let index = ["index-finger-phalanx-intermediate", "index-finger-phalanx-distal"];
     vec![
-        SweepSpec { name: "index-pip", parameter: "degrees", values: range(110.0, 5.0), motion: Motion::Dof("index-finger-phalanx-intermediate.flex"), joint: index[0], next: index[1] },
-        SweepSpec { name: "index-mcp", parameter: "degrees", values: range(90.0, 5.0), motion: Motion::Dof("index-finger-phalanx-proximal.flex"), joint: "index-finger-phalanx-proximal", next: index[0] },
-        SweepSpec { name: "fist", parameter: "percent", values: range(100.0, 10.0), motion: Motion::Gesture("fist"), joint: "middle-finger-phalanx-intermediate", next: "middle-finger-phalanx-distal" },
-        SweepSpec { name: "index-pip-twist", parameter: "degrees", values: range(200.0, 10.0), motion: Motion::Twist(&["index-finger-phalanx-intermediate"]), joint: index[0], next: index[1] },
+        SweepSpec { name: "index-pip", parameter: "degrees", values: range(110.0, 5.0), motion: Motion::Dof("index-finger-phalanx-intermediate.flex"), joint: index[0], next: index[1], contact: false },
+        SweepSpec { name: "index-mcp", parameter: "degrees", values: range(90.0, 5.0), motion: Motion::Dof("index-finger-phalanx-proximal.flex"), joint: "index-finger-phalanx-proximal", next: index[0], contact: false },
+        SweepSpec { name: "fist", parameter: "percent", values: range(100.0, 10.0), motion: Motion::Gesture("fist"), joint: "middle-finger-phalanx-intermediate", next: "middle-finger-phalanx-distal", contact: true },
+        SweepSpec { name: "index-pip-twist", parameter: "degrees", values: range(200.0, 10.0), motion: Motion::Twist(&["index-finger-phalanx-intermediate"]), joint: index[0], next: index[1], contact: false },
         SweepSpec {
             name: "wrist-twist",
             parameter: "degrees",
@@ -52,6 +55,7 @@ fn specs() -> Vec<SweepSpec> {
             motion: Motion::Twist(&["thumb-metacarpal", "index-finger-metacarpal", "middle-finger-metacarpal", "ring-finger-metacarpal", "pinky-finger-metacarpal"]),
             joint: "middle-finger-metacarpal",
             next: "middle-finger-phalanx-proximal",
+            contact: false,
         },
     ]
 }
@@ -73,6 +77,8 @@ pub struct FrameMetrics {
     pub distortion_max: f32,
     /// Largest vertex displacement from the previous frame of the sweep (m).
     pub jump: f32,
+    /// Skin inside skin between the hand's parts, in the sweeps where they meet (the fist).
+    pub self_contact: Option<SelfContact>,
 }
 
 /// One sweep measured under the three methods.
@@ -149,6 +155,7 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     let bind_world = model.bind_world();
     let all_edges = edges(mesh.indices());
     let mut locals = skeleton.rest_locals();
+    let parts = hand_parts(&model);
     let mut sweeps = Vec::new();
     for spec in specs() {
         let region = JointRegion::new(skeleton, &bind_world, mesh, spec.joint, spec.next)?;
@@ -180,6 +187,7 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
                     distortion_mean,
                     distortion_max,
                     jump,
+                    self_contact: spec.contact.then(|| self_contact(posed, mesh.indices(), &parts)),
                 });
                 previous[m.index()] = Some(posed.to_vec());
             }
@@ -188,7 +196,6 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     }
     let mut intersections = Vec::new();
     let mut contact = Vec::new();
-    let parts = hand_parts(&model);
     for g in &GESTURES {
         hand.pose(&g.pose(JointModel::Full));
         skin.deform(hand.layer());
@@ -258,6 +265,9 @@ impl Report {
                         "distortion_max": col(|f| json!(f.distortion_max)),
                         "jump": col(|f| json!(f.jump)),
                     });
+                    if frames.iter().any(|f| f.self_contact.is_some()) {
+                        o[m.as_str()]["self_contact"] = col(|f| f.self_contact.as_ref().map_or(Value::Null, contact_json));
+                    }
                 }
                 (s.name.to_owned(), o)
             })
@@ -286,13 +296,14 @@ impl Report {
     pub fn write_csv(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
         for s in &self.sweeps {
-            let mut text = format!("{},method,volume,min_distance,max_distance,section_radius,distortion_mean,distortion_max,jump_m\n", s.parameter);
+            let mut text = format!("{},method,volume,min_distance,max_distance,section_radius,distortion_mean,distortion_max,jump_m,contact_depth_m,contact_volume_m3\n", s.parameter);
             for (m, frames) in Method::ALL.iter().zip(&s.frames) {
                 for (v, f) in s.values.iter().zip(frames) {
                     let volume = f.volume.map_or(String::new(), |x| x.to_string());
+                    let (depth, shared) = f.self_contact.map_or((String::new(), String::new()), |c| (c.depth_m.to_string(), c.volume_m3.to_string()));
                     let _ = writeln!(
                         text,
-                        "{v},{m},{volume},{},{},{},{},{},{}",
+                        "{v},{m},{volume},{},{},{},{},{},{},{depth},{shared}",
                         f.min_distance, f.max_distance, f.section_radius, f.distortion_mean, f.distortion_max, f.jump
                     );
                 }
