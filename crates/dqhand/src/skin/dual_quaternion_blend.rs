@@ -10,7 +10,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{cross, dot, inv_sq_lanes, mad, recip, rotate, Blend, Chunk};
+use super::kernel::{cross, dot, mad, recip, rotate, Blend, Chunk};
 use crate::math::DualQuat;
 
 /// Blend parameters: real part `(x, y, z, w)`, then dual part.
@@ -29,16 +29,12 @@ impl Blend<W> for Dqb {
 
     #[inline(always)]
     fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
-        let lanes = inv_sq_lanes::<L, W, ISA>(b);
         for l in 0..L {
             let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
             let (d0, a0) = ([q[0], q[1], q[2]], q[3]);
             let (de, ae) = ([b[4][l], b[5][l], b[6][l]], b[7][l]);
             // Eq. (5) is quadratic in b̂, so dividing once by ‖b₀‖² normalises it exactly.
-            let inv_sq = match lanes {
-                Some(s) => s[l],
-                None => recip(dot::<ISA, 4>(q, q)),
-            };
+            let inv_sq = recip(dot::<ISA, 4>(q, q));
             let k = 2.0 * inv_sq;
             // Eq. (5): translation 2(a₀ d_ε − a_ε d₀ + d₀ × d_ε).
             let c = cross::<ISA>(d0, de);

@@ -441,26 +441,6 @@ pub(crate) fn recip(sq: f32) -> f32 {
     1.0 / sq.max(1e-30)
 }
 
-/// On the AVX-512 kernel, `1 / ‖q‖²` (floored as [`recip`]) of the blended quaternion
-/// `b[0..4]` of all 16 lanes at once, by an estimate refined by one Newton step (relative error
-/// near the rounding of a division): a 512-bit division takes ~10 cycles of the one divider
-/// on Intel cores. Elsewhere `None`: each lane divides.
-#[inline(always)]
-pub(crate) fn inv_sq_lanes<const L: usize, const W: usize, const ISA: u8>(b: &[[f32; L]; W]) -> Option<[f32; L]> {
-    #[cfg(target_arch = "x86_64")]
-    if ISA == AVX512 && L == BLOCK {
-        let mut sq = [0.0; L];
-        for (l, sq) in sq.iter_mut().enumerate() {
-            let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
-            *sq = dot::<ISA, 4>(q, q);
-        }
-        // SAFETY: `ISA` is AVX512 only inside `deform_avx512`; `sq` holds 16 floats.
-        return Some(unsafe { avx512::recip(sq) });
-    }
-    let _ = b;
-    None
-}
-
 /// `1 / sqrt(x)` per lane, with a floor that keeps degenerate inputs finite. On the AVX-512
 /// kernel an approximate one refined by one Newton step (relative error near the rounding
 /// of the exact one): a 512-bit square root and division take ~20 cycles of the one divider
@@ -805,8 +785,8 @@ mod avx512 {
                     let p = self.params.get_unchecked(usize::from(run.joint)).as_ptr();
                     // Sign 0 is the heaviest joint's own (+1).
                     let sw = if B::SIGNED == 0 || run.sign == 0 { w } else { _mm512_mul_ps(w, _mm512_set1_ps(*self.signs.get_unchecked(run.sign as usize))) };
-                    for c in 0..B::USED {
-                        acc[c] = _mm512_mask3_fmadd_ps(if c < B::SIGNED { sw } else { w }, _mm512_set1_ps(*p.add(c)), acc[c], run.lanes);
+                    for (c, a) in acc.iter_mut().enumerate().take(B::USED) {
+                        *a = _mm512_mask3_fmadd_ps(if c < B::SIGNED { sw } else { w }, _mm512_set1_ps(*p.add(c)), *a, run.lanes);
                     }
                 }
             }
@@ -814,18 +794,6 @@ mod avx512 {
                 _mm512_storeu_ps(b[c].as_mut_ptr(), acc[c]);
             }
         }
-    }
-
-    /// `1 / max(x, 1e-30)` of 16 lanes: `rcp14` (relative error 2⁻¹⁴) and one Newton step
-    /// `r (2 − x r)`; as [`inv_len`].
-    #[inline(always)]
-    pub(super) unsafe fn recip<const L: usize>(x: [f32; L]) -> [f32; L] {
-        debug_assert_eq!(L, 16, "16 lanes");
-        let x = _mm512_max_ps(_mm512_loadu_ps(x.as_ptr()), _mm512_set1_ps(1e-30));
-        let r = _mm512_rcp14_ps(x);
-        let mut out = [0.0; L];
-        _mm512_storeu_ps(out.as_mut_ptr(), _mm512_mul_ps(r, _mm512_fnmadd_ps(x, r, _mm512_set1_ps(2.0))));
-        out
     }
 
     /// `1 / sqrt(max(x, 1e-30))` of 16 lanes: `rsqrt14` (relative error 2⁻¹⁴) and one

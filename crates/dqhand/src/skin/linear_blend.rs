@@ -43,8 +43,8 @@ impl Blend<W> for Lb {
             let (m, sq, det) = normal::<ISA>(r, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
             // A mirroring blend (negative determinant) would turn the normal inside out.
             let s = inv_len::<1, ISA>([sq])[0].copysign(det);
-            for i in 0..3 {
-                out.n[i][l] = m[i] * s;
+            for (n, m) in out.n.iter_mut().zip(m) {
+                n[l] = m * s;
             }
         }
         if !NORMALS || !split {
@@ -55,8 +55,8 @@ impl Blend<W> for Lb {
             let r = [[b[0][l], b[1][l], b[2][l]], [b[4][l], b[5][l], b[6][l]], [b[8][l], b[9][l], b[10][l]]];
             let m;
             (m, sq[l], det[l]) = normal::<ISA>(r, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
-            for i in 0..3 {
-                out.n[i][l] = m[i];
+            for (n, m) in out.n.iter_mut().zip(m) {
+                n[l] = m;
             }
         }
         let s = inv_len::<L, ISA>(sq);

@@ -6,7 +6,7 @@
 
 use glam::Affine3A;
 
-use super::kernel::{dot, inv_sq_lanes, recip, rotate, Blend, Chunk};
+use super::kernel::{dot, recip, rotate, Blend, Chunk};
 
 /// Blend parameters: the rotation `(x, y, z, w)`, then the translation and a zero.
 pub(crate) const W: usize = 8;
@@ -26,13 +26,9 @@ impl Blend<W> for Qb {
 
     #[inline(always)]
     fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
-        let lanes = inv_sq_lanes::<L, W, ISA>(b);
         for l in 0..L {
             let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
-            let inv_sq = match lanes {
-                Some(s) => s[l],
-                None => recip(dot::<ISA, 4>(q, q)),
-            };
+            let inv_sq = recip(dot::<ISA, 4>(q, q));
             let p = rotate::<ISA>(q, inv_sq, [rest.p[0][l], rest.p[1][l], rest.p[2][l]]);
             for i in 0..3 {
                 out.p[i][l] = p[i] + b[4 + i][l];
