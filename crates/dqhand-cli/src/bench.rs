@@ -5,6 +5,10 @@
 //! and the ratios of medians. Each frame the engine's kinematics stage poses the hand
 //! untimed; what is timed is one variant's `Deformer::deform` on the engine's skinning
 //! transforms, per-bone conversion included.
+//!
+//! On an AVX-512 CPU the kernel's lookup strategies are timed side by side, with the one
+//! `Deformer::new` chose, against a straightforward AVX-512 DQB kernel
+//! ([`PlainSoaKernel`]) and the frame's roofline ([`roofline`](crate::roofline)).
 
 use std::time::Instant;
 
@@ -14,9 +18,12 @@ use dqhand::engine::ModelSource;
 use dqhand::gesture::Sequence;
 use dqhand::kinematics::{HandKinematics, JointModel, KinematicsLayer, Pose, Transform};
 use dqhand::model::Model;
-use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method};
-use glam::Quat;
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method, SkinnedMesh, Strategy};
+use glam::{Affine3A, Quat};
 use serde_json::json;
+
+use crate::plain_soa_kernel::PlainSoaKernel;
+use crate::roofline::{Machine, Work};
 
 /// Arguments of `dqhand bench`.
 #[derive(clap::Args)]
@@ -40,23 +47,44 @@ pub struct Args {
     stream: Option<f64>,
 }
 
-/// One timed configuration: a method on a kernel, on some threads, with or without normals.
+/// One timed configuration: a method on a kernel (with a lookup strategy: `None` for the
+/// one `Deformer::new` chose), on some threads, with or without normals; or the plain kernel.
 struct Variant {
     method: Method,
-    kernel: Kernel,
+    kernel: &'static str,
+    strategy: Option<Strategy>,
     threads: usize,
     normals: bool,
-    deformer: Deformer,
-    out: Deformed,
+    runner: Runner,
     samples: Vec<f64>,
 }
 
+/// What a variant runs.
+enum Runner {
+    Engine(Deformer, Deformed),
+    /// The straightforward kernel and its positions and normals (#V each).
+    Plain(Box<PlainSoaKernel>, Vec<[f32; 3]>, Vec<[f32; 3]>),
+}
+
+/// The plain kernel's name in the report.
+const PLAIN: &str = "avx512-plain";
+
 impl Variant {
     /// Deforms one frame and returns the µs it took.
-    fn time(&mut self, mesh: &dqhand::skin::SkinnedMesh, skinning: &[glam::Affine3A]) -> f64 {
+    fn time(&mut self, mesh: &SkinnedMesh, skinning: &[Affine3A]) -> f64 {
         let t = Instant::now();
-        self.deformer.deform(mesh, skinning, &mut self.out);
+        match &mut self.runner {
+            Runner::Engine(deformer, out) => deformer.deform(mesh, skinning, out),
+            Runner::Plain(kernel, positions, normals) => kernel.deform(skinning, positions, normals),
+        }
         t.elapsed().as_secs_f64() * 1e6
+    }
+
+    fn positions(&self) -> &[[f32; 3]] {
+        match &self.runner {
+            Runner::Engine(_, out) => out.positions(),
+            Runner::Plain(_, positions, _) => positions,
+        }
     }
 }
 
@@ -73,33 +101,58 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let threads: Vec<usize> = if args.threads.is_empty() { (2..=cores).collect() } else { args.threads.iter().copied().filter(|&t| t > 1).collect() };
     anyhow::ensure!(threads.iter().all(|&t| t <= 256), "--threads: at most 256");
+    let forced = std::env::var(Strategy::ENV).ok();
+    if let Some(name) = &forced {
+        let names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
+        anyhow::ensure!(Strategy::named(name).is_some(), "{}={name:?} is not a strategy ({})", Strategy::ENV, names.join(", "));
+    }
     let model = Arc::new(model);
     let mesh = &model.mesh;
     let best = Kernel::best();
+    // The run-time choice, made before the timed variants' deformers are built (the first
+    // deformer of each method measures; the rest reuse the choice).
+    let chosen = Method::ALL.map(|m| Deformer::new(m, mesh).strategy());
+    let strategies: Vec<Strategy> = if best == Kernel::Avx512 { Strategy::ALL.into_iter().filter(|s| s.serves(mesh.inverse_bind().len())).collect() } else { Vec::new() };
     let kernels: Vec<Kernel> = Kernel::ALL.into_iter().filter(|k| k.available()).collect();
     let mut variants = Vec::new();
     // One crew per thread count, shared by its variants, as an application would keep one.
     let crews: Vec<(usize, Arc<Crew>)> = threads.iter().map(|&t| Ok((t, Arc::new(Crew::new(t, Crew::SPIN)?)))).collect::<anyhow::Result<_>>()?;
-    let mut add = |method, kernel, threads: usize, normals| {
+    let mut add = |method, kernel: Kernel, strategy: Option<Strategy>, threads: usize, normals| {
         let mut deformer = Deformer::new(method, mesh).with_kernel(kernel);
+        if let Some(s) = strategy {
+            deformer = deformer.with_strategy(s);
+        }
         if let Some((_, crew)) = crews.iter().find(|(t, _)| *t == threads) {
             deformer = deformer.with_crew(Arc::clone(crew));
         }
         let out = if normals { Deformed::new(mesh) } else { Deformed::positions_only(mesh) };
-        variants.push(Variant { method, kernel, threads, normals, deformer, out, samples: Vec::with_capacity(args.frames) });
+        variants.push(Variant { method, kernel: kernel.name(), strategy, threads, normals, runner: Runner::Engine(deformer, out), samples: Vec::with_capacity(args.frames) });
     };
     for &kernel in &kernels {
         for normals in [true, false] {
             for m in Method::ALL {
-                add(m, kernel, 1, normals);
+                add(m, kernel, None, 1, normals);
+            }
+        }
+    }
+    for &s in &strategies {
+        for normals in [true, false] {
+            for m in Method::ALL {
+                add(m, Kernel::Avx512, Some(s), 1, normals);
             }
         }
     }
     for &t in &threads {
         for normals in [true, false] {
-            add(Method::Dqb, best, t, normals);
+            add(Method::Dqb, best, None, t, normals);
         }
     }
+    if let Some(plain) = PlainSoaKernel::new(mesh) {
+        let n = mesh.vertex_count();
+        let runner = Runner::Plain(Box::new(plain), vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        variants.push(Variant { method: Method::Dqb, kernel: PLAIN, strategy: None, threads: 1, normals: true, runner, samples: Vec::with_capacity(args.frames) });
+    }
+    let machine = Machine::measure();
     let mut animation = Animation::new(model.clone());
     // Warm-up: caches, branch predictors, CPU frequency, the crews' threads.
     for f in 0..100 {
@@ -116,23 +169,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let v = &mut variants[(f + k) % n];
             let us = v.time(mesh, animation.skinning());
             v.samples.push(us);
-            std::hint::black_box(v.out.positions());
+            std::hint::black_box(v.positions());
         }
     }
     let rows: Vec<serde_json::Value> = variants
         .iter_mut()
         .map(|v| {
             let (med, p10, p90) = (percentile(&mut v.samples, 0.5), percentile(&mut v.samples, 0.1), percentile(&mut v.samples, 0.9));
-            json!({ "method": v.method.as_str(), "kernel": v.kernel.name(), "threads": v.threads, "normals": v.normals, "us_per_frame": med, "p10_us": p10, "p90_us": p90, "fps": 1e6 / med })
+            json!({ "method": v.method.as_str(), "kernel": v.kernel, "strategy": v.strategy.map(Strategy::name), "threads": v.threads, "normals": v.normals, "us_per_frame": med, "p10_us": p10, "p90_us": p90, "fps": 1e6 / med })
         })
         .collect();
-    let row = |method: Method, kernel: Kernel, threads: usize, normals: bool| {
-        rows.iter()
-            .find(|r| r["method"] == method.as_str() && r["kernel"] == kernel.name() && r["threads"] == threads && r["normals"] == normals)
-            .expect("a timed variant")
+    let find = |method: Method, kernel: &str, strategy: Option<Strategy>, threads: usize, normals: bool| {
+        rows.iter().find(|r| r["method"] == method.as_str() && r["kernel"] == kernel && r["strategy"] == json!(strategy.map(Strategy::name)) && r["threads"] == threads && r["normals"] == normals)
     };
+    let row = |method: Method, kernel: Kernel, threads: usize, normals: bool| find(method, kernel.name(), None, threads, normals).expect("a timed variant");
     let stat = |r: &serde_json::Value, key: &str| r[key].as_f64().expect("a number");
     let us = |method, kernel, threads, normals| stat(row(method, kernel, threads, normals), "us_per_frame");
+    let by_strategy = |method, s, normals| stat(find(method, Kernel::Avx512.name(), Some(s), 1, normals).expect("a timed strategy"), "us_per_frame");
+    let plain = find(Method::Dqb, PLAIN, None, 1, true).map(|r| stat(r, "us_per_frame"));
+    let roofline: Vec<serde_json::Value> = Method::ALL
+        .into_iter()
+        .flat_map(|m| [true, false].map(|normals| (m, normals)))
+        .map(|(m, normals)| {
+            let work = Work::of(mesh, m, normals);
+            let (bound, measured) = (work.bound_us(&machine), us(m, best, 1, normals));
+            json!({ "method": m.as_str(), "normals": normals, "bytes_read": work.read, "bytes_written": work.written, "flops": work.flops, "bound_us": bound, "us_per_frame": measured, "over_bound": measured / bound })
+        })
+        .collect();
     let table3 = |m: Method| us(m, best, 1, true);
     let animation = animation.name;
     let report = json!({
@@ -149,6 +212,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "kernels": kernels.iter().map(|k| k.name()).collect::<Vec<_>>(),
         "methods": Method::ALL.iter().map(|&m| (m.as_str().to_owned(), json!({ "us_per_frame": table3(m), "fps": 1e6 / table3(m) }))).collect::<serde_json::Map<_, _>>(),
         "ratios": { "dqb_over_lb": table3(Method::Dqb) / table3(Method::Lb), "dqb_over_qb": table3(Method::Dqb) / table3(Method::Qb) },
+        "strategies": strategies.iter().map(|s| s.name()).collect::<Vec<_>>(),
+        "chosen_strategy": Method::ALL.iter().zip(&chosen).map(|(m, s)| (m.as_str().to_owned(), json!(s.name()))).collect::<serde_json::Map<_, _>>(),
+        "strategy_forced": forced,
+        "plain_soa_dqb_us": plain,
+        "machine": { "l2_read_bytes_per_s": machine.l2_read_bytes_per_s, "l2_write_bytes_per_s": machine.l2_write_bytes_per_s, "peak_flops": machine.peak_flops, "vector_bits": machine.vector_bits },
+        "roofline": roofline,
         "variants": rows,
     });
     if args.json {
@@ -177,6 +246,49 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let cell = |normals| Method::ALL.map(|m| format!("{:>8.1}", us(m, k, 1, normals))).join(" ");
         println!("{:<9} {} | {}", k.name(), cell(true), cell(false));
     }
+    if !strategies.is_empty() {
+        println!("\nAVX-512 lookup strategies: one thread; positions and normals | positions only");
+        println!("{:<9} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}", "strategy", "LB", "QB", "DQB", "LB", "QB", "DQB");
+        for &s in &strategies {
+            let cell = |normals| Method::ALL.map(|m| format!("{:>8.1}", by_strategy(m, s, normals))).join(" ");
+            println!("{:<9} {} | {}", s.name(), cell(true), cell(false));
+        }
+        let how = forced.as_ref().map_or_else(|| "measured when each deformer was built".to_owned(), |name| format!("forced by {}={name}", Strategy::ENV));
+        println!("run-time choice ({how}): {}", Method::ALL.iter().zip(&chosen).map(|(m, s)| format!("{} {}", m.as_str().to_uppercase(), s.name())).collect::<Vec<_>>().join(", "));
+    }
+    if let Some(plain) = plain {
+        let dqb = table3(Method::Dqb);
+        println!("\nstraightforward SoA AVX-512 DQB kernel (gathers, no tuning), positions and normals: {plain:.1} µs; the engine's {dqb:.1} µs is {:.2}× it", dqb / plain);
+    }
+    println!(
+        "\nroofline, one core, measured here: L2 read {:.0} GB/s, write {:.0} GB/s, peak {:.0} Gflop/s ({}-bit fused multiply-adds); {} kernel",
+        machine.l2_read_bytes_per_s / 1e9,
+        machine.l2_write_bytes_per_s / 1e9,
+        machine.peak_flops / 1e9,
+        machine.vector_bits,
+        best.name()
+    );
+    println!("{:<6} {:<16} {:>9} {:>12} {:>9} {:>9} {:>8}", "method", "outputs", "KB/frame", "kflop/frame", "bound µs", "median", "× bound");
+    for r in &roofline {
+        let outputs = if r["normals"] == true { "positions+normals" } else { "positions" };
+        println!(
+            "{:<6} {outputs:<16} {:>9.0} {:>12.0} {:>9.2} {:>9.1} {:>8.2}",
+            r["method"].as_str().unwrap_or_default().to_uppercase(),
+            (stat(r, "bytes_read") + stat(r, "bytes_written")) / 1e3,
+            stat(r, "flops") / 1e3,
+            stat(r, "bound_us"),
+            stat(r, "us_per_frame"),
+            stat(r, "over_bound")
+        );
+    }
+    let over_bound = stat(&roofline[Method::Dqb.index() * 2], "over_bound");
+    let met = |ok: bool| if ok { "met" } else { "not met" };
+    print!("\ntargets (issue 33): DQB with normals {over_bound:.2}× the roofline (≤ 2: {})", met(over_bound <= 2.0));
+    if let Some(plain) = plain {
+        let r = table3(Method::Dqb) / plain;
+        print!(", {r:.2}× the straightforward kernel (≤ 0.75: {})", met(r <= 0.75));
+    }
+    println!(", LB/DQB {:.2} (≤ 1: {})", table3(Method::Lb) / table3(Method::Dqb), met(table3(Method::Lb) <= table3(Method::Dqb)));
     println!("\nthreads: DQB, {} kernel ({cores} cores here)", best.name());
     println!("{:<8} {:>18} {:>8} {:>18} {:>8}", "threads", "positions+normals", "speed-up", "positions only", "speed-up");
     for t in std::iter::once(1).chain(threads.iter().copied()) {

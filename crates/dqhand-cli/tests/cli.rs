@@ -228,6 +228,21 @@ fn bench_json_reports_every_method() {
     }
     positive_number(&report, "/ratios/dqb_over_lb");
     positive_number(&report, "/ratios/dqb_over_qb");
+    // Issue 33: the lookup strategy each method's deformer chose, and the roofline.
+    for method in ["lb", "qb", "dqb"] {
+        let chosen = report["chosen_strategy"][method].as_str().unwrap_or_else(|| panic!("no chosen strategy for {method} in {report}"));
+        assert!(dqhand::skin::Strategy::named(chosen).is_some(), "{method}: {chosen:?} is not a strategy");
+    }
+    for key in ["l2_read_bytes_per_s", "l2_write_bytes_per_s", "peak_flops"] {
+        positive_number(&report, &format!("/machine/{key}"));
+    }
+    let rows = report["roofline"].as_array().expect("roofline rows");
+    assert_eq!(rows.len(), 6, "a row per method, with and without normals");
+    for i in 0..rows.len() {
+        for key in ["bytes_read", "bytes_written", "flops", "bound_us", "over_bound"] {
+            positive_number(&report, &format!("/roofline/{i}/{key}"));
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -10,7 +10,7 @@ use dqhand::math::DualQuat;
 use std::sync::Arc;
 use std::time::Duration;
 
-use dqhand::skin::{Crew, Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, MIN_VERTICES_PER_THREAD};
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, Strategy, MIN_VERTICES_PER_THREAD};
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 use proptest::prelude::*;
 use support::{rotation, vec3};
@@ -242,6 +242,13 @@ fn kernels_threads_and_batches_agree_on_the_hand() {
             let single = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &pinch);
             for (a, b) in single.positions().iter().zip(portable.positions()).chain(single.normals().iter().zip(portable.normals())) {
                 assert_close!(*a, *b, 1e-5, "{method} on {kernel:?} against portable; {kernels}");
+            }
+            // Every lookup strategy of the AVX-512 kernel, forced, against the portable kernel.
+            for strategy in if kernel == Kernel::Avx512 { &Strategy::ALL[..] } else { &[] } {
+                let forced = deform_with(Deformer::new(method, mesh).with_kernel(kernel).with_strategy(*strategy), mesh, &pinch);
+                for (a, b) in forced.positions().iter().zip(portable.positions()).chain(forced.normals().iter().zip(portable.normals())) {
+                    assert_close!(*a, *b, 1e-5, "{method} on {kernel:?} ({}) against portable; {kernels}", strategy.name());
+                }
             }
             let fisted = deform_with(Deformer::new(method, mesh).with_kernel(kernel), mesh, &fist);
             for crew in &crews {

@@ -10,7 +10,7 @@
 
 mod support;
 
-use dqhand::skin::{Deformed, Deformer, MeshData, Method, SkinnedMesh};
+use dqhand::skin::{Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, Strategy as LookupStrategy};
 use glam::{Affine3A, DMat3, DQuat, DVec3, Quat, Vec3};
 use proptest::prelude::*;
 
@@ -203,27 +203,34 @@ fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> 
     }
 }
 
-/// Every method on every kernel this CPU runs, positions and normals, then positions only
-/// (which kernels ran is said, and required with `DQHAND_REQUIRE_KERNELS`: `support::kernels`).
+/// Every method on every kernel this CPU runs, and on the AVX-512 kernel every lookup
+/// strategy, positions and normals, then positions only (which kernels ran is said, and
+/// required with `DQHAND_REQUIRE_KERNELS`: `support::kernels`).
 fn check(c: &Case, stride: usize) -> Result<(), TestCaseError> {
     let mesh = mesh(c, stride);
     let kernels = support::kernels::kernels();
-    for &kernel in &kernels.run {
+    let paths = kernels.run.iter().flat_map(|&k| if k == Kernel::Avx512 { LookupStrategy::ALL.map(Some).to_vec() } else { vec![None] }.into_iter().map(move |s| (k, s)));
+    for (kernel, strategy) in paths {
         for method in Method::ALL {
-            let mut deformer = Deformer::new(method, &mesh).with_kernel(kernel);
+            let deformer = Deformer::new(method, &mesh).with_kernel(kernel);
+            let mut deformer = match strategy {
+                Some(s) => deformer.with_strategy(s),
+                None => deformer,
+            };
+            let kernel = format!("{kernel:?}{}", strategy.map_or(String::new(), |s| format!(" ({})", s.name())));
             let (mut out, mut only) = (Deformed::new(&mesh), Deformed::positions_only(&mesh));
             deformer.deform(&mesh, &c.skinning, &mut out);
             deformer.deform(&mesh, &c.skinning, &mut only);
-            prop_assert!(only.normals().is_empty(), "{method} on {kernel:?}: normals when only positions are asked for; {kernels}");
+            prop_assert!(only.normals().is_empty(), "{method} on {kernel}: normals when only positions are asked for; {kernels}");
             for v in 0..c.positions.len() {
                 let Some((p, n, condition)) = reference(c, v, method) else { continue };
                 let (gp, gn) = (Vec3::from(out.positions()[v]).as_dvec3(), Vec3::from(out.normals()[v]).as_dvec3());
-                prop_assert!(gp.distance(p) < 2e-4, "{method} on {kernel:?}, vertex {v}: position {gp} but the reference gives {p}; {kernels}");
+                prop_assert!(gp.distance(p) < 2e-4, "{method} on {kernel}, vertex {v}: position {gp} but the reference gives {p}; {kernels}");
                 // Rounding of f32 (~1e-7) grows with the condition number (3 for a rotation).
                 let normal_tolerance = 2e-4_f64.max(1e-6 * condition);
-                prop_assert!(gn.distance(n) < normal_tolerance, "{method} on {kernel:?}, vertex {v}: normal {gn} but the reference gives {n} (condition {condition:.0}); {kernels}");
+                prop_assert!(gn.distance(n) < normal_tolerance, "{method} on {kernel}, vertex {v}: normal {gn} but the reference gives {n} (condition {condition:.0}); {kernels}");
                 let op = Vec3::from(only.positions()[v]).as_dvec3();
-                prop_assert!(op.distance(p) < 2e-4, "{method} on {kernel:?}, positions only, vertex {v}: {op} but the reference gives {p}; {kernels}");
+                prop_assert!(op.distance(p) < 2e-4, "{method} on {kernel}, positions only, vertex {v}: {op} but the reference gives {p}; {kernels}");
             }
         }
     }

@@ -98,7 +98,8 @@ def main(argv=None):
             report = json.loads(subprocess.run([args.dqhand, "bench", "--frames", "300", "--json"], check=True, capture_output=True, text=True).stdout)
             threads = {}
             for variant in report["variants"]:
-                if variant["method"] == "dqb" and not variant["normals"] and variant["kernel"] == report["kernel"]:
+                # The run-time choice's rows (no forced lookup strategy).
+                if variant["method"] == "dqb" and not variant["normals"] and variant["kernel"] == report["kernel"] and variant.get("strategy") is None:
                     threads[variant["threads"]] = variant
             for variant in threads.values():
                 what = f"dqhand bench: DQB kernel alone, {report['kernel']}, {variant['threads']} thread(s) on one frame"

@@ -8,8 +8,10 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::crew::Crew;
+use super::fastest_strategy::fastest_strategy;
 use super::kernel::{self, Frame, FrameTable, Kernel};
 use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
+use super::strategy::Strategy;
 use super::Method;
 use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
 use crate::kinematics::KinematicsLayer;
@@ -100,8 +102,8 @@ pub enum VertexBuffers<'a> {
 pub const MIN_VERTICES_PER_THREAD: usize = 2048;
 
 /// A skinning method with its per-frame scratch: bone parameters, the sign table and the
-/// AVX-512 loop's lookup table of both; the kernel it runs and, optionally, a crew of threads
-/// it splits each deformation across.
+/// AVX-512 loop's lookup table of both; the kernel it runs, that kernel's lookup
+/// [`Strategy`] and, optionally, a crew of threads it splits each deformation across.
 ///
 /// ```
 /// use dqhand::glam::{Affine3A, Quat, Vec3};
@@ -132,14 +134,27 @@ pub struct Deformer {
     lb_table: FrameTable<{ lb::W }>,
     quat_table: FrameTable<{ dqb::W }>,
     kernel: Kernel,
+    strategy: Strategy,
     crew: Option<Arc<Crew>>,
 }
 
 impl Deformer {
     /// A deformer for `mesh` (and meshes with the same joints and influence pairs) on the
     /// fastest kernel this CPU runs, on the calling thread; all buffers are allocated here.
+    ///
+    /// On the AVX-512 kernel the lookup strategy is the one named by [`Strategy::ENV`] if
+    /// that is set to a strategy's name (other values are ignored), else the fastest on this
+    /// mesh: the first deformer of a method and mesh shape in the process times each
+    /// strategy for a few frames (about a millisecond for the built-in hand), later ones
+    /// reuse its choice.
     #[must_use]
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
+        let forced = std::env::var(Strategy::ENV).ok().and_then(|name| Strategy::named(&name));
+        let strategy = forced.unwrap_or_else(|| if Kernel::best() == Kernel::Avx512 { fastest_strategy(method, mesh) } else { Strategy::Permute });
+        Self::with_parts(method, mesh, strategy)
+    }
+
+    fn with_parts(method: Method, mesh: &SkinnedMesh, strategy: Strategy) -> Self {
         let joints = mesh.inverse_bind().len();
         let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
         Self {
@@ -147,9 +162,10 @@ impl Deformer {
             lb: vec![[0.0; lb::W]; lbn],
             quat: vec![[0.0; dqb::W]; qn],
             signs: vec![1.0; sn],
-            lb_table: if lbn > 0 { FrameTable::new(lbn) } else { FrameTable::default() },
-            quat_table: if qn > 0 { FrameTable::new(qn) } else { FrameTable::default() },
+            lb_table: FrameTable::new(lbn, strategy),
+            quat_table: FrameTable::new(qn, strategy),
             kernel: Kernel::best(),
+            strategy,
             crew: None,
         }
     }
@@ -159,6 +175,15 @@ impl Deformer {
     #[must_use]
     pub fn with_kernel(self, kernel: Kernel) -> Self {
         Self { kernel, ..self }
+    }
+
+    /// The same deformer with the AVX-512 kernel's lookup `strategy` instead of the one
+    /// chosen at construction (one that does not serve the skin, [`Strategy::Permute`] past
+    /// 32 joints, gathers; results agree to rounding).
+    #[must_use]
+    pub fn with_strategy(self, strategy: Strategy) -> Self {
+        let (lbn, qn) = (self.lb.len(), self.quat.len());
+        Self { strategy, lb_table: FrameTable::new(lbn, strategy), quat_table: FrameTable::new(qn, strategy), ..self }
     }
 
     /// The same deformer splitting each deformation across `crew`'s threads (started once:
@@ -179,6 +204,12 @@ impl Deformer {
     #[must_use]
     pub fn kernel(&self) -> Kernel {
         self.kernel.or_best()
+    }
+
+    /// The AVX-512 kernel's lookup strategy (unused by the other kernels).
+    #[must_use]
+    pub fn strategy(&self) -> Strategy {
+        if self.strategy.serves(self.lb.len().max(self.quat.len())) { self.strategy } else { Strategy::Gather }
     }
 
     /// Deforms `mesh` by the bones' transforms into `out` (positions and normals, or
@@ -339,11 +370,11 @@ impl Deformer {
 
     /// The vertex loop over the chunks from `first` that `positions` holds.
     fn run(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
-        let kernel = self.kernel;
+        let (kernel, strategy) = (self.kernel, self.strategy);
         match self.method {
-            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], table: &self.lb_table, kernel }, first, positions, normals),
-            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel }, first, positions, normals),
-            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel }, first, positions, normals),
+            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], table: &self.lb_table, kernel, strategy }, first, positions, normals),
+            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel, strategy }, first, positions, normals),
         }
     }
 

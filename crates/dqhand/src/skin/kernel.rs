@@ -9,7 +9,8 @@
 //! The same code is compiled for three instruction sets and one is chosen at run time
 //! ([`Kernel`]): portable; AVX2 + FMA, chunks of 8 vertices; AVX-512, blocks of 16 vertices
 //! (two of the mesh's 8-vertex chunks) blended one vertex per lane from the start, with no
-//! transpose (module `avx512`), and finished 16 lanes per register. In WebAssembly the
+//! transpose, the bones' parameters found by the deformer's [`Strategy`] (module `avx512`),
+//! and finished 16 lanes per register. In WebAssembly the
 //! fourth, simd128, is compiled in or not (a module cannot detect features at run time: the
 //! page loads the build its engine validates), and blends in 128-bit blocks (module
 //! `simd128`).
@@ -17,6 +18,7 @@
 #[cfg(target_arch = "x86_64")]
 use super::skinned_mesh::BLOCK;
 use super::skinned_mesh::{SkinnedMesh, LANES};
+use super::strategy::Strategy;
 
 /// Which compiled vertex loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -87,8 +89,9 @@ impl Kernel {
 const PORTABLE: u8 = 0;
 #[cfg(target_arch = "x86_64")]
 const AVX2: u8 = 1;
-#[cfg(target_arch = "x86_64")]
-const AVX512: u8 = 2;
+/// The AVX-512 set (named off x86-64 too, where no loop is compiled for it, so that the
+/// finishes can test for it).
+pub(crate) const AVX512: u8 = 2;
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 const SIMD128: u8 = 3;
 
@@ -141,12 +144,16 @@ pub(crate) struct Frame<'a, const W: usize> {
     pub table: &'a FrameTable<W>,
     /// The loop to run (one this CPU does not run falls back to the best it does).
     pub kernel: Kernel,
+    /// How the AVX-512 loop looks parameters up (permute falls back to gather where `table`
+    /// is empty).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    pub strategy: Strategy,
 }
 
 /// The AVX-512 loop's lookup table of a frame's parameters and pair signs (module `avx512`),
 /// kept by the deformer and updated once per frame that runs that loop, not once per piece
-/// of a split frame. Empty where the CPU has no AVX-512 or the skin has more joints than it
-/// holds: that loop then gathers.
+/// of a split frame. Empty unless the CPU has AVX-512 and the strategy is
+/// [`Strategy::Permute`] for a skin it holds: that loop then uses another strategy.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct FrameTable<const W: usize> {
     #[cfg(target_arch = "x86_64")]
@@ -154,15 +161,16 @@ pub(crate) struct FrameTable<const W: usize> {
 }
 
 impl<const W: usize> FrameTable<W> {
-    /// A table for a skin of `joints` joints (empty if it would not be used).
-    pub(crate) fn new(joints: usize) -> Self {
+    /// A table for a skin of `joints` joints looked up by `strategy` (empty if it would not
+    /// be used: none for the parameters a method does not use).
+    pub(crate) fn new(joints: usize, strategy: Strategy) -> Self {
         #[cfg(target_arch = "x86_64")]
         {
-            Self { table: (joints <= avx512::TABLE_JOINTS && Kernel::Avx512.available()).then(Box::default) }
+            Self { table: (joints > 0 && strategy == Strategy::Permute && strategy.serves(joints) && Kernel::Avx512.available()).then(Box::default) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = joints;
+            let _ = (joints, strategy);
             Self {}
         }
     }
@@ -246,9 +254,10 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
     if ISA == AVX512 {
         // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature detection.
         c = unsafe {
-            match frame.table.table.as_deref() {
-                Some(table) => blocks::<W, K, B, NORMALS>(table, mesh, first, positions, normals),
-                None => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, first, positions, normals),
+            match (frame.strategy, frame.table.table.as_deref()) {
+                (Strategy::Permute, Some(table)) => blocks::<W, K, B, NORMALS>(table, mesh, first, positions, normals),
+                (Strategy::Broadcast, _) => blocks::<W, K, B, NORMALS>(&avx512::Runs { params: frame.params, signs: frame.signs }, mesh, first, positions, normals),
+                _ => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, first, positions, normals),
             }
         };
     }
@@ -268,7 +277,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: bool>(
-    lookup: &impl avx512::Lookup<W>,
+    blender: &impl avx512::Blender<W>,
     mesh: &SkinnedMesh,
     first: usize,
     positions: &mut [[f32; 3]],
@@ -284,7 +293,7 @@ unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: boo
         let chunk = first + c;
         let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
         // SAFETY: joint indices are below the parameter rows (asserted in `chunks`).
-        avx512::blend::<W, K, B>(lookup, mesh, chunk / 2, usize::from(kc), &mut b.0);
+        blender.blend::<K, B>(mesh, chunk / 2, usize::from(kc), &mut b.0);
         run::<W, B, BLOCK, NORMALS, AVX512>(mesh, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 2;
     }
@@ -432,10 +441,22 @@ pub(crate) fn recip(sq: f32) -> f32 {
     1.0 / sq.max(1e-30)
 }
 
-/// `1 / sqrt(x)` with a floor that keeps degenerate inputs finite.
+/// `1 / sqrt(x)` per lane, with a floor that keeps degenerate inputs finite. On the AVX-512
+/// kernel an approximate one refined by one Newton step (relative error near the rounding
+/// of the exact one): a 512-bit square root and division take ~20 cycles of the one divider
+/// on Intel cores per 16 vertices, which made LB's normals cost more than DQB's.
 #[inline(always)]
-pub(crate) fn inv_len(sq: f32) -> f32 {
-    1.0 / sq.max(1e-30).sqrt()
+pub(crate) fn inv_len<const L: usize, const ISA: u8>(sq: [f32; L]) -> [f32; L] {
+    #[cfg(target_arch = "x86_64")]
+    if ISA == AVX512 && L == BLOCK {
+        // SAFETY: `ISA` is AVX512 only inside `deform_avx512`; `sq` holds 16 floats.
+        return unsafe { avx512::inv_len(sq) };
+    }
+    let mut r = sq;
+    for x in &mut r {
+        *x = 1.0 / x.max(1e-30).sqrt();
+    }
+    r
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -578,18 +599,26 @@ mod simd128 {
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     //! The blend step with AVX-512, one vertex per lane from the start: per influence slot
-    //! the block's 16 joint indices and weights come in one load each, each parameter
-    //! component of the 16 joints is looked up at once — from two registers by a two-source
-    //! permute when the skin has at most 32 joints (a hand has 16 to 26), else by a gather —
-    //! and one fused multiply-add per component blends it. The sum is already one register
-    //! per component, as the finish wants it: no transpose.
+    //! the block's 16 weights come in one load, and each parameter component of the 16 lanes'
+    //! joints is found by the frame's [`Strategy`](super::Strategy) — a two-source permute
+    //! from two registers ([`Table`]), a gather ([`Gather`]), or one broadcast per run of
+    //! lanes that share a joint ([`Runs`]) — and blended by fused multiply-adds. The sum is
+    //! already one register per component, as the finish wants it: no transpose.
 
     use core::arch::x86_64::*;
 
-    use super::{Blend, SkinnedMesh, BLOCK};
+    use super::{Blend, SkinnedMesh, Strategy, BLOCK};
 
     /// Joints a [`Table`] holds: the 32 lanes of a two-source permute.
-    pub(super) const TABLE_JOINTS: usize = 32;
+    const TABLE_JOINTS: usize = Strategy::PERMUTE_JOINTS;
+
+    /// A way to blend a block: `b[c][lane] = Σₖ wₖ sₖ params[jₖ][c]` as the portable
+    /// `blend`, for the 16 vertices of block `block` over its first `kc` slots.
+    pub(super) trait Blender<const W: usize> {
+        /// Inlined into `deform_avx512`, whose features it uses. Joint indices must be below
+        /// the parameter rows and sign indices below the signs.
+        unsafe fn blend<const K: usize, B: Blend<W>>(&self, mesh: &SkinnedMesh, block: usize, kc: usize, b: &mut [[f32; BLOCK]; W]);
+    }
 
     /// How the blend finds a component of the 16 lanes' joints' parameters.
     pub(super) trait Lookup<const W: usize> {
@@ -692,17 +721,16 @@ mod avx512 {
         }
     }
 
-    /// As the portable `blend`, for the 16 vertices of block `block`, each influence signed
-    /// to its heaviest one's hemisphere by [`Lookup::opposite`]. Inlined into
-    /// `deform_avx512`, whose features it uses.
+    /// Each influence signed to its heaviest one's hemisphere by [`Lookup::opposite`].
+    impl<const W: usize, L: Lookup<W>> Blender<W> for L {
+        #[inline(always)]
+        unsafe fn blend<const K: usize, B: Blend<W>>(&self, mesh: &SkinnedMesh, block: usize, kc: usize, b: &mut [[f32; BLOCK]; W]) {
+            blend_lookup::<W, K, B>(self, mesh, block, kc, b);
+        }
+    }
+
     #[inline(always)]
-    pub(super) unsafe fn blend<const W: usize, const K: usize, B: Blend<W>>(
-        lookup: &impl Lookup<W>,
-        mesh: &SkinnedMesh,
-        block: usize,
-        kc: usize,
-        b: &mut [[f32; BLOCK]; W],
-    ) {
+    unsafe fn blend_lookup<const W: usize, const K: usize, B: Blend<W>>(lookup: &impl Lookup<W>, mesh: &SkinnedMesh, block: usize, kc: usize, b: &mut [[f32; BLOCK]; W]) {
         let slot = |k: usize| (block * K + k) * BLOCK;
         let zero = _mm512_setzero_ps();
         let mut acc = [zero; W];
@@ -734,6 +762,53 @@ mod avx512 {
         for c in 0..B::USED {
             _mm512_storeu_ps(b[c].as_mut_ptr(), acc[c]);
         }
+    }
+
+    /// The frame's parameter rows and pair signs, blended run by run (`SkinnedMesh::block_runs`):
+    /// per run, the sign once and one broadcast and masked fused multiply-add per component.
+    /// No permute: the broadcasts are loads, and a slot whose lanes share few joints (as
+    /// neighbouring vertices do) costs few of them.
+    pub(super) struct Runs<'a, const W: usize> {
+        pub params: &'a [[f32; W]],
+        pub signs: &'a [f32],
+    }
+
+    impl<const W: usize> Blender<W> for Runs<'_, W> {
+        #[inline(always)]
+        unsafe fn blend<const K: usize, B: Blend<W>>(&self, mesh: &SkinnedMesh, block: usize, kc: usize, b: &mut [[f32; BLOCK]; W]) {
+            let mut acc = [_mm512_setzero_ps(); W];
+            for k in 0..kc.min(K) {
+                let s = block * K + k;
+                let w = _mm512_loadu_ps(mesh.block_weights.as_ptr().add(s * BLOCK));
+                let (start, end) = (*mesh.block_run_start.get_unchecked(s) as usize, *mesh.block_run_start.get_unchecked(s + 1) as usize);
+                for run in mesh.block_runs.get_unchecked(start..end) {
+                    let p = self.params.get_unchecked(usize::from(run.joint)).as_ptr();
+                    // Sign 0 is the heaviest joint's own (+1).
+                    let sw = if B::SIGNED == 0 || run.sign == 0 { w } else { _mm512_mul_ps(w, _mm512_set1_ps(*self.signs.get_unchecked(run.sign as usize))) };
+                    for (c, a) in acc.iter_mut().enumerate().take(B::USED) {
+                        *a = _mm512_mask3_fmadd_ps(if c < B::SIGNED { sw } else { w }, _mm512_set1_ps(*p.add(c)), *a, run.lanes);
+                    }
+                }
+            }
+            for c in 0..B::USED {
+                _mm512_storeu_ps(b[c].as_mut_ptr(), acc[c]);
+            }
+        }
+    }
+
+    /// `1 / sqrt(max(x, 1e-30))` of 16 lanes: `rsqrt14` (relative error 2⁻¹⁴) and one
+    /// Newton step `y (1.5 − ½ x y²)`. Inlined into `deform_avx512`, whose features it uses
+    /// (no function pointer: called through one, it would be compiled without them and pay
+    /// the AVX-to-SSE transition on Intel cores).
+    #[inline(always)]
+    pub(super) unsafe fn inv_len<const L: usize>(x: [f32; L]) -> [f32; L] {
+        debug_assert_eq!(L, 16, "16 lanes");
+        let x = _mm512_max_ps(_mm512_loadu_ps(x.as_ptr()), _mm512_set1_ps(1e-30));
+        let y = _mm512_rsqrt14_ps(x);
+        let half_xy = _mm512_mul_ps(_mm512_mul_ps(x, _mm512_set1_ps(0.5)), y);
+        let mut out = [0.0; L];
+        _mm512_storeu_ps(out.as_mut_ptr(), _mm512_mul_ps(y, _mm512_fnmadd_ps(half_xy, y, _mm512_set1_ps(1.5))));
+        out
     }
 
     /// The permutes that interleave 16 lanes of x, y and z into 48 floats `x₀ y₀ z₀ x₁ …`:

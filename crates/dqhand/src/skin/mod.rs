@@ -4,6 +4,7 @@
 mod crew;
 mod deformer;
 mod dual_quaternion_blend;
+mod fastest_strategy;
 mod kernel;
 mod linear_blend;
 mod method;
@@ -11,6 +12,7 @@ mod method_set;
 mod quaternion_blend;
 mod skin_layer;
 mod skinned_mesh;
+mod strategy;
 
 pub use crew::Crew;
 pub use deformer::{Bones, Deformed, Deformer, VertexBuffers, MIN_VERTICES_PER_THREAD};
@@ -19,3 +21,4 @@ pub use method::Method;
 pub use method_set::MethodSet;
 pub use skin_layer::SkinLayer;
 pub use skinned_mesh::{MeshData, Part, SkinnedMesh, LANES, MAX_INFLUENCES};
+pub use strategy::Strategy;

@@ -85,6 +85,39 @@ impl MeshData {
     }
 }
 
+/// The lanes of one block's slot that share a joint and a pair sign (an index of
+/// `SkinnedMesh::slot_pairs`): bit `l` of `lanes` is vertex `l` of the block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Run {
+    pub joint: u16,
+    pub lanes: u16,
+    pub sign: u32,
+}
+
+/// The runs of `blocks` full blocks of `k` slots, from the packed influences, and where each
+/// slot's runs start (one more entry than slots).
+fn runs(blocks: usize, k: usize, joints: &[u16], weights: &[f32], slot_pairs: &[u32]) -> (Vec<Run>, Vec<u32>) {
+    let (mut runs, mut start) = (Vec::new(), vec![0u32]);
+    for block in 0..blocks {
+        for s in 0..k {
+            let first = runs.len();
+            for l in 0..BLOCK {
+                let i = (block * BLOCK + l) * k + s;
+                if weights[i] == 0.0 {
+                    continue;
+                }
+                let (joint, sign) = (joints[i], slot_pairs[i]);
+                match runs[first..].iter_mut().find(|r: &&mut Run| r.joint == joint && r.sign == sign) {
+                    Some(r) => r.lanes |= 1 << l,
+                    None => runs.push(Run { joint, lanes: 1 << l, sign }),
+                }
+            }
+            start.push(runs.len() as u32);
+        }
+    }
+    (runs, start)
+}
+
 /// A validated skinned mesh in structure-of-arrays layout.
 ///
 /// Positions and normals are stored as separate `x`, `y`, `z` arrays padded to a multiple
@@ -113,6 +146,12 @@ pub struct SkinnedMesh {
     /// needs no transpose).
     pub(crate) block_joints: Vec<u16>,
     pub(crate) block_weights: Vec<f32>,
+    /// Per block and slot, the lanes that share a joint and a pair sign, lanes of zero
+    /// weight left out: `block_runs[block_run_start[s]..block_run_start[s + 1]]` for slot
+    /// `s = block * k + slot` (the broadcast strategy of the AVX-512 blend, which blends each
+    /// run with one broadcast of each parameter).
+    pub(crate) block_runs: Vec<Run>,
+    pub(crate) block_run_start: Vec<u32>,
     max_influences: usize,
     uvs: Vec<[f32; 2]>,
     indices: Vec<u32>,
@@ -251,6 +290,7 @@ impl SkinnedMesh {
                 (block_joints[at], block_weights[at]) = (joints[v * k + s], weights[v * k + s]);
             }
         }
+        let (block_runs, block_run_start) = runs(blocks, k, &joints, &weights, &slot_pairs);
         let chunk_influences = slots
             .chunks(LANES)
             .map(|c| c.iter().map(Vec::len).max().unwrap_or(1) as u8)
@@ -299,6 +339,8 @@ impl SkinnedMesh {
             chunk_influences,
             block_joints,
             block_weights,
+            block_runs,
+            block_run_start,
             max_influences,
             uvs: data.uvs,
             indices: data.indices,
