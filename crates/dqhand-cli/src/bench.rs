@@ -213,7 +213,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "methods": Method::ALL.iter().map(|&m| (m.as_str().to_owned(), json!({ "us_per_frame": table3(m), "fps": 1e6 / table3(m) }))).collect::<serde_json::Map<_, _>>(),
         "ratios": { "dqb_over_lb": table3(Method::Dqb) / table3(Method::Lb), "dqb_over_qb": table3(Method::Dqb) / table3(Method::Qb) },
         "strategies": strategies.iter().map(|s| s.name()).collect::<Vec<_>>(),
-        "chosen_strategy": Method::ALL.iter().zip(&chosen).map(|(m, s)| (m.as_str().to_owned(), json!(s.name()))).collect::<serde_json::Map<_, _>>(),
+        "chosen_strategy": Method::ALL.iter().zip(&chosen).map(|(m, s)| (m.as_str().to_owned(), json!(s.map(Strategy::name)))).collect::<serde_json::Map<_, _>>(),
         "strategy_forced": forced,
         "plain_soa_dqb_us": plain,
         "machine": { "l2_read_bytes_per_s": machine.l2_read_bytes_per_s, "l2_write_bytes_per_s": machine.l2_write_bytes_per_s, "peak_flops": machine.peak_flops, "vector_bits": machine.vector_bits },
@@ -254,7 +254,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             println!("{:<9} {} | {}", s.name(), cell(true), cell(false));
         }
         let how = forced.as_ref().map_or_else(|| "measured when each deformer was built".to_owned(), |name| format!("forced by {}={name}", Strategy::ENV));
-        println!("run-time choice ({how}): {}", Method::ALL.iter().zip(&chosen).map(|(m, s)| format!("{} {}", m.as_str().to_uppercase(), s.name())).collect::<Vec<_>>().join(", "));
+        println!("run-time choice ({how}): {}", Method::ALL.iter().zip(&chosen).map(|(m, s)| format!("{} {}", m.as_str().to_uppercase(), s.map_or("none", Strategy::name))).collect::<Vec<_>>().join(", "));
     }
     if let Some(plain) = plain {
         let dqb = table3(Method::Dqb);

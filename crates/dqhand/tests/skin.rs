@@ -272,6 +272,47 @@ fn kernels_threads_and_batches_agree_on_the_hand() {
     }
 }
 
+/// The AVX-512 kernel's lookup strategies give the same bits, not only the same values to
+/// rounding: the run-time choice is a matter of speed and must not change what is drawn, even
+/// where a pair's sign alignment sits on a knife's edge (each phalanx turned a half-turn from
+/// its parent, about axes in 24 directions: their rotations' dot product is 0 up to rounding;
+/// the gather strategy's sign once summed it fused, and differed from the others here).
+#[test]
+fn every_lookup_strategy_gives_the_same_bits() {
+    let (model, pinch) = posed_hand("pinch");
+    let mesh = &model.mesh;
+    let joints = model.skeleton.joints();
+    // Half-turns about axes in many directions (which of a product's roundings the sum meets
+    // first depends on the components' order and signs).
+    let half_turned: Vec<Vec<Affine3A>> = (0..24)
+        .map(|k| {
+            let (theta, phi) = (k as f32 * 0.61, k as f32 * 1.37);
+            let axis = glam::Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()).normalize();
+            let mut pose = pinch.clone();
+            for (j, joint) in joints.iter().enumerate().filter(|(_, j)| j.name.contains("phalanx")) {
+                let parent = joint.parent.expect("a phalanx has a parent");
+                pose[j] = pinch[parent] * Affine3A::from_axis_angle(axis, std::f32::consts::PI);
+            }
+            pose
+        })
+        .collect();
+    let kernels = support::kernels::kernels();
+    if !kernels.run.contains(&Kernel::Avx512) {
+        // (`DQHAND_REQUIRE_KERNELS` makes the kernels' test fail where AVX-512 is required.)
+        eprintln!("no AVX-512 kernel on this CPU: the strategies are not compared; {kernels}");
+        return;
+    }
+    for method in Method::ALL {
+        for pose in core::iter::once(&pinch).chain(&half_turned) {
+            let outs: Vec<Deformed> = Strategy::ALL.iter().map(|&s| deform_with(Deformer::new(method, mesh).with_kernel(Kernel::Avx512).with_strategy(s), mesh, pose)).collect();
+            for (s, out) in Strategy::ALL.iter().zip(&outs).skip(1) {
+                let same = out.positions().iter().chain(out.normals()).zip(outs[0].positions().iter().chain(outs[0].normals())).all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+                assert!(same, "{method}: {} and {} differ", s.name(), Strategy::ALL[0].name());
+            }
+        }
+    }
+}
+
 fn deform_with(mut deformer: Deformer, mesh: &SkinnedMesh, skinning: &[Affine3A]) -> Deformed {
     let mut out = Deformed::new(mesh);
     deformer.deform(mesh, skinning, &mut out);

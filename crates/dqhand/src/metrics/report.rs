@@ -109,9 +109,10 @@ pub struct Report {
     pub rest_intersections: usize,
     /// Intersecting triangle pairs per gesture, per method (in [`Method::ALL`] order).
     pub intersections: Vec<(&'static str, [usize; 3])>,
-    /// Skin inside skin between the fingers and the palm at rest.
-    pub rest_self_contact: SelfContact,
-    /// The same in every gesture of the library, per method.
+    /// Skin inside skin between the fingers and the palm at rest (`None` for a mesh that is not
+    /// closed, whose winding numbers mean nothing).
+    pub rest_self_contact: Option<SelfContact>,
+    /// The same in every gesture of the library, per method (none for a mesh not closed).
     pub self_contact: Vec<(&'static str, [SelfContact; 3])>,
 }
 
@@ -187,7 +188,7 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
                     distortion_mean,
                     distortion_max,
                     jump,
-                    self_contact: spec.contact.then(|| self_contact(posed, mesh.indices(), &parts)),
+                    self_contact: (spec.contact && closed.is_ok()).then(|| self_contact(posed, mesh.indices(), &parts)),
                 });
                 previous[m.index()] = Some(posed.to_vec());
             }
@@ -203,10 +204,12 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         if INTERSECTION_GESTURES.contains(&g.name) {
             intersections.push((g.name, Method::ALL.map(|m| count_self_intersections(posed(m), mesh.indices()))));
         }
-        contact.push((g.name, Method::ALL.map(|m| self_contact(posed(m), mesh.indices(), &parts))));
+        if closed.is_ok() {
+            contact.push((g.name, Method::ALL.map(|m| self_contact(posed(m), mesh.indices(), &parts))));
+        }
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
-    let rest_self_contact = self_contact(&rest_positions, mesh.indices(), &parts);
+    let rest_self_contact = closed.is_ok().then(|| self_contact(&rest_positions, mesh.indices(), &parts));
     Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections, rest_self_contact, self_contact: contact })
 }
 
@@ -282,7 +285,7 @@ impl Report {
                 "gestures": self.intersections.iter().map(|(g, c)| json!({ "gesture": g, "lb": c[0], "qb": c[1], "dqb": c[2] })).collect::<Vec<_>>(),
             },
             "self_contact": {
-                "rest": contact_json(&self.rest_self_contact),
+                "rest": self.rest_self_contact.as_ref().map(contact_json),
                 "gestures": self.self_contact.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]) })).collect::<Vec<_>>(),
             },
             "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2] })).collect::<Vec<_>>(),
@@ -344,7 +347,7 @@ impl Report {
             (format!("intersecting triangle pairs, {g} (rest: {})", self.rest_intersections), c.map(|n| Some(n as f32)))
         }));
         for (g, c) in self.self_contact.iter().filter(|(g, _)| INTERSECTION_GESTURES.contains(g)) {
-            let rest = &self.rest_self_contact;
+            let rest = self.rest_self_contact.unwrap_or_default();
             rows.push((format!("skin inside skin between parts, {g}: deepest (mm; rest {:.2})", rest.depth_m * 1000.0), c.map(|x| Some(x.depth_m * 1000.0))));
             rows.push((format!("skin inside skin between parts, {g}: shared volume (mm³; rest {:.1})", rest.volume_m3 * 1e9), c.map(|x| Some((x.volume_m3 * 1e9) as f32))));
         }

@@ -11,8 +11,8 @@
 //! number 2 in the box around those vertices (grown by their depth and longest edge): exact
 //! along lines parallel to x (the intervals between sorted crossings where two layers enclose
 //! them), [`SPACING`] apart across (an overlap holding no vertex, smaller than a triangle, is not
-//! seen; a skin folded into its own part in that box is counted). Counting intersecting triangle pairs (`count_self_intersections`)
-//! says that the skin crosses itself, not how far.
+//! seen; a skin folded into its own part in that box is counted). Counting intersecting
+//! triangle pairs (`count_self_intersections`) says that the skin crosses itself, not how far.
 
 use glam::Vec3;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -28,7 +28,7 @@ const UNDER: f32 = 1e-5;
 /// Three ray directions, none along an axis or a simple diagonal: a ray through an edge or a
 /// vertex counts a crossing twice or not at all, so each point's winding number is the median
 /// of three.
-const RAYS: [Vec3; 3] = [Vec3::new(0.5773, 0.5774, 0.5775), Vec3::new(-0.3712, 0.8355, 0.4051), Vec3::new(0.6988, -0.2671, -0.6636)];
+const RAYS: [Vec3; 3] = [Vec3::new(0.3137, 0.8613, 0.3995), Vec3::new(-0.3712, 0.8355, 0.4051), Vec3::new(0.6988, -0.2671, -0.6636)];
 
 /// The self-contact of one posed skin.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -171,20 +171,18 @@ pub fn self_contact(positions: &[[f32; 3]], indices: &[u32], parts: &[u8]) -> Se
             edge[b] = edge[b].max(l);
         }
     }
-    // Per part, the triangles with none of its vertices.
-    let mut others: Vec<Vec<u32>> = Vec::new();
+    // Per part, the triangles with none of its vertices (made when first needed).
+    let mut others: Vec<Option<Vec<u32>>> = Vec::new();
     let mut inside = Vec::new();
     for (v, (p, n)) in positions.iter().zip(&normals).enumerate() {
         let p = Vec3::from(*p);
         if surface.winding(p - Vec3::from(*n) * UNDER) >= 2 {
             let own = usize::from(parts[v]);
             if others.len() <= own {
-                others.resize(own + 1, Vec::new());
+                others.resize(own + 1, None);
             }
-            if others[own].is_empty() {
-                others[own] = surface.triangles.iter().filter(|t| !t.iter().any(|&i| parts[i as usize] == parts[v])).flatten().copied().collect();
-            }
-            if winding_number(positions, &others[own], p) < 0.5 {
+            let others = others[own].get_or_insert_with(|| surface.triangles.iter().filter(|t| !t.iter().any(|&i| parts[i as usize] == parts[v])).flatten().copied().collect());
+            if winding_number(positions, others, p) < 0.5 {
                 continue;
             }
             let depth = surface.distance_to_others(p, parts, parts[v]);

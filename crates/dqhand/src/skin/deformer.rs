@@ -206,10 +206,11 @@ impl Deformer {
         self.kernel.or_best()
     }
 
-    /// The AVX-512 kernel's lookup strategy (unused by the other kernels).
+    /// The AVX-512 kernel's lookup strategy; `None` where another kernel runs (they have
+    /// none).
     #[must_use]
-    pub fn strategy(&self) -> Strategy {
-        if self.strategy.serves(self.lb.len().max(self.quat.len())) { self.strategy } else { Strategy::Gather }
+    pub fn strategy(&self) -> Option<Strategy> {
+        (self.kernel() == Kernel::Avx512).then(|| if self.strategy.serves(self.lb.len().max(self.quat.len())) { self.strategy } else { Strategy::Gather })
     }
 
     /// Deforms `mesh` by the bones' transforms into `out` (positions and normals, or

@@ -4,7 +4,7 @@
 //! (permutes on Zen 5, loads on Intel cores) and on how many joints a block's lanes share.
 
 use std::collections::HashMap;
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use glam::Affine3A;
@@ -25,11 +25,12 @@ const ROUNDS: usize = 8;
 /// The strategy that deformed `mesh` by `method` fastest here (positions and normals, the rest
 /// pose), measured by the first call for the method and mesh shape, remembered after.
 pub(crate) fn fastest_strategy(method: Method, mesh: &SkinnedMesh) -> Strategy {
-    static CHOSEN: OnceLock<Mutex<HashMap<Key, Strategy>>> = OnceLock::new();
+    static CHOSEN: OnceLock<Mutex<HashMap<Key, Arc<OnceLock<Strategy>>>>> = OnceLock::new();
     let key = (method, mesh.vertex_count(), mesh.inverse_bind().len(), mesh.k, mesh.pairs.len());
-    // Held while measuring: a second deformer of the same mesh waits for the first's choice.
-    let mut chosen = CHOSEN.get_or_init(Mutex::default).lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    *chosen.entry(key).or_insert_with(|| match method {
+    // The map is locked only to find the key's cell; a second deformer of the same mesh shape
+    // waits in the cell for the first's measurement, others of other shapes do not.
+    let cell = Arc::clone(CHOSEN.get_or_init(Mutex::default).lock().unwrap_or_else(std::sync::PoisonError::into_inner).entry(key).or_default());
+    *cell.get_or_init(|| match method {
         Method::Lb => measure::<{ lb::W }, lb::Lb>(mesh, lb::params),
         Method::Qb => measure::<{ qb::W }, qb::Qb>(mesh, qb::params),
         Method::Dqb => measure::<{ dqb::W }, dqb::Dqb>(mesh, dqb::params),

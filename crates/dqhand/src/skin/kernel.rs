@@ -710,12 +710,15 @@ mod avx512 {
             _mm512_i32gather_ps::<4>(_mm512_add_epi32(offsets, _mm512_set1_epi32(c as i32)), self.0.as_ptr().cast())
         }
 
-        /// From the rotations themselves: the rule of the frame's pair signs, without a table.
+        /// From the rotations themselves: the rule of the frame's pair signs, without a table,
+        /// in the same arithmetic (products summed left to right, unfused), so that a dot
+        /// product within rounding of 0 (a half-turn between two bones) takes the same sign
+        /// as in every other strategy and kernel.
         #[inline(always)]
         unsafe fn opposite(&self, _: __m512i, _: __m512i, h: &[__m512; 4], v: &[__m512; 4]) -> __mmask16 {
-            let mut dot = _mm512_setzero_ps();
-            for c in 0..4 {
-                dot = _mm512_fmadd_ps(h[c], v[c], dot);
+            let mut dot = _mm512_mul_ps(h[0], v[0]);
+            for c in 1..4 {
+                dot = _mm512_add_ps(dot, _mm512_mul_ps(h[c], v[c]));
             }
             _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dot, _mm512_setzero_ps())
         }

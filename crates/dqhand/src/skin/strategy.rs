@@ -29,7 +29,8 @@ impl Strategy {
 
     /// Environment variable that forces a strategy on every deformer built without
     /// [`Deformer::with_strategy`](super::Deformer::with_strategy) (for benchmarks): a
-    /// [`Self::name`].
+    /// [`Self::name`]. The library ignores any other value (it has no way to say so but a
+    /// panic); `dqhand bench` refuses it.
     pub const ENV: &'static str = "DQHAND_STRATEGY";
 
     /// Most joints [`Strategy::Permute`] holds: the 32 lanes of a two-source permute.
