@@ -427,9 +427,25 @@ def test_the_report_is_the_command_lines(hand, report):
     ours = hand.realism_report()
     assert ours.keys() == report.keys() and ours["vertices"] == report["vertices"] == len(hand.rest_vertices)
     assert ours["self_intersections"] == report["self_intersections"]
+
+    def same_contact(a, b, what):
+        # A self-contact: depth, shared volume and vertex count (null where not measured).
+        assert (a is None) == (b is None) and (a is None or a.keys() == b.keys()), what
+        for key in a or {}:
+            np.testing.assert_allclose(a[key], b[key], rtol=1e-5, atol=1e-6, err_msg=f"{what} {key}")
+
+    same_contact(ours["self_contact"]["rest"], report["self_contact"]["rest"], "rest")
+    assert [g["gesture"] for g in ours["self_contact"]["gestures"]] == [g["gesture"] for g in report["self_contact"]["gestures"]]
+    for a, b in zip(ours["self_contact"]["gestures"], report["self_contact"]["gestures"]):
+        for method in ("lb", "qb", "dqb"):
+            same_contact(a[method], b[method], f"{a['gesture']} {method}")
     for name, sweep in report["sweeps"].items():
         for method in ("lb", "qb", "dqb"):
             for measure, values in sweep[method].items():
+                if measure == "self_contact":
+                    for k, (a, b) in enumerate(zip(ours["sweeps"][name][method][measure], values, strict=True)):
+                        same_contact(a, b, f"{name} {method} frame {k}")
+                    continue
                 np.testing.assert_allclose(ours["sweeps"][name][method][measure], values, rtol=1e-5, atol=1e-6, err_msg=f"{name} {method} {measure}")
 
 
