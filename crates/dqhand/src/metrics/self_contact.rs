@@ -18,7 +18,7 @@ use glam::Vec3;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
-use crate::geometry::{vertex_normals, winding_number};
+use crate::geometry::{edges, vertex_normals, winding_number};
 use crate::math::triangle_closest;
 
 /// How far apart the lines measuring the shared volume are (m).
@@ -163,13 +163,10 @@ pub fn self_contact(positions: &[[f32; 3]], indices: &[u32], parts: &[u8]) -> Se
     // Per vertex, its longest edge: the surface inside another part lies within it of the
     // vertices inside.
     let mut edge = vec![0.0f32; positions.len()];
-    for t in &surface.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let l = Vec3::from(positions[a]).distance(Vec3::from(positions[b]));
-            edge[a] = edge[a].max(l);
-            edge[b] = edge[b].max(l);
-        }
+    for [a, b] in edges(indices).into_iter().map(|e| e.map(|v| v as usize)) {
+        let l = Vec3::from(positions[a]).distance(Vec3::from(positions[b]));
+        edge[a] = edge[a].max(l);
+        edge[b] = edge[b].max(l);
     }
     // Per part, the triangles with none of its vertices (made when first needed).
     let mut others: Vec<Option<Vec<u32>>> = Vec::new();
