@@ -151,10 +151,6 @@ impl Deformer {
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
         let forced = std::env::var(Strategy::ENV).ok().and_then(|name| Strategy::named(&name));
         let strategy = forced.unwrap_or_else(|| if Kernel::best() == Kernel::Avx512 { fastest_strategy(method, mesh) } else { Strategy::Permute });
-        Self::with_parts(method, mesh, strategy)
-    }
-
-    fn with_parts(method: Method, mesh: &SkinnedMesh, strategy: Strategy) -> Self {
         let joints = mesh.inverse_bind().len();
         let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
         Self {
@@ -179,7 +175,7 @@ impl Deformer {
 
     /// The same deformer with the AVX-512 kernel's lookup `strategy` instead of the one
     /// chosen at construction (one that does not serve the skin, [`Strategy::Permute`] past
-    /// 32 joints, gathers; results agree to rounding).
+    /// 32 joints, gathers; every strategy gives the same bits: tests/skin.rs).
     #[must_use]
     pub fn with_strategy(self, strategy: Strategy) -> Self {
         let (lbn, qn) = (self.lb.len(), self.quat.len());

@@ -786,8 +786,8 @@ mod avx512 {
                 let (start, end) = (*mesh.block_run_start.get_unchecked(s) as usize, *mesh.block_run_start.get_unchecked(s + 1) as usize);
                 for run in mesh.block_runs.get_unchecked(start..end) {
                     let p = self.params.get_unchecked(usize::from(run.joint)).as_ptr();
-                    // Sign 0 is the heaviest joint's own (+1).
-                    let sw = if B::SIGNED == 0 || run.sign == 0 { w } else { _mm512_mul_ps(w, _mm512_set1_ps(*self.signs.get_unchecked(run.sign as usize))) };
+                    // Pair 0 is the heaviest joint's own (sign +1).
+                    let sw = if B::SIGNED == 0 || run.pair == 0 { w } else { _mm512_mul_ps(w, _mm512_set1_ps(*self.signs.get_unchecked(run.pair as usize))) };
                     for (c, a) in acc.iter_mut().enumerate().take(B::USED) {
                         *a = _mm512_mask3_fmadd_ps(if c < B::SIGNED { sw } else { w }, _mm512_set1_ps(*p.add(c)), *a, run.lanes);
                     }

@@ -85,13 +85,14 @@ impl MeshData {
     }
 }
 
-/// The lanes of one block's slot that share a joint and a pair sign (an index of
-/// `SkinnedMesh::slot_pairs`): bit `l` of `lanes` is vertex `l` of the block.
+/// The lanes of one block's slot that share a joint and a pair (whose sign they take: a
+/// value of `SkinnedMesh::slot_pairs`, 0 for the heaviest joint's own): bit `l` of `lanes` is
+/// vertex `l` of the block.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Run {
     pub joint: u16,
     pub lanes: u16,
-    pub sign: u32,
+    pub pair: u32,
 }
 
 /// The runs of `blocks` full blocks of `k` slots, from the packed influences, and where each
@@ -106,10 +107,10 @@ fn runs(blocks: usize, k: usize, joints: &[u16], weights: &[f32], slot_pairs: &[
                 if weights[i] == 0.0 {
                     continue;
                 }
-                let (joint, sign) = (joints[i], slot_pairs[i]);
-                match runs[first..].iter_mut().find(|r: &&mut Run| r.joint == joint && r.sign == sign) {
+                let (joint, pair) = (joints[i], slot_pairs[i]);
+                match runs[first..].iter_mut().find(|r: &&mut Run| r.joint == joint && r.pair == pair) {
                     Some(r) => r.lanes |= 1 << l,
-                    None => runs.push(Run { joint, lanes: 1 << l, sign }),
+                    None => runs.push(Run { joint, lanes: 1 << l, pair }),
                 }
             }
             start.push(runs.len() as u32);
