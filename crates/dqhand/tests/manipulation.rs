@@ -175,11 +175,11 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
             // Its contacts (kept from frame to frame while the grip holds still) are what a
             // fresh query of the joint's proxies finds: the same point and normal.
             let teapot = &m.objects().objects()[0];
-            let mesh = teapot.surface.as_trimesh().unwrap();
+            let mesh = teapot.triangles().expect("the teapot is a mesh");
             for c in m.hands()[0].contacts() {
                 let fresh = proxies.colliders().iter().enumerate().filter(|(_, p)| p.joint == c.joint).filter_map(|(k, p)| {
                     let pose = dqhand::collision::pose_of(&m.hands()[0].constraint().world()[p.joint]);
-                    query.nearest(k, &*p.shape, &pose, mesh, &teapot.pose, dqhand::collision::CONTACT_DISTANCE)
+                    query.nearest(k, &pose, mesh, &teapot.pose, dqhand::collision::CONTACT_DISTANCE)
                 });
                 let miss = fresh.map(|f| (f.point.distance(c.point), f.normal.angle_between(c.normal))).fold((f32::INFINITY, f32::INFINITY), |a, b| if b.0 < a.0 { b } else { a });
                 off_surface = off_surface.max(miss.0);

@@ -400,7 +400,7 @@ impl ContactConstraint {
             // would test every triangle the swept box meets).
             let reach = (linvel.length() + angvel.length() * radius) * toi;
             for (_, o) in objects.near(&swept, 0.0, held) {
-                let mesh = o.surface.as_trimesh();
+                let mesh = o.triangles();
                 // A mesh's own advancement starts with its distance: the hull's is enough here.
                 let (gap, slack) = match mesh {
                     Some(_) => (o.hull_distance(&from, p).unwrap_or(0.0), MESH_DISTANCE_SLACK),
@@ -417,7 +417,7 @@ impl ContactConstraint {
                 }
                 let still = NonlinearRigidMotion::constant_position(o.pose);
                 let hit = match mesh {
-                    Some(mesh) => self.mesh_query.time_of_impact(i, &*p.shape, &motion, radius, &swept, mesh, &o.pose, toi),
+                    Some(mesh) => self.mesh_query.time_of_impact(i, &motion, radius, &swept, mesh, &o.pose, toi),
                     // A proxy touching a primitive stops the wrist unless it moves off the
                     // surface: parry's directional cast read a thumb 0.2 mm off a bar as
                     // overlapping it, judged the overlap a leaving one, and let the hand 5 mm
@@ -549,8 +549,8 @@ impl ContactConstraint {
                         let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                         for &o in &self.near {
                             let c = objects.collider(o);
-                            let here = match c.surface.as_trimesh() {
-                                Some(mesh) => self.mesh_query.distance_at_least(*p, &*proxy.shape, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
+                            let here = match c.triangles() {
+                                Some(mesh) => self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
                                 None => c.distance_at_least(&pose, proxy, STOP_DISTANCE),
                             };
                             if here < d {
@@ -635,8 +635,8 @@ impl ContactConstraint {
             let aabb = p.aabb(&pose);
             let skip = still_on.map(|(o, _)| o).filter(|_| unmoved(p.joint));
             for (i, o) in objects.near(&aabb, CONTACT_DISTANCE, skip).filter(|(i, _)| *i < objects.objects().len()) {
-                if let Some(mesh) = o.surface.as_trimesh() {
-                    if let Some(n) = self.mesh_query.nearest(k, &*p.shape, &pose, mesh, &o.pose, CONTACT_DISTANCE) {
+                if let Some(mesh) = o.triangles() {
+                    if let Some(n) = self.mesh_query.nearest(k, &pose, mesh, &o.pose, CONTACT_DISTANCE) {
                         self.contacts.push(Contact { joint: p.joint, part: p.part, object: i, point: n.point, normal: n.normal, distance: n.distance });
                     }
                     continue;

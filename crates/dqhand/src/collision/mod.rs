@@ -8,6 +8,8 @@
 //! * [`ProxyMeshQuery`] — a proxy against a triangle mesh (the nearest triangle, the time of
 //!   impact), its own rather than parry's, whose GJK in metres is centimetres off there;
 //!   a hull proxy's support points by hill climbing (`hull_support`).
+//! * [`TriangleTree`] — a mesh object's triangles in a tree of its own, built once, which
+//!   those queries search.
 
 mod contact_constraint;
 mod hand_proxies;
@@ -15,9 +17,11 @@ mod hull_support;
 mod object_colliders;
 mod proxy;
 mod proxy_mesh_query;
+mod triangle_tree;
 
 pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S, STOP_DISTANCE};
 pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
 pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};
 pub use proxy_mesh_query::{MeshNearest, ProxyMeshQuery};
+pub use triangle_tree::{TreeNode, TreeTriangle, TriangleTree};

@@ -10,6 +10,8 @@
 //! With two hands, each hand's proxies, where it was last rendered, are obstacles to the
 //! other ([`ObjectColliders::add_hand`]): the rendered hands do not pass through each other.
 
+use std::sync::Arc;
+
 use glam::{Affine3A, Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
@@ -19,6 +21,7 @@ use parry3d::shape::{SharedShape, SupportMap, TriMeshFlags};
 
 use super::hand_proxies::{pose_of, ProxyCollider};
 use super::hull_support::HullSupport;
+use super::triangle_tree::TriangleTree;
 use super::HandProxies;
 use crate::Warning;
 use crate::scene::{ObjectMesh, ObjectShape, Scene};
@@ -39,6 +42,9 @@ pub struct ObjectCollider {
     /// The object's current world pose.
     pub pose: Pose,
     aabb: Aabb,
+    /// A mesh's triangles in the tree the hand's proxies search (shared: colliders are cloned
+    /// with the scene).
+    triangles: Option<Arc<TriangleTree>>,
     /// The hull's support function by hill climbing, where the hull is a convex polyhedron.
     hull_support: Option<HullSupport>,
 }
@@ -48,6 +54,12 @@ impl ObjectCollider {
     #[must_use]
     pub fn aabb(&self) -> &Aabb {
         &self.aabb
+    }
+
+    /// A mesh object's triangles, as [`super::ProxyMeshQuery`] searches them.
+    #[must_use]
+    pub fn triangles(&self) -> Option<&TriangleTree> {
+        self.triangles.as_deref()
     }
 
     /// A convex shape that holds the surface and is much cheaper to query (a mesh's hull), where
@@ -180,7 +192,8 @@ impl ObjectColliders {
             let pose = Pose::from_parts(o.position, o.rotation);
             let aabb = surface.compute_aabb(&pose);
             let hull_support = mesh.as_ref().and(solid.as_convex_polyhedron()).map(|h| HullSupport::new(h, 1.0));
-            objects.push(ObjectCollider { name: o.name.clone(), surface, solid, mesh, pose, aabb, hull_support });
+            let triangles = mesh.as_ref().map(|m| Arc::new(TriangleTree::new(&m.vertices, &m.triangles)));
+            objects.push(ObjectCollider { name: o.name.clone(), surface, solid, mesh, pose, aabb, triangles, hull_support });
         }
         let count = objects.len();
         let table = scene.table.map(|t| table_top(t.height, &objects));
@@ -188,7 +201,7 @@ impl ObjectColliders {
             let surface = SharedShape::cuboid(t.half[0], TABLE_HALF_THICKNESS, t.half[1]);
             let pose = Pose::from_translation(Vec3::new(t.centre[0], t.height - TABLE_HALF_THICKNESS, t.centre[1]));
             let aabb = surface.compute_aabb(&pose);
-            objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb, hull_support: None });
+            objects.push(ObjectCollider { name: "table".to_owned(), solid: surface.clone(), surface, mesh: None, pose, aabb, triangles: None, hull_support: None });
         }
         Ok(Self { all: objects, count, hands: Vec::new(), solving: None, table, warnings })
     }
@@ -282,7 +295,7 @@ impl ObjectColliders {
         for p in proxies.colliders() {
             let pose = Pose::IDENTITY;
             let aabb = p.aabb(&pose);
-            self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb, hull_support: None });
+            self.all.push(ObjectCollider { name: "hand".to_owned(), surface: p.shape.clone(), solid: p.shape.clone(), mesh: None, pose, aabb, triangles: None, hull_support: None });
         }
         self.hands.push((start..self.all.len(), proxies.colliders().iter().map(|p| (p.joint, p.aabb(&Pose::IDENTITY))).collect(), false));
         self.hands.len() - 1

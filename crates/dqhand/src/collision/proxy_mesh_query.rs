@@ -29,13 +29,13 @@
 use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
-use parry3d::partitioning::BvhLeafCost;
-use parry3d::query::{self, NonlinearRigidMotion};
+use parry3d::query::NonlinearRigidMotion;
 use parry3d::query::details::contact_support_map_support_map;
-use parry3d::shape::{Shape, SupportMap, TriMesh, Triangle};
+use parry3d::shape::{Shape, SupportMap, Triangle};
 use std::sync::Arc;
 
 use super::hull_support::HullSupport;
+use super::triangle_tree::{TreeNode, TreeTriangle, TriangleTree};
 use super::HandProxies;
 use crate::math::{segment_distance, segment_triangle_closest};
 
@@ -77,12 +77,6 @@ pub struct MeshNearest {
     pub point: Vec3,
 }
 
-impl BvhLeafCost for MeshNearest {
-    fn cost(&self) -> f32 {
-        self.distance
-    }
-}
-
 /// The gap between two boxes (0 where they overlap): a lower bound of the distance between
 /// anything inside them.
 fn box_gap(a: &Aabb, b: &Aabb) -> f32 {
@@ -94,7 +88,7 @@ fn box_gap(a: &Aabb, b: &Aabb) -> f32 {
 #[derive(Clone)]
 pub struct ProxyMeshQuery {
     /// Per proxy of the hand, in [`HandProxies::colliders`]' order.
-    shapes: Vec<Option<QueryShape>>,
+    shapes: Vec<QueryShape>,
     candidates: Vec<Candidate>,
 }
 
@@ -148,16 +142,20 @@ fn face_normal_towards(tri: &Triangle, x: Vec3) -> Vec3 {
 }
 
 impl QueryShape {
-    /// How `shape` is queried; `None` for a shape parry cannot scale.
-    fn of(shape: &dyn Shape) -> Option<Self> {
+    /// How `shape` is queried.
+    ///
+    /// # Panics
+    /// For a shape that is not convex or that parry cannot scale: a hand's proxies are
+    /// capsules and hulls ([`super::ProxyShape`]).
+    fn of(shape: &dyn Shape) -> Self {
         if let Some(c) = shape.as_capsule() {
-            return Some(Self::Capsule { a: c.segment.a, b: c.segment.b, radius: c.radius });
+            return Self::Capsule { a: c.segment.a, b: c.segment.b, radius: c.radius };
         }
         let convex = match shape.as_convex_polyhedron() {
             Some(hull) => Convex::Hull(HullSupport::new(hull, UNIT)),
-            None => Convex::Other(Arc::from(shape.scale_dyn(Vec3::splat(UNIT), 16).filter(|s| s.as_support_map().is_some())?)),
+            None => Convex::Other(Arc::from(shape.scale_dyn(Vec3::splat(UNIT), 16).filter(|s| s.as_support_map().is_some()).expect("a convex proxy"))),
         };
-        Some(Self::Scaled(convex, shape.compute_local_aabb()))
+        Self::Scaled(convex, shape.compute_local_aabb())
     }
 
     /// The box holding the proxy at `pose` (the mesh's frame).
@@ -171,23 +169,6 @@ impl QueryShape {
         }
     }
 
-    /// A lower bound of the distance to anything in the tree's node `node` (the mesh's frame),
-    /// the proxy at `pose` (`to_local` its inverse) and within `aabb`: the gap between the
-    /// boxes, or where larger (a slanted finger's box holds much that the finger is far from)
-    /// the proxy's distance to the node's centre less the node's half diagonal.
-    fn node_gap(&self, pose: &Pose, to_local: &Pose, aabb: &Aabb, node: &Aabb) -> f32 {
-        let boxes = box_gap(node, aabb);
-        let (centre, half) = (node.center(), node.half_extents().length());
-        let centre_gap = match self {
-            Self::Capsule { a, b, radius } => segment_distance(centre, *pose * *a, *pose * *b) - radius,
-            Self::Scaled(_, local) => {
-                let c = to_local * centre;
-                (local.mins - c).max(c - local.maxs).max(Vec3::ZERO).length()
-            }
-        } - half;
-        if boxes > 0.0 || centre_gap > 0.0 { boxes.max(centre_gap) } else { self.deepest() }
-    }
-
     /// The least signed distance it can have to anything: a node of the tree whose box meets
     /// the proxy's may hold a triangle this deep in it.
     fn deepest(&self) -> f32 {
@@ -197,37 +178,14 @@ impl QueryShape {
         }
     }
 
-    /// A lower bound of the distance to `tri` at `pose` (the mesh's frame), far cheaper than
-    /// the distance: for a capsule, the larger of its axis's distance to the triangle's
-    /// bounding sphere and to the triangle's plane; for a hull, the larger of the gap between its
-    /// box and the triangle's box in the joint's frame and the gap along the triangle's normal.
-    /// `to_local` is `pose`'s inverse, which the caller makes once for all its triangles.
-    fn bound(&self, pose: &Pose, to_local: &Pose, tri: &Triangle) -> f32 {
-        match self {
-            Self::Capsule { a, b, radius } => {
-                let (p, q) = (*pose * *a, *pose * *b);
-                // A small triangle is no nearer than its centroid less its vertices' reach (a
-                // finger lying on a mesh has hundreds of triangles within its length), a large
-                // one no nearer than its plane when the axis is on one side of it.
-                let centroid = (tri.a + tri.b + tri.c) / 3.0;
-                let spread = centroid.distance_squared(tri.a).max(centroid.distance_squared(tri.b)).max(centroid.distance_squared(tri.c)).sqrt();
-                let n = face_normal(tri);
-                let (dp, dq) = ((p - tri.a).dot(n), (q - tri.a).dot(n));
-                let plane = if dp * dq > 0.0 { dp.abs().min(dq.abs()) } else { 0.0 };
-                (segment_distance(centroid, p, q) - spread).max(plane) - radius
-            }
-            Self::Scaled(_, aabb) => {
-                let [a, b, c] = [to_local * tri.a, to_local * tri.b, to_local * tri.c];
-                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-                let boxes = (aabb.mins - hi).max(lo - aabb.maxs).max(Vec3::ZERO).length();
-                let n = (b - a).cross(c - a).normalize_or_zero();
-                let reach = (aabb.half_extents() * n.abs()).element_sum();
-                let along = (a - aabb.center()).dot(n).abs() - reach;
-                // Where both gaps close the hull may overlap the triangle: as deep as it can.
-                let gap = boxes.max(along);
-                if gap > 0.0 { gap } else { self.deepest() }
-            }
-        }
+    /// The proxy at `pose` (the mesh's frame), ready for the bounds of many nodes and
+    /// triangles.
+    fn at(&self, pose: Pose) -> Placed<'_> {
+        let axis = match self {
+            Self::Capsule { a, b, .. } => (pose * *a, pose * *b),
+            Self::Scaled(..) => (pose.translation, pose.translation),
+        };
+        Placed { shape: self, to_local: pose.inverse(), aabb: self.aabb(&pose), axis }
     }
 
     /// The signed distance to `tri` (negative inside), the triangle's normal there towards the
@@ -269,6 +227,65 @@ impl QueryShape {
     }
 }
 
+/// A proxy at a pose (the mesh's frame), with what each bound needs made once.
+struct Placed<'a> {
+    shape: &'a QueryShape,
+    /// The pose's inverse.
+    to_local: Pose,
+    /// The box holding it.
+    aabb: Aabb,
+    /// A capsule's axis (the mesh's frame).
+    axis: (Vec3, Vec3),
+}
+
+impl Placed<'_> {
+    /// A lower bound of the distance to anything in the tree's node `node`: the gap between
+    /// the boxes, or where larger (a slanted finger's box holds much that the finger is far
+    /// from) the proxy's distance to the node's centre less the node's half diagonal.
+    fn node_gap(&self, node: &TreeNode) -> f32 {
+        let boxes = box_gap(&node.aabb, &self.aabb);
+        let centre_gap = match self.shape {
+            QueryShape::Capsule { radius, .. } => segment_distance(node.centre, self.axis.0, self.axis.1) - radius,
+            QueryShape::Scaled(_, local) => {
+                let c = self.to_local * node.centre;
+                (local.mins - c).max(c - local.maxs).max(Vec3::ZERO).length()
+            }
+        } - node.radius;
+        if boxes > 0.0 || centre_gap > 0.0 { boxes.max(centre_gap) } else { self.shape.deepest() }
+    }
+
+    /// A lower bound of the distance to `tri`, far cheaper than the distance: for a capsule,
+    /// the larger of its axis's distance to the triangle's bounding sphere and to the
+    /// triangle's plane; for a hull, the larger of the gap between its box and the triangle's
+    /// box in the joint's frame and the gap along the triangle's normal.
+    fn bound(&self, tri: &TreeTriangle) -> f32 {
+        match self.shape {
+            QueryShape::Capsule { radius, .. } => {
+                let (p, q) = self.axis;
+                // A small triangle is no nearer than its centroid less its vertices' reach (a
+                // finger lying on a mesh has hundreds of triangles within its length), a large
+                // one no nearer than its plane when the axis is on one side of it.
+                let (n, a) = (tri.normal, tri.triangle.a);
+                let (dp, dq) = ((p - a).dot(n), (q - a).dot(n));
+                let plane = if dp * dq > 0.0 { dp.abs().min(dq.abs()) } else { 0.0 };
+                (segment_distance(tri.centroid, p, q) - tri.spread).max(plane) - radius
+            }
+            QueryShape::Scaled(_, aabb) => {
+                let t = &tri.triangle;
+                let [a, b, c] = [self.to_local * t.a, self.to_local * t.b, self.to_local * t.c];
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                let boxes = (aabb.mins - hi).max(lo - aabb.maxs).max(Vec3::ZERO).length();
+                let n = self.to_local.rotation * tri.normal;
+                let reach = (aabb.half_extents() * n.abs()).element_sum();
+                let along = (a - aabb.center()).dot(n).abs() - reach;
+                // Where both gaps close the hull may overlap the triangle: as deep as it can.
+                let gap = boxes.max(along);
+                if gap > 0.0 { gap } else { self.shape.deepest() }
+            }
+        }
+    }
+}
+
 impl ProxyMeshQuery {
     /// The advancement for `proxies`.
     #[must_use]
@@ -276,20 +293,17 @@ impl ProxyMeshQuery {
         Self { shapes: proxies.colliders().iter().map(|p| QueryShape::of(&*p.shape)).collect(), candidates: Vec::new() }
     }
 
-    /// The point of `mesh` (at `mesh_pose`) nearest proxy `proxy` (`shape` at `pose`), if it is
-    /// nearer than `limit` (m). (A proxy parry cannot scale is measured by parry.)
+    /// The point of `mesh` (at `mesh_pose`) nearest proxy `proxy` (at `pose`), if it is nearer
+    /// than `limit` (m).
     #[must_use]
-    pub fn nearest(&self, proxy: usize, shape: &dyn Shape, pose: &Pose, mesh: &TriMesh, mesh_pose: &Pose, limit: f32) -> Option<MeshNearest> {
-        let Some(query) = &self.shapes[proxy] else {
-            let c = query::contact(pose, shape, mesh_pose, mesh, limit).ok().flatten()?;
-            return Some(MeshNearest { distance: c.dist, normal: (-c.normal1).normalize_or_zero(), point: c.point2 });
-        };
+    pub fn nearest(&self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, limit: f32) -> Option<MeshNearest> {
+        let query = &self.shapes[proxy];
         let local = mesh_pose.inv_mul(pose);
         let near = Self::search(query, &local, mesh, limit, f32::INFINITY, 0.0)?;
         Some(MeshNearest { distance: near.distance, normal: mesh_pose.rotation * near.normal, point: *mesh_pose * near.point })
     }
 
-    /// A lower bound of the distance from proxy `proxy` (`shape` at `pose`) to `mesh` (at
+    /// A lower bound of the distance from proxy `proxy` (at `pose`) to `mesh` (at
     /// `mesh_pose`), exact where it is under `exact_below`, and at most `limit` (m): what
     /// conservative advancement needs, where a triangle whose cheap bound is enough is never
     /// measured (a finger a centimetre off a mesh has dozens of triangles about as near).
@@ -298,10 +312,8 @@ impl ProxyMeshQuery {
     /// hundreds of triangles within a millimetre of its distance, which it need not tell apart.
     #[allow(clippy::too_many_arguments)]
     #[must_use]
-    pub fn distance_at_least(&self, proxy: usize, shape: &dyn Shape, pose: &Pose, mesh: &TriMesh, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
-        let Some(query) = &self.shapes[proxy] else {
-            return query::distance(pose, shape, mesh_pose, mesh).map_or(0.0, |d| d.distance.min(limit));
-        };
+    pub fn distance_at_least(&self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
+        let query = &self.shapes[proxy];
         // Nothing found within the limit: what was passed over may be a little nearer.
         let passed_over = limit - SHORT_ABOVE * (limit - exact_below).max(0.0);
         Self::search(query, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
@@ -312,42 +324,38 @@ impl ProxyMeshQuery {
     /// cheap bound is above `exact_below` counts as that far (with no normal or point). With
     /// `short` above 0, the distance found may be short of the true one by that share of its
     /// excess over `exact_below`: what is no nearer than that is not looked at.
-    fn search(query: &QueryShape, pose: &Pose, mesh: &TriMesh, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
-        let (aabb, to_local) = (query.aabb(pose), pose.inverse());
+    fn search(query: &QueryShape, pose: &Pose, mesh: &TriangleTree, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
+        let placed = query.at(*pose);
         // What can still count, with `best` found: rising with `best`, so that it holds for
         // everything passed over on the way to the final `best`.
         let worth = |best: f32| best - short * (best - exact_below).max(0.0);
-        mesh.bvh()
-            .find_best(
-                limit,
-                |node, best| Some(query.node_gap(pose, &to_local, &aabb, &node.aabb())).filter(|&gap| gap < worth(best)).unwrap_or(f32::MAX),
-                |triangle, best| {
-                    let triangle = mesh.triangle(triangle);
-                    // The cheap bound first: most triangles near the proxy are not the nearest.
-                    let bound = query.bound(pose, &to_local, &triangle);
-                    if bound >= worth(best) {
-                        return None;
-                    }
-                    if bound > exact_below {
-                        return Some(MeshNearest { distance: bound, normal: Vec3::ZERO, point: Vec3::ZERO });
-                    }
-                    let (distance, normal, point) = query.to_triangle(pose, &triangle);
-                    Some(MeshNearest { distance, normal, point: point - normal * distance })
-                },
-            )
-            .map(|(_, near)| MeshNearest { distance: worth(near.distance), ..near })
+        mesh.find_best(
+            limit,
+            |node| placed.node_gap(node),
+            |tri, best| {
+                // The cheap bound first: most triangles near the proxy are not the nearest.
+                let bound = placed.bound(tri);
+                if bound >= worth(best) {
+                    return None;
+                }
+                if bound > exact_below {
+                    return Some((bound, (Vec3::ZERO, Vec3::ZERO)));
+                }
+                let (distance, normal, point) = query.to_triangle(pose, &tri.triangle);
+                Some((distance, (normal, point - normal * distance)))
+            },
+            worth,
+        )
+        .map(|(distance, (normal, point))| MeshNearest { distance: worth(distance), normal, point })
     }
 
-    /// The first time in `[0, end)` at which proxy `proxy` (`shape`), moving by `motion`, comes
-    /// within [`TOLERANCE`] of `mesh` (still at `mesh_pose`), if any. No point of the proxy is
-    /// farther than `radius` from the motion's centre; `swept` (world) holds the proxy over
-    /// the whole motion. (A proxy parry cannot scale is cast by parry.)
+    /// The first time in `[0, end)` at which proxy `proxy`, moving by `motion`, comes within
+    /// [`TOLERANCE`] of `mesh` (still at `mesh_pose`), if any. No point of the proxy is farther
+    /// than `radius` from the motion's centre; `swept` (world) holds the proxy over the whole
+    /// motion.
     #[allow(clippy::too_many_arguments)]
-    pub fn time_of_impact(&mut self, proxy: usize, shape: &dyn Shape, motion: &NonlinearRigidMotion, radius: f32, swept: &Aabb, mesh: &TriMesh, mesh_pose: &Pose, end: f32) -> Option<f32> {
-        let Some(cast) = &self.shapes[proxy] else {
-            let still = NonlinearRigidMotion::constant_position(*mesh_pose);
-            return query::cast_shapes_nonlinear(motion, shape, &still, mesh, 0.0, end, false).ok().flatten().map(|hit| hit.time_of_impact);
-        };
+    pub fn time_of_impact(&mut self, proxy: usize, motion: &NonlinearRigidMotion, radius: f32, swept: &Aabb, mesh: &TriangleTree, mesh_pose: &Pose, end: f32) -> Option<f32> {
+        let cast = &self.shapes[proxy];
         // How fast a point of the proxy may move, m per unit of time: all told, and by turning.
         let turning = motion.angvel.length() * radius;
         let speed = motion.linvel.length() + turning;
@@ -356,12 +364,13 @@ impl ProxyMeshQuery {
         }
         let local_pose = |t: f32| mesh_pose.inv_mul(&motion.position_at_time(t));
         let start = local_pose(0.0);
-        let to_start = start.inverse();
+        let placed = cast.at(start);
         self.candidates.clear();
-        self.candidates.extend(mesh.bvh().intersect_aabb(&swept.transform_by(&mesh_pose.inverse())).map(|triangle| {
-            let bound = cast.bound(&start, &to_start, &mesh.triangle(triangle));
-            Candidate { triangle, bound, at: 0.0, rate: speed, left: None }
-        }));
+        let candidates = &mut self.candidates;
+        mesh.overlapping(&swept.transform_by(&mesh_pose.inverse()), |triangle| {
+            let bound = placed.bound(&mesh.triangles()[triangle as usize]);
+            candidates.push(Candidate { triangle, bound, at: 0.0, rate: speed, left: None });
+        });
         // Nearest first: a contact at the start is then found after few exact distances.
         self.candidates.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound));
         let pivot = motion.start * motion.local_center;
@@ -372,7 +381,7 @@ impl ProxyMeshQuery {
             let mut next = end;
             for c in &mut self.candidates {
                 if c.left.is_some() || c.bound - c.rate * (t - c.at) <= DUE * TOLERANCE {
-                    let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangle(c.triangle));
+                    let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangles()[c.triangle as usize].triangle);
                     (c.bound, c.at) = (distance, t);
                     let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
                     if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
@@ -423,9 +432,9 @@ mod tests {
     use crate::math::triangle_closest;
 
     /// A flat square of two triangles, 20 cm across, in the plane y = 0.
-    fn floor() -> TriMesh {
-        let v = vec![Vec3::new(-0.1, 0.0, -0.1), Vec3::new(0.1, 0.0, -0.1), Vec3::new(0.1, 0.0, 0.1), Vec3::new(-0.1, 0.0, 0.1)];
-        TriMesh::new(v, vec![[0, 2, 1], [0, 3, 2]]).expect("a square")
+    fn floor() -> TriangleTree {
+        let v = [Vec3::new(-0.1, 0.0, -0.1), Vec3::new(0.1, 0.0, -0.1), Vec3::new(0.1, 0.0, 0.1), Vec3::new(-0.1, 0.0, 0.1)];
+        TriangleTree::new(&v, &[[0, 2, 1], [0, 3, 2]])
     }
 
     fn cast(shape: &SharedShape, from: Vec3, linvel: Vec3, angvel: Vec3) -> Option<f32> {
@@ -435,7 +444,7 @@ mod tests {
         let extent = shape.compute_local_bounding_sphere().radius;
         let to = motion.position_at_time(1.0);
         let swept = shape.compute_swept_aabb(&start, &to).loosened(extent * angvel.length());
-        cast.time_of_impact(0, &**shape, &motion, extent, &swept, &floor(), &Pose::identity(), 1.0)
+        cast.time_of_impact(0, &motion, extent, &swept, &floor(), &Pose::identity(), 1.0)
     }
 
     #[test]
@@ -505,7 +514,8 @@ mod tests {
         // points of the segment and each triangle, by brute force, no tree and no bound), and
         // the advancement's bound must never be above it and be it below `exact_below`.
         let triangles = teapot_triangles();
-        let mesh = TriMesh::new(triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect(), (0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect()).expect("a mesh");
+        let corners: Vec<Vec3> = triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect();
+        let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
         let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
         let shapes = [SharedShape::capsule(a, b, radius), SharedShape::cuboid(0.04, 0.01, 0.03)];
         let query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), candidates: Vec::new() };
@@ -527,7 +537,7 @@ mod tests {
                 p.distance(q) - radius
             });
             let reference = brute.fold(f32::INFINITY, f32::min);
-            let found = query.nearest(0, &*shapes[0], &pose, &mesh, &mesh_pose, 0.05);
+            let found = query.nearest(0, &pose, &mesh, &mesh_pose, 0.05);
             match found {
                 Some(n) => {
                     assert!((n.distance - reference).abs() < 1e-6, "nearest {} where every triangle gives {reference}", n.distance);
@@ -539,7 +549,7 @@ mod tests {
                 }
                 None => assert!(reference >= 0.05, "nothing found within 5 cm where a triangle is {reference} m off"),
             }
-            let bound = query.distance_at_least(0, &*shapes[0], &pose, &mesh, &mesh_pose, 0.002, 0.03);
+            let bound = query.distance_at_least(0, &pose, &mesh, &mesh_pose, 0.002, 0.03);
             assert!(bound <= reference + 1e-6 && bound <= 0.03, "bound {bound} above the distance {reference}");
             if reference < 0.002 {
                 assert!((bound - reference).abs() < 1e-6, "bound {bound} not exact at {reference}");
@@ -557,9 +567,9 @@ mod tests {
                     break;
                 }
                 exact_box = exact_box.min(polyhedron_triangle(&box_points, &box_triangles, &local, t));
-                each_box = each_box.min(query.shapes[1].as_ref().expect("a box scales").to_triangle(&local, t).0);
+                each_box = each_box.min(query.shapes[1].to_triangle(&local, t).0);
             }
-            let found = query.nearest(1, &*shapes[1], &pose, &mesh, &mesh_pose, 0.05);
+            let found = query.nearest(1, &pose, &mesh, &mesh_pose, 0.05);
             assert!(exact_box >= 0.05 || found.is_some(), "no box contact where a triangle is {exact_box} m off");
             if let Some(n) = found {
                 // The search finds the least of the triangles' values (the deepest overlap too), up
@@ -585,7 +595,7 @@ mod tests {
     fn parry_distance_to_small_triangles_needs_a_larger_unit() {
         let capsule = SharedShape::capsule(Vec3::new(0.0, -0.015, 0.0), Vec3::new(0.0, 0.015, 0.0), 0.008);
         let scaled = QueryShape::Scaled(Convex::Other(Arc::from(capsule.scale_dyn(Vec3::splat(UNIT), 16).expect("a capsule scales"))), capsule.compute_local_aabb());
-        let exact = QueryShape::of(&*capsule).expect("a capsule");
+        let exact = QueryShape::of(&*capsule);
         let (mut in_metres, mut in_units) = (0.0f32, 0.0f32);
         for (k, tri) in teapot_triangles().into_iter().enumerate().step_by(7) {
             let centre = (tri.a + tri.b + tri.c) / 3.0;
@@ -596,7 +606,7 @@ mod tests {
             if reference <= 0.0 {
                 continue;
             }
-            let metres = query::distance(&pose, &*capsule, &Pose::identity(), &tri).expect("a distance").distance;
+            let metres = parry3d::query::distance(&pose, &*capsule, &Pose::identity(), &tri).expect("a distance").distance;
             in_metres = in_metres.max((metres - reference).abs());
             in_units = in_units.max((scaled.to_triangle(&pose, &tri).0 + GJK_ERROR - reference).abs());
         }
@@ -644,7 +654,7 @@ mod tests {
                 continue;
             }
             let shape = SharedShape::convex_mesh(points.clone(), triangles).expect("a hull");
-            let cast = QueryShape::of(&*shape).expect("a hull scales");
+            let cast = QueryShape::of(&*shape);
             let (lowest, _) = points.iter().fold((f32::INFINITY, Vec3::ZERO), |(y, p), &q| if q.y < y { (q.y, q) } else { (y, p) });
             for (k, tri) in teapot.iter().enumerate().step_by(97) {
                 let normal = face_normal(tri);

@@ -100,31 +100,40 @@ pub fn triangle_closest(x: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
 }
 
 /// The closest points of the segment `p0`–`p1` and the triangle `tri`, first on the segment:
-/// where the segment crosses the triangle, that point twice; otherwise the nearer of its ends'
-/// nearest points on the triangle and its nearest points to the triangle's edges (a segment
-/// that does not cross a triangle is nearest to it at one of its ends or at an edge).
+/// where the segment crosses the triangle, that point twice; otherwise the nearest of its
+/// ends' feet on the triangle's plane that fall inside the triangle and its nearest points to
+/// the triangle's edges (a segment that does not cross a triangle is nearest to it at one of
+/// its ends or at an edge, and an end is nearest to the triangle's inside only at its foot).
+/// A triangle with no area is its edges.
 #[must_use]
 pub fn segment_triangle_closest(p0: Vec3, p1: Vec3, tri: [Vec3; 3]) -> (Vec3, Vec3) {
     let [a, b, c] = tri;
     let n = (b - a).cross(c - a);
+    // On the same side of each edge as the triangle (or on an edge).
+    let inside = |x: Vec3| (b - a).cross(x - a).dot(n) >= 0.0 && (c - b).cross(x - b).dot(n) >= 0.0 && (a - c).cross(x - c).dot(n) >= 0.0;
     let (s0, s1) = ((p0 - a).dot(n), (p1 - a).dot(n));
     if (s0 <= 0.0) != (s1 <= 0.0) {
         let x = p0 + (p1 - p0) * (s0 / (s0 - s1));
-        // Inside when it is on the same side of each edge as the triangle.
-        let inside = (b - a).cross(x - a).dot(n) >= 0.0 && (c - b).cross(x - b).dot(n) >= 0.0 && (a - c).cross(x - c).dot(n) >= 0.0;
-        if inside {
+        if inside(x) {
             return (x, x);
         }
     }
-    let mut best = (p0, triangle_closest(p0, tri));
+    let mut best = segment_segment_closest(p0, p1, a, b);
     let mut consider = |pair: (Vec3, Vec3)| {
         if pair.0.distance_squared(pair.1) < best.0.distance_squared(best.1) {
             best = pair;
         }
     };
-    consider((p1, triangle_closest(p1, tri)));
-    for (u, v) in [(a, b), (b, c), (c, a)] {
-        consider(segment_segment_closest(p0, p1, u, v));
+    consider(segment_segment_closest(p0, p1, b, c));
+    consider(segment_segment_closest(p0, p1, c, a));
+    let area = n.length_squared();
+    if area > 0.0 {
+        for (p, s) in [(p0, s0), (p1, s1)] {
+            let foot = p - n * (s / area);
+            if inside(foot) {
+                consider((p, foot));
+            }
+        }
     }
     best
 }
