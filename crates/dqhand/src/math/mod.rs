@@ -19,4 +19,4 @@ pub use rng::Rng;
 #[cfg(feature = "interaction")]
 pub use rigid_fit::rigid_fit;
 pub use screw::Screw;
-pub use segment::{segment_closest, segment_distance, segment_segment_closest, segment_triangle_closest, triangle_closest};
+pub use segment::{is_sliver, segment_closest, segment_distance, segment_segment_closest, segment_triangle_closest, triangle_closest};

@@ -53,13 +53,23 @@ pub fn segment_segment_closest(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (Vec3,
     (p0 + d1 * s, q0 + d2 * t)
 }
 
+/// Whether the triangle is too thin for its normal (the cross product of two edges) to be
+/// more than f32's rounding: the sine of its angle at the first corner under 10⁻⁶ (a 1 cm
+/// edge with the third corner 10 nm off it). A long thin triangle's normal can be tilted by
+/// a tenth, its plane millimetres off its far corners.
+#[must_use]
+pub fn is_sliver([a, b, c]: [Vec3; 3]) -> bool {
+    let (ab, ac) = (b - a, c - a);
+    ab.cross(ac).length_squared() <= 1e-12 * ab.length_squared() * ac.length_squared()
+}
+
 /// The point of the triangle `a`, `b`, `c` closest to `x` (Ericson 5.1.5, by Voronoi regions;
-/// a triangle with no area, by its edges).
+/// a sliver, [`is_sliver`], by its edges).
 #[must_use]
 pub fn triangle_closest(x: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
     let ab = b - a;
     let ac = c - a;
-    if ab.cross(ac).length_squared() <= 1e-12 * ab.length_squared() * ac.length_squared() {
+    if is_sliver([a, b, c]) {
         return [segment_closest(x, a, b), segment_closest(x, b, c), segment_closest(x, c, a)]
             .into_iter()
             .min_by(|p, q| p.distance_squared(x).total_cmp(&q.distance_squared(x)))
@@ -104,15 +114,16 @@ pub fn triangle_closest(x: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
 /// ends' feet on the triangle's plane that fall inside the triangle and its nearest points to
 /// the triangle's edges (a segment that does not cross a triangle is nearest to it at one of
 /// its ends or at an edge, and an end is nearest to the triangle's inside only at its foot).
-/// A triangle with no area is its edges.
+/// A triangle too thin for its normal to mean anything in f32 ([`is_sliver`]) is its edges.
 #[must_use]
 pub fn segment_triangle_closest(p0: Vec3, p1: Vec3, tri: [Vec3; 3]) -> (Vec3, Vec3) {
     let [a, b, c] = tri;
     let n = (b - a).cross(c - a);
+    let sliver = is_sliver(tri);
     // On the same side of each edge as the triangle (or on an edge).
     let inside = |x: Vec3| (b - a).cross(x - a).dot(n) >= 0.0 && (c - b).cross(x - b).dot(n) >= 0.0 && (a - c).cross(x - c).dot(n) >= 0.0;
     let (s0, s1) = ((p0 - a).dot(n), (p1 - a).dot(n));
-    if (s0 <= 0.0) != (s1 <= 0.0) {
+    if !sliver && (s0 <= 0.0) != (s1 <= 0.0) {
         let x = p0 + (p1 - p0) * (s0 / (s0 - s1));
         if inside(x) {
             return (x, x);
@@ -126,10 +137,9 @@ pub fn segment_triangle_closest(p0: Vec3, p1: Vec3, tri: [Vec3; 3]) -> (Vec3, Ve
     };
     consider(segment_segment_closest(p0, p1, b, c));
     consider(segment_segment_closest(p0, p1, c, a));
-    let area = n.length_squared();
-    if area > 0.0 {
+    if !sliver {
         for (p, s) in [(p0, s0), (p1, s1)] {
-            let foot = p - n * (s / area);
+            let foot = p - n * (s / n.length_squared());
             if inside(foot) {
                 consider((p, foot));
             }
@@ -186,6 +196,44 @@ mod tests {
         }
         // Both cases were met: segments through the triangle and clear of it.
         assert!(crossing > 5 && crossing < 295, "{crossing} crossings");
+    }
+
+    #[test]
+    fn a_needle_is_its_edges() {
+        // Triangles 1–2 cm long whose third corner is on (in f32) or 0.01–1 nm off the line of
+        // the other two, in an object's frame (within 5 cm of its origin): their normals are
+        // f32's rounding. The segment's distance to one is its distance to the edges (the
+        // reference: both sampled densely), never shorter by more than the sampling.
+        let at = Vec3::new(0.03, 0.05, -0.02);
+        let mut slivers = 0;
+        for k in 0..60 {
+            let f = k as f32;
+            let dir = Vec3::new((0.7 * f).cos(), (1.3 * f).sin(), (0.4 * f).cos()).normalize();
+            let side = dir.any_orthonormal_vector();
+            let length = 0.01 + 0.01 * (f * 0.37).fract();
+            let (a, b) = (at, at + dir * length);
+            let off = if k % 2 == 0 { 0.0 } else { 1e-11 * 100f32.powf((f * 0.71).fract()) };
+            let c = a + (b - a) * (0.2 + 0.6 * (f * 0.53).fract()) + side * off;
+            slivers += usize::from(is_sliver([a, b, c]));
+            let up = side.cross(dir) * (0.0005 + 0.002 * (f * 0.29).fract());
+            let (p0, p1) = (at + up - dir * 0.003 + side * 0.001 * (f * 0.17).sin(), at + up + dir * 0.02);
+            let (p, q) = segment_triangle_closest(p0, p1, [a, b, c]);
+            let n = 400;
+            let sample = |u: Vec3, v: Vec3, i: usize| u + (v - u) * (i as f32 / n as f32);
+            let mut reference = f32::MAX;
+            for i in 0..=n {
+                let x = sample(p0, p1, i);
+                for (u, v) in [(a, b), (b, c), (c, a)] {
+                    for j in 0..=n {
+                        reference = reference.min(x.distance(sample(u, v, j)));
+                    }
+                }
+            }
+            // The samples are under 60 µm apart: the exact is under the sampled, by less than that.
+            let exact = p.distance(q);
+            assert!(exact <= reference + 1e-6 && reference - exact <= 1e-4, "case {k}: {exact} m against {reference} m sampled");
+        }
+        assert!(slivers >= 20, "{slivers} of 60 needles are slivers");
     }
 
     #[test]
