@@ -16,7 +16,7 @@
 //! far above any mesh a scene may load.
 
 use glam::Vec3;
-use parry3d::bounding_volume::Aabb;
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::shape::Triangle;
 
 use crate::math::is_sliver;
@@ -101,12 +101,6 @@ impl TriangleTree {
         &self.triangles
     }
 
-    /// The box holding the whole mesh (`None` for a mesh with no triangle).
-    #[must_use]
-    pub fn aabb(&self) -> Option<Aabb> {
-        self.nodes.first().map(|n| n.aabb)
-    }
-
     /// Calls `each` with the index (in [`Self::triangles`]) of every triangle whose box meets
     /// `aabb`.
     pub fn overlapping(&self, aabb: &Aabb, mut each: impl FnMut(u32)) {
@@ -116,16 +110,13 @@ impl TriangleTree {
             depth -= 1;
             let i = stack[depth] as usize;
             let node = &self.nodes[i];
-            if !intersects(&node.aabb, aabb) {
+            if !node.aabb.intersects(aabb) {
                 continue;
             }
             match node.leaf() {
                 Some(range) => {
-                    for t in range {
-                        let tri = &self.triangles[t].triangle;
-                        if intersects(&Aabb::new(tri.a.min(tri.b).min(tri.c), tri.a.max(tri.b).max(tri.c)), aabb) {
-                            each(t as u32);
-                        }
+                    for t in range.filter(|&t| self.triangles[t].triangle.local_aabb().intersects(aabb)) {
+                        each(t as u32);
                     }
                 }
                 None => {
@@ -182,11 +173,6 @@ impl TriangleTree {
         }
         best
     }
-}
-
-/// Whether two boxes meet (touching counts).
-fn intersects(a: &Aabb, b: &Aabb) -> bool {
-    a.mins.cmple(b.maxs).all() && b.mins.cmple(a.maxs).all()
 }
 
 /// Appends the subtree of `triangles` (reordered in place; `offset` is the first one's index
@@ -284,10 +270,7 @@ mod tests {
             let mut found = Vec::new();
             tree.overlapping(&query, |t| found.push(t));
             let reference: Vec<u32> = (0..tree.triangles().len() as u32)
-                .filter(|&t| {
-                    let tri = &tree.triangles()[t as usize].triangle;
-                    intersects(&Aabb::new(tri.a.min(tri.b).min(tri.c), tri.a.max(tri.b).max(tri.c)), &query)
-                })
+                .filter(|&t| tree.triangles()[t as usize].triangle.local_aabb().intersects(&query))
                 .collect();
             found.sort_unstable();
             assert_eq!(found, reference, "query {k}");
