@@ -513,11 +513,17 @@ impl ContactConstraint {
             };
             // Where the closure starts: open, else as last rendered, else the tracked angles
             // (clear after a snap of the wrist); the first whose proxies are clear. When
-            // none is (an object has moved into the finger), the finger stays as last
-            // rendered, the least change, and the physics pushes the object off it.
+            // none is (an object has moved into the finger), the finger takes the one its
+            // proxies overlap the least (by the signed distance a mesh gives; a primitive's
+            // is 0 at any overlap, and then as last rendered, the least change): the physics
+            // pushes a free object off it, but an object let go passes through the fingers
+            // round it (`ScenePhysics::release`), and one settling onto the table turned into
+            // the fingers that stayed, 1 mm under the skin.
             // `checking` is the start being tried (0 open, 1 last rendered, 2 tracked) until
-            // one is clear. A gripping finger starts as last rendered, touching.
+            // one is clear, and `overlap` each one's nearest distance.
+            // A gripping finger starts as last rendered, touching.
             let mut checking = Some(0);
+            let mut overlap = [f32::NEG_INFINITY; 3];
             if gripping {
                 for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                     start[k] = self.previous.angles[i];
@@ -568,9 +574,16 @@ impl ContactConstraint {
                 }
                 if let Some(tried) = checking.take() {
                     if nearest.0 <= STOP_DISTANCE {
-                        let from = if tried == 1 { &self.tracked } else { &self.previous };
+                        overlap[tried] = nearest.0;
+                        // The next start to try; after the last, the least overlapped (ties:
+                        // as last rendered, then open).
+                        let next = if tried < 2 { tried + 1 } else { [1, 0, 2].into_iter().fold(1, |a, b| if overlap[b] > overlap[a] { b } else { a }) };
                         for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                            start[k] = from.angles[i];
+                            start[k] = match next {
+                                0 => 0.0,
+                                1 => self.previous.angles[i],
+                                _ => self.tracked.angles[i],
+                            };
                         }
                         if tried == 2 {
                             break;
