@@ -42,8 +42,8 @@ fn a_small_run_reports_every_measure_and_meets_the_targets() {
 
 /// Issue 28: the teapot set down from the front, tracked as a headset tracks it, turns into
 /// the ring and little fingers round it as it settles on the table (the fingers let it
-/// through, so as not to bat it away); a finger that no start leaves clear takes the one it
-/// overlaps least, not the one as last rendered, which left the skin 1.02 mm in the teapot.
+/// through, so as not to bat it away); a finger that no start leaves clear takes the one the
+/// mesh overlaps least, not the one as last rendered, which left the skin 1.02 mm in it.
 #[test]
 fn the_teapot_set_down_from_the_front_stays_out_of_the_fingers_round_it() {
     let out = bench(&["--json", "--objects", "teapot", "--speeds", "0.5", "--approaches", "front"]);

@@ -67,6 +67,11 @@ const MESH_DISTANCE_SLACK: f32 = 0.01;
 /// mesh would cost more than it saves).
 const MESH_LOOKOUT: f32 = 0.03;
 
+/// How much less a finger's start must overlap a mesh than the finger as last rendered for
+/// the finger to jump to it when no start is clear (m): less would let it flicker between
+/// starts with the tracking's jitter.
+const SWITCH_OVERLAP: f32 = 0.0001;
+
 /// Seconds the rendered wrist may be held back before it jumps to a free tracked pose.
 pub const SNAP_AFTER_S: f64 = 0.5;
 
@@ -513,17 +518,17 @@ impl ContactConstraint {
             };
             // Where the closure starts: open, else as last rendered, else the tracked angles
             // (clear after a snap of the wrist); the first whose proxies are clear. When
-            // none is (an object has moved into the finger), the finger takes the one its
-            // proxies overlap the least (by the signed distance a mesh gives; a primitive's
-            // is 0 at any overlap, and then as last rendered, the least change): the physics
-            // pushes a free object off it, but an object let go passes through the fingers
-            // round it (`ScenePhysics::release`), and one settling onto the table turned into
-            // the fingers that stayed, 1 mm under the skin.
+            // none is (an object has moved into the finger), the finger stays as last
+            // rendered, the least change, and the physics pushes the object off it; but an
+            // object let go passes through the fingers round it (`ScenePhysics::release`),
+            // so where only meshes are that near, whose signed distances tell how deep, the
+            // finger takes the start they overlap clearly the least ([`SWITCH_OVERLAP`]).
             // `checking` is the start being tried (0 open, 1 last rendered, 2 tracked) until
-            // one is clear, and `overlap` each one's nearest distance.
-            // A gripping finger starts as last rendered, touching.
+            // one is clear, and `tried` each one's nearest distance and whether nothing but a
+            // mesh was within the stop distance (a primitive's or the table's reads 0 at any
+            // depth). A gripping finger starts as last rendered, touching.
             let mut checking = Some(0);
-            let mut overlap = [f32::NEG_INFINITY; 3];
+            let mut tried = [(0.0f32, false); 3];
             if gripping {
                 for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                     start[k] = self.previous.angles[i];
@@ -542,6 +547,7 @@ impl ContactConstraint {
                 // bound may have come down to the stop distance: the others cannot stop the
                 // finger here, and their bounds still limit the step.
                 let mut nearest = (f32::INFINITY, 0, usize::MAX);
+                let mut meshes_only = true;
                 let mut step = f32::INFINITY;
                 for ((p, last, levers), (bound, at)) in chain.proxies.iter().zip(chain.bounds.iter_mut()) {
                     if *last < active {
@@ -555,10 +561,11 @@ impl ContactConstraint {
                         let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                         for &o in &self.near {
                             let c = objects.collider(o);
-                            let here = match c.triangles() {
-                                Some(mesh) => self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT),
-                                None => c.distance_at_least(&pose, proxy, STOP_DISTANCE),
+                            let (here, signed) = match c.triangles() {
+                                Some(mesh) => (self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT), true),
+                                None => (c.distance_at_least(&pose, proxy, STOP_DISTANCE), false),
                             };
+                            meshes_only &= signed || here > STOP_DISTANCE;
                             if here < d {
                                 (d, to) = (here, o);
                             }
@@ -572,12 +579,16 @@ impl ContactConstraint {
                         step = step.min(remaining / speed);
                     }
                 }
-                if let Some(tried) = checking.take() {
+                if let Some(this) = checking.take() {
                     if nearest.0 <= STOP_DISTANCE {
-                        overlap[tried] = nearest.0;
-                        // The next start to try; after the last, the least overlapped (ties:
-                        // as last rendered, then open).
-                        let next = if tried < 2 { tried + 1 } else { [1, 0, 2].into_iter().fold(1, |a, b| if overlap[b] > overlap[a] { b } else { a }) };
+                        tried[this] = (nearest.0, meshes_only);
+                        // The next start to try; after the last, as last rendered unless
+                        // another overlaps only meshes, clearly less (the least; ties: open).
+                        let next = match this {
+                            0 | 1 => this + 1,
+                            _ if !tried[1].1 => 1,
+                            _ => [2, 0].into_iter().filter(|&b| tried[b].1 && tried[b].0 > tried[1].0 + SWITCH_OVERLAP).max_by(|&a, &b| tried[a].0.total_cmp(&tried[b].0)).unwrap_or(1),
+                        };
                         for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                             start[k] = match next {
                                 0 => 0.0,
@@ -585,10 +596,10 @@ impl ContactConstraint {
                                 _ => self.tracked.angles[i],
                             };
                         }
-                        if tried == 2 {
+                        if this == 2 {
                             break;
                         }
-                        checking = Some(tried + 1);
+                        checking = Some(this + 1);
                         chain.bounds.fill(UNMEASURED);
                         continue;
                     }
