@@ -1,9 +1,11 @@
 //! The scene's rigid bodies in a rapier world.
 
 use glam::{Affine3A, Quat, Vec3};
-use rapier3d::prelude::{ActiveHooks, ColliderBuilder, ColliderHandle, ColliderSet, PairFilterContext, PhysicsHooks, RigidBodyBuilder, RigidBodyHandle, RigidBodyType, SolverFlags};
+use rapier3d::prelude::{ActiveHooks, Collider, ColliderBuilder, ColliderHandle, ColliderSet, PairFilterContext, PhysicsHooks, RigidBodyBuilder, RigidBodyHandle, RigidBodyType, SolverFlags};
 use rapier3d::pipeline::PhysicsWorld;
 use parry3d::math::Pose;
+use parry3d::bounding_volume::BoundingVolume;
+use parry3d::query::ShapeCastOptions;
 
 use crate::collision::{pose_of, HandProxies, ObjectColliders};
 use crate::scene::Scene;
@@ -37,12 +39,17 @@ const PLACED_RAD: f32 = 1e-6;
 /// m ([`ScenePhysics::release`]).
 const CLEAR_M: f32 = 0.002;
 
-/// The pairs of an object let go and a hand's proxy within [`CLEAR_M`] of it then, which the
-/// solver leaves alone until they are [`CLEAR_M`] apart (rapier asks this filter of every pair
-/// of an object with its hook on).
+/// How far below an object let go its path is searched for proxies in the way, m: a hand's
+/// length, past which no finger round it reaches.
+const DROP_M: f32 = 0.2;
+
+/// The pairs of an object let go and a hand's proxy in its way then ([`in_the_way`]), which
+/// the solver leaves alone until they are clear (rapier asks this filter of every pair of an
+/// object with its hook on).
 struct LetGo {
-    /// The object's collider, the proxy's collider and the proxy's body.
-    pairs: Vec<(ColliderHandle, ColliderHandle, RigidBodyHandle)>,
+    /// The object's collider, the proxy's collider, the proxy's body, and how far apart the
+    /// two are clear, m.
+    pairs: Vec<(ColliderHandle, ColliderHandle, RigidBodyHandle, f32)>,
 }
 
 impl PhysicsHooks for LetGo {
@@ -51,6 +58,22 @@ impl PhysicsHooks for LetGo {
         let pair = |a, b| self.pairs.iter().any(|p| (p.0, p.1) == (a, b));
         (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then(SolverFlags::default)
     }
+}
+
+/// Whether hand proxy `proxy` is in the way of object `object` settling from the hand: within
+/// [`CLEAR_M`] of it, or of it moved `drop` straight down. If so, how far apart they are clear
+/// (and meet again), m: [`CLEAR_M`], or the gap now plus [`CLEAR_M`] for a proxy below it.
+fn in_the_way(colliders: &ColliderSet, object: ColliderHandle, proxy: ColliderHandle, drop: f32) -> Option<f32> {
+    let (a, b) = (&colliders[object], &colliders[proxy]);
+    let gap = parry3d::query::distance(a.position(), a.shape(), b.position(), b.shape()).ok()?.distance;
+    if gap < CLEAR_M {
+        return Some(CLEAR_M);
+    }
+    // Cast only from apart: parry finds a cast that starts within the target distance by a
+    // penetration query, which allocates.
+    let options = ShapeCastOptions { max_time_of_impact: drop, target_distance: CLEAR_M, ..ShapeCastOptions::default() };
+    let hit = parry3d::query::cast_shapes(a.position(), Vec3::NEG_Y, a.shape(), b.position(), Vec3::ZERO, b.shape(), options);
+    hit.ok().flatten().map(|_| gap + CLEAR_M)
 }
 
 /// Whether colliders `a` and `b` of `colliders` are nearer than `gap` (overlapping ones are 0 apart).
@@ -179,6 +202,23 @@ impl ScenePhysics {
         }
     }
 
+    /// How far object collider `object` can fall straight down before it meets anything but a
+    /// hand, m (at most [`DROP_M`]).
+    fn drop_height(&self, object: ColliderHandle) -> f32 {
+        let o = &self.world.colliders[object];
+        let mut path = o.compute_aabb();
+        path.mins.y -= DROP_M;
+        let hand = |h: ColliderHandle| self.hands.iter().flatten().any(|p| p.2 == h);
+        let below = |&(h, c): &(ColliderHandle, &Collider)| h != object && !hand(h) && c.compute_aabb().intersects(&path);
+        let options = ShapeCastOptions::with_max_time_of_impact(DROP_M);
+        // As in `in_the_way`: cast only from apart (an object resting on the table falls 0).
+        let down = |(_, c): (ColliderHandle, &Collider)| match parry3d::query::distance(o.position(), o.shape(), c.position(), c.shape()) {
+            Ok(d) if d.distance <= 0.0 => Some(0.0),
+            _ => parry3d::query::cast_shapes(o.position(), Vec3::NEG_Y, o.shape(), c.position(), Vec3::ZERO, c.shape(), options).ok().flatten().map(|hit| hit.time_of_impact),
+        };
+        self.world.colliders.iter().filter(below).filter_map(down).fold(DROP_M, f32::min)
+    }
+
     /// Object `i`'s pose: rotation and translation.
     #[must_use]
     pub fn pose(&self, i: usize) -> (Quat, Vec3) {
@@ -211,13 +251,17 @@ impl ScenePhysics {
     /// grasp held it kinematically): the solver would push them apart, and an object settling
     /// past them would be nudged away (a ball set down by a still hand rolled 21 mm, by a
     /// headset-tracked one 30 cm). So each proxy within [`CLEAR_M`] of it passes through it
-    /// until they are [`CLEAR_M`] apart ([`Self::step`]); the other proxies still hold it off.
-    /// The rendered hand stops at it whatever the physics does (the contact constraint).
+    /// until they are [`CLEAR_M`] apart ([`Self::step`]), and so does each proxy below it in
+    /// the path it may fall before anything else stops it ([`Self::drop_height`]): a ball
+    /// let go 8 mm above the table by a headset-tracked hand landed on the little finger 4.5
+    /// mm below it and rolled 23 cm away. The other proxies still hold it off. The rendered
+    /// hand stops at it whatever the physics does (the contact constraint).
     pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3) {
         let object = self.colliders[i];
+        let drop = self.drop_height(object);
         for &(body, _, proxy) in self.hands.iter().flatten() {
-            if self.world.bodies[body].is_enabled() && nearer(&self.world.colliders, object, proxy, CLEAR_M) {
-                self.let_go.pairs.push((object, proxy, body));
+            if let Some(gap) = self.world.bodies[body].is_enabled().then(|| in_the_way(&self.world.colliders, object, proxy, drop)).flatten() {
+                self.let_go.pairs.push((object, proxy, body, gap));
             }
         }
         // The filter is asked only while the object has such pairs (rapier allocates more
@@ -260,7 +304,7 @@ impl ScenePhysics {
         self.world.step_with_events(&self.let_go, &());
         if !self.let_go.pairs.is_empty() {
             let (colliders, bodies) = (&self.world.colliders, &self.world.bodies);
-            self.let_go.pairs.retain(|&(object, proxy, body)| bodies[body].is_enabled() && nearer(colliders, object, proxy, CLEAR_M));
+            self.let_go.pairs.retain(|&(object, proxy, body, gap)| bodies[body].is_enabled() && nearer(colliders, object, proxy, gap));
             self.unhook();
         }
         self.returned.clear();
