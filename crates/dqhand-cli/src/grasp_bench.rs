@@ -297,7 +297,7 @@ fn report(runs: &[Run], lags: &[LagScore]) -> Value {
                 "object": r.object, "kind": r.kind.name(), "hands": r.kind.hands(),
                 "approach": r.approach, "speed_m_s": r.speed, "headset": r.headset, "success": r.score.success, "place_error_mm": mm(r.score.place_error_m),
                 "max_penetration_mm": mm(r.score.max_penetration_m), "mean_penetration_mm": mm(r.score.mean_penetration_m), "held_penetration_mm": mm(r.score.held_penetration_m),
-                "slip_mm": mm(r.score.slip_m), "slip_deg": (f64::from(r.score.slip_deg) * 100.0).round() / 100.0, "carry_lag_mm": mm(r.score.carry_lag_m), "release_drift_mm": mm(r.score.release_drift_m), "release_frames": r.score.release_frames, "tunnelled": r.score.tunnelled, "step_us": us(steps),
+                "slip_mm": mm(r.score.slip_m), "slip_deg": (f64::from(r.score.slip_deg) * 100.0).round() / 100.0, "carry_lag_mm": mm(r.score.carry_lag_m), "release_drift_mm": mm(r.score.release_drift_m), "release_frames": r.score.release_frames, "tunnelled": r.score.tunnelled, "finger_jumps": r.score.finger_jumps, "step_us": us(steps),
             })
         })
         .collect();
@@ -313,6 +313,7 @@ fn report(runs: &[Run], lags: &[LagScore]) -> Value {
         "drift_pass": drift(Kind::Drop) <= DRIFT_TARGET_M && runs.iter().any(|r| r.kind == Kind::Drop) && runs.iter().filter(|r| r.kind == Kind::Drop).all(|r| r.score.release_frames.is_some()),
         "release_frames": Distribution::of(&mut latency),
         "tunnelled": tunnelled, "tunnelling_pass": tunnelled == 0,
+        "finger_jumps": runs.iter().map(|r| r.score.finger_jumps).sum::<u32>(), "runs_with_finger_jumps": runs.iter().filter(|r| r.score.finger_jumps > 0).count(),
         "step_us": us(Distribution::of(&mut all_steps)), "teapot_step_us": us(teapot), "teapot_step_pass": teapot.is_some_and(|d| d.median * 1e6 <= STEP_TARGET_US),
         "worst_step_p99_us_per_hand": worst_p99 * 1e6, "step_p99_pass": worst_p99 * 1e6 <= STEP_P99_TARGET_US,
         "two_hand_runs": runs.iter().filter(|r| r.kind.hands() == 2).count(), "two_hand_successes": runs.iter().filter(|r| r.kind.hands() == 2 && r.score.success).count(),
@@ -336,12 +337,12 @@ fn print_tables(r: &Value) {
     }
     println!();
     println!(
-        "{:<8} {:<8} {:<6} {:>6} {:>8} {:>8} {:>10} {:>10} {:>8} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>10} {:>10}",
-        "object", "kind", "from", "m/s", "tracking", "success", "place mm", "pen. mm", "mean mm", "held mm", "slip mm", "slip °", "drift mm", "release", "tunnelled", "step µs", "p99 µs"
+        "{:<8} {:<8} {:<6} {:>6} {:>8} {:>8} {:>10} {:>10} {:>8} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>6} {:>10} {:>10}",
+        "object", "kind", "from", "m/s", "tracking", "success", "place mm", "pen. mm", "mean mm", "held mm", "slip mm", "slip °", "drift mm", "release", "tunnelled", "jumps", "step µs", "p99 µs"
     );
     for run in r["runs"].as_array().into_iter().flatten() {
         println!(
-            "{:<8} {:<8} {:<6} {:>6} {:>8} {:>8} {:>10.1} {:>10.2} {:>8.2} {:>9.2} {:>8.2} {:>7.2} {:>9.1} {:>9} {:>10} {:>10.0} {:>10.0}",
+            "{:<8} {:<8} {:<6} {:>6} {:>8} {:>8} {:>10.1} {:>10.2} {:>8.2} {:>9.2} {:>8.2} {:>7.2} {:>9.1} {:>9} {:>10} {:>6} {:>10.0} {:>10.0}",
             run["object"].as_str().unwrap_or_default(),
             run["kind"].as_str().unwrap_or_default(),
             run["approach"].as_str().unwrap_or_default(),
@@ -357,6 +358,7 @@ fn print_tables(r: &Value) {
             f(&run["release_drift_mm"]),
             run["release_frames"].as_u64().map_or_else(|| "-".to_owned(), |x| x.to_string()),
             if run["tunnelled"] == true { "YES" } else { "no" },
+            run["finger_jumps"].as_u64().unwrap_or_default(),
             f(&run["step_us"]["median"]),
             f(&run["step_us"]["p99"]),
         );
@@ -375,6 +377,7 @@ fn print_tables(r: &Value) {
     println!("rendered skin penetration ≤ 1 mm         {:>6.2} mm (mean {:.2})  {}", f(&r["max_penetration_mm"]), f(&r["mean_penetration_mm"]), pass(&r["penetration_pass"]));
     println!("slip over the 0.5 m carry ≤ 3 mm         {:>6.2} mm     {}", f(&r["max_slip_mm"]), pass(&r["slip_pass"]));
     println!("tunnelling, up to 10 m/s: none           {:>6} runs   {}", r["tunnelled"], pass(&r["tunnelling_pass"]));
+    println!("rendered fingers jumping where the tracked ones did not (> 0.15 rad and 3× theirs in a frame): {} times in {} runs", r["finger_jumps"], r["runs_with_finger_jumps"]);
     println!("no hiccups: every run's p99 frame ≤ 1 ms a hand  {:>6.0} µs     {}", f(&r["worst_step_p99_us_per_hand"]), pass(&r["step_p99_pass"]));
     println!("(success also needs the rendered skin no deeper than 1 mm in the held object on every held frame; two hands: {}/{} runs)", r["two_hand_successes"], r["two_hand_runs"]);
     println!("(headset: 2 mm joint jitter, 1 % of records lost, 30 ms behind; every grasp from every approach at 0.5 m/s, and the drops)");

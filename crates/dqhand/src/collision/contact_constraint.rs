@@ -150,6 +150,8 @@ pub struct ContactConstraint {
     /// Per finger: how many of its leading closing joints its last closure stopped on contacts
     /// with the held object.
     held_prefix: [usize; 5],
+    /// Per finger: whether its last closure reached the tracked angles untouched.
+    free: [bool; 5],
     /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
     /// small to cast add up to [`STILL_M`] at most.
     uncast: f32,
@@ -245,6 +247,7 @@ impl ContactConstraint {
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
             held_prefix: [0; 5],
+            free: [false; 5],
             uncast: 0.0,
             moved_by,
             proxies,
@@ -274,6 +277,7 @@ impl ContactConstraint {
         self.carried = None;
         self.contacts.clear();
         self.held_prefix = [0; 5];
+        self.free = [false; 5];
         self.uncast = 0.0;
     }
 
@@ -486,6 +490,7 @@ impl ContactConstraint {
             for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
                 self.rendered.angles[i] = self.previous.angles[i];
             }
+            self.free[f] = false;
             self.fingers[f] = chain;
             return;
         }
@@ -523,12 +528,24 @@ impl ContactConstraint {
             // object let go passes through the fingers round it (`ScenePhysics::release`),
             // so where only meshes are that near, whose signed distances tell how deep, the
             // finger takes the start they overlap clearly the least ([`SWITCH_OVERLAP`]).
-            // `checking` is the start being tried (0 open, 1 last rendered, 2 tracked) until
-            // one is clear, and `tried` each one's nearest distance and whether nothing but a
-            // mesh was within the stop distance (a primitive's or the table's reads 0 at any
-            // depth). A gripping finger starts as last rendered, touching.
+            // A finger of a hand holding something that reached the tracked angles untouched
+            // last frame tries as last rendered first: from open it would meet the object on
+            // its way to angles clear of it, and flicker between the two every other frame
+            // (the little finger curled under a ball held from above). Not while nothing is
+            // held: closing from where they were drawn let the 4 cm ball through the fingers
+            // on the approach. The starts are kinds 0 (open), 1 (last rendered) and 2
+            // (tracked), tried in `order`; `checking` is the place in `order` of the one being
+            // tried until one is clear, and `tried` holds per kind its nearest distance and
+            // whether nothing but a mesh was within the stop distance (a primitive's or the
+            // table's reads 0 at any depth). A gripping finger starts as last rendered,
+            // touching.
+            let free = self.free[f] && held.is_some();
+            let order = if free { [1, 0, 2] } else { [0, 1, 2] };
             let mut checking = Some(0);
             let mut tried = [(0.0f32, false); 3];
+            for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                start[k] = if free { self.previous.angles[i] } else { 0.0 };
+            }
             if gripping {
                 for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                     start[k] = self.previous.angles[i];
@@ -579,13 +596,13 @@ impl ContactConstraint {
                         step = step.min(remaining / speed);
                     }
                 }
-                if let Some(this) = checking.take() {
+                if let Some(at) = checking.take() {
                     if nearest.0 <= STOP_DISTANCE {
-                        tried[this] = (nearest.0, meshes_only);
+                        tried[order[at]] = (nearest.0, meshes_only);
                         // The next start to try; after the last, as last rendered unless
                         // another overlaps only meshes, clearly less (the least; ties: open).
-                        let next = match this {
-                            0 | 1 => this + 1,
+                        let next = match at {
+                            0 | 1 => order[at + 1],
                             _ if !tried[1].1 => 1,
                             _ => [2, 0].into_iter().filter(|&b| tried[b].1 && tried[b].0 > tried[1].0 + SWITCH_OVERLAP).max_by(|&a, &b| tried[a].0.total_cmp(&tried[b].0)).unwrap_or(1),
                         };
@@ -596,10 +613,10 @@ impl ContactConstraint {
                                 _ => self.tracked.angles[i],
                             };
                         }
-                        if this == 2 {
+                        if at == 2 {
                             break;
                         }
-                        checking = Some(this + 1);
+                        checking = Some(at + 1);
                         chain.bounds.fill(UNMEASURED);
                         continue;
                     }
@@ -634,6 +651,7 @@ impl ContactConstraint {
             prefix = 0;
         }
         self.held_prefix[f] = prefix;
+        self.free[f] = self.near.is_empty() || (active == 0 && s >= 1.0);
         self.fingers[f] = chain;
     }
 

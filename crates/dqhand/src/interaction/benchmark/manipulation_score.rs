@@ -17,7 +17,7 @@ use parry3d::bounding_volume::Aabb;
 use parry3d::query::Ray;
 use serde::Serialize;
 
-use crate::collision::{ObjectCollider, ObjectColliders};
+use crate::collision::{Closure, ObjectCollider, ObjectColliders};
 use crate::geometry::winding_number;
 use crate::grasp::GraspEvent;
 use crate::interaction::grasp_script::{Script, RATE_HZ};
@@ -35,6 +35,9 @@ pub const HELD_DEPTH_M: f32 = 0.001;
 /// is too slow for every vertex of every frame, and skin deeper than this would have crossed
 /// the surface within it on its way in (the palm-crossing check counts a hand gone further).
 pub const MESH_DEPTH_RANGE_M: f32 = 0.01;
+
+/// The least change of a rendered finger's closure in one frame that counts as a jump (rad).
+pub const JUMP_RAD: f32 = 0.15;
 
 /// A mesh's vertex positions and flat triangle indices, as the winding number reads them.
 pub type FlatMesh = (Vec<[f32; 3]>, Vec<u32>);
@@ -72,6 +75,10 @@ pub struct RunScore {
     /// The rendered palm's centre or a finger's last phalanx crossed the surface of an object
     /// it did not hold between two frames.
     pub tunnelled: bool,
+    /// How many times a rendered finger jumped in one frame where the tracked finger did not:
+    /// its closure (the sum of its closing angles) changed by more than [`JUMP_RAD`] and
+    /// three times the tracked finger's change. A flicker between two poses counts each frame.
+    pub finger_jumps: u32,
     /// Seconds each frame's [`ManipulationLoop::step`] took (collision, grasp, physics; every
     /// hand's).
     #[serde(skip)]
@@ -135,6 +142,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
         release_drift_m: 0.0,
         release_frames: None,
         tunnelled: false,
+        finger_jumps: 0,
         step_s: Vec::with_capacity(script.records.len()),
     };
     let (mut grasped_before_carry, mut held_through_carry) = (false, true);
@@ -147,6 +155,7 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
     let mut let_go: Option<Vec3> = None;
     let mut fallen: Option<Vec3> = None;
     let mut rendered_points: Vec<Option<[Vec3; TIPS.len() + 1]>> = vec![None; manip.hands().len()];
+    let mut closures: Vec<Option<[Closure; 5]>> = vec![None; manip.hands().len()];
     let mut skin: Vec<[f32; 3]> = Vec::new();
     let mut next = 0;
     while next < script.records.len() {
@@ -232,6 +241,14 @@ pub fn score(manip: &mut ManipulationLoop, script: &Script, object: usize, carri
             }
             if let Some(last) = rendered_points[k].replace(now) {
                 score.tunnelled |= last.iter().zip(&now).any(|(a, b)| crossed(manip.objects(), hand.held(), *a, *b));
+            }
+            let closure = *hand.constraint().closure();
+            if let Some(last) = closures[k].replace(closure) {
+                let jumped = |(a, b): (&Closure, &Closure)| {
+                    let rendered = (b.rendered - a.rendered).abs();
+                    rendered > JUMP_RAD && rendered > 3.0 * (b.tracked - a.tracked).abs()
+                };
+                score.finger_jumps += last.iter().zip(&closure).filter(|&p| jumped(p)).count() as u32;
             }
             rendered_skin[k].deform(hand.rendered().layer());
             skin.extend_from_slice(rendered_skin[k].deformed(Method::Dqb).expect("DQB is the set").positions());
