@@ -257,7 +257,7 @@ fn a_dropped_ball_bounces_and_rests_on_the_table_a_thrown_one_flies() {
     // Held 20 cm above the table and thrown sideways at 2 m/s.
     physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.95, 0.0));
     physics.step(1.0 / 60.0);
-    physics.release(0, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO);
+    physics.release(0, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO, &[]);
     physics.step(1.0 / 60.0);
     let (p, v) = (physics.pose(0).1, physics.velocity(0).0);
     assert!((v.x - 2.0).abs() < 0.05 && p.x > 0.02, "keeps the hand's velocity: {v} at {p}");
@@ -293,7 +293,7 @@ fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
         }
         physics.hold(0, glam::Quat::IDENTITY, Vec3::new(0.0, 0.74, 0.0));
         physics.step(1.0 / 60.0);
-        physics.release(0, Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO);
+        physics.release(0, Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO, &[]);
         let mut deepest = 0.0f32;
         for _ in 0..60 {
             if with_hand {
@@ -431,7 +431,7 @@ fn the_floor_stops_a_falling_ball_and_one_thrown_out_of_reach_is_put_back() {
     let mut physics = ScenePhysics::new(&scene, &objects);
     physics.hold(0, glam::Quat::IDENTITY, scene.objects[0].position + Vec3::Y * 0.05);
     physics.step(1.0 / 60.0);
-    physics.release(0, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO); // off the table's front edge
+    physics.release(0, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, &[]); // off the table's front edge
     for _ in 0..180 {
         physics.step(1.0 / 60.0);
         assert!(physics.returned().is_empty());
@@ -442,7 +442,7 @@ fn the_floor_stops_a_falling_ball_and_one_thrown_out_of_reach_is_put_back() {
     let mut physics = ScenePhysics::new(&scene, &objects);
     physics.hold(0, glam::Quat::IDENTITY, scene.objects[0].position + Vec3::Y * 0.05);
     physics.step(1.0 / 60.0);
-    physics.release(0, Vec3::new(30.0, 3.0, 0.0), Vec3::ZERO);
+    physics.release(0, Vec3::new(30.0, 3.0, 0.0), Vec3::ZERO, &[]);
     let returned = (0..120).find(|_| {
         physics.step(1.0 / 60.0);
         physics.returned() == [0]

@@ -61,25 +61,31 @@ impl PhysicsHooks for LetGo {
 }
 
 /// Whether hand proxy `proxy` is in the way of object `object` settling from the hand: within
-/// [`CLEAR_M`] of it, or of it moved `drop` straight down. If so, how far apart they are clear
-/// (and meet again), m: [`CLEAR_M`], or the gap now plus [`CLEAR_M`] for a proxy below it.
+/// [`CLEAR_M`] of it, or, with `drop` above 0, of it moved `drop` straight down. If so, how
+/// far apart they are clear (and meet again), m: [`CLEAR_M`], or for a proxy below it the gap
+/// now plus [`CLEAR_M`], which [`ScenePhysics::step`] narrows to their nearest since plus
+/// [`CLEAR_M`]. The proxy is where the last step put it: its body's pose this frame, which the
+/// next step moves it to, let more fingers through, and the teapot set down from the front,
+/// headset-tracked, settled 1.46 mm into them (0.80 mm so).
 fn in_the_way(colliders: &ColliderSet, object: ColliderHandle, proxy: ColliderHandle, drop: f32) -> Option<f32> {
     let (a, b) = (&colliders[object], &colliders[proxy]);
-    let gap = parry3d::query::distance(a.position(), a.shape(), b.position(), b.shape()).ok()?.distance;
+    let (at, b) = (b.position(), b.shape());
+    let gap = parry3d::query::distance(a.position(), a.shape(), at, b).ok()?.distance;
     if gap < CLEAR_M {
         return Some(CLEAR_M);
     }
-    // Cast only from apart: parry finds a cast that starts within the target distance by a
-    // penetration query, which allocates.
+    // Cast only from apart: parry answers a cast that starts within the target distance with a
+    // contact query, a penetration query (which allocates) where the shapes overlap.
     let options = ShapeCastOptions { max_time_of_impact: drop, target_distance: CLEAR_M, ..ShapeCastOptions::default() };
-    let hit = parry3d::query::cast_shapes(a.position(), Vec3::NEG_Y, a.shape(), b.position(), Vec3::ZERO, b.shape(), options);
-    hit.ok().flatten().map(|_| gap + CLEAR_M)
+    let hit = (drop > 0.0).then(|| parry3d::query::cast_shapes(a.position(), Vec3::NEG_Y, a.shape(), at, Vec3::ZERO, b, options));
+    hit?.ok().flatten().map(|_| gap + CLEAR_M)
 }
 
-/// Whether colliders `a` and `b` of `colliders` are nearer than `gap` (overlapping ones are 0 apart).
-fn nearer(colliders: &ColliderSet, a: ColliderHandle, b: ColliderHandle, gap: f32) -> bool {
+/// How far apart colliders `a` and `b` of `colliders` are (0 where they overlap; infinite
+/// where parry cannot tell).
+fn distance(colliders: &ColliderSet, a: ColliderHandle, b: ColliderHandle) -> f32 {
     let (a, b) = (&colliders[a], &colliders[b]);
-    parry3d::query::distance(a.position(), a.shape(), b.position(), b.shape()).is_ok_and(|d| d.distance < gap)
+    parry3d::query::distance(a.position(), a.shape(), b.position(), b.shape()).map_or(f32::INFINITY, |d| d.distance)
 }
 
 /// Whether `a` and `b` are within [`PLACED_M`] and [`PLACED_RAD`] of each other.
@@ -203,7 +209,8 @@ impl ScenePhysics {
     }
 
     /// How far object collider `object` can fall straight down before it meets anything but a
-    /// hand, m (at most [`DROP_M`]).
+    /// hand, m (at most [`DROP_M`]); 0 where it touches anything (it rests on it, or the
+    /// proxies within [`CLEAR_M`] are all that is let through).
     fn drop_height(&self, object: ColliderHandle) -> f32 {
         let o = &self.world.colliders[object];
         let mut path = o.compute_aabb();
@@ -251,17 +258,21 @@ impl ScenePhysics {
     /// grasp held it kinematically): the solver would push them apart, and an object settling
     /// past them would be nudged away (a ball set down by a still hand rolled 21 mm, by a
     /// headset-tracked one 30 cm). So each proxy within [`CLEAR_M`] of it passes through it
-    /// until they are [`CLEAR_M`] apart ([`Self::step`]), and so does each proxy below it in
-    /// the path it may fall before anything else stops it ([`Self::drop_height`]): a ball
-    /// let go 8 mm above the table by a headset-tracked hand landed on the little finger 4.5
-    /// mm below it and rolled 23 cm away. The other proxies still hold it off. The rendered
+    /// until they are [`CLEAR_M`] apart ([`Self::step`]), and so does each proxy of the hands
+    /// letting go, `by` (their indices), below it in the path it may fall before anything else
+    /// stops it ([`Self::drop_height`]): a ball let go 8 mm above the table by a
+    /// headset-tracked hand landed on the little finger 4.5 mm below it and rolled 23 cm away.
+    /// The other proxies still hold it off (another hand under it catches it). The rendered
     /// hand stops at it whatever the physics does (the contact constraint).
-    pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3) {
+    pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3, by: &[usize]) {
         let object = self.colliders[i];
         let drop = self.drop_height(object);
-        for &(body, _, proxy) in self.hands.iter().flatten() {
-            if let Some(gap) = self.world.bodies[body].is_enabled().then(|| in_the_way(&self.world.colliders, object, proxy, drop)).flatten() {
-                self.let_go.pairs.push((object, proxy, body, gap));
+        for (h, hand) in self.hands.iter().enumerate() {
+            let drop = if by.contains(&h) { drop } else { 0.0 };
+            for &(body, _, proxy) in hand {
+                if let Some(gap) = self.world.bodies[body].is_enabled().then(|| in_the_way(&self.world.colliders, object, proxy, drop)).flatten() {
+                    self.let_go.pairs.push((object, proxy, body, gap));
+                }
             }
         }
         // The filter is asked only while the object has such pairs (rapier allocates more
@@ -304,7 +315,13 @@ impl ScenePhysics {
         self.world.step_with_events(&self.let_go, &());
         if !self.let_go.pairs.is_empty() {
             let (colliders, bodies) = (&self.world.colliders, &self.world.bodies);
-            self.let_go.pairs.retain(|&(object, proxy, body, gap)| bodies[body].is_enabled() && nearer(colliders, object, proxy, gap));
+            // A pair ends once the two are CLEAR_M farther apart than their nearest since the
+            // release: the object has passed the proxy, or come to rest beside it.
+            self.let_go.pairs.retain_mut(|(object, proxy, body, gap)| {
+                let d = distance(colliders, *object, *proxy);
+                *gap = gap.min(d + CLEAR_M);
+                bodies[*body].is_enabled() && d < *gap
+            });
             self.unhook();
         }
         self.returned.clear();
