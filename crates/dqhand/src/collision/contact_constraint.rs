@@ -543,9 +543,7 @@ impl ContactConstraint {
             let order = if free { [1, 0, 2] } else { [0, 1, 2] };
             let mut checking = Some(0);
             let mut tried = [(0.0f32, false); 3];
-            for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                start[k] = if free { self.previous.angles[i] } else { 0.0 };
-            }
+            starting_angles(order[0], &chain.dofs, &self.previous, &self.tracked, &mut start);
             if gripping {
                 for (k, &(i, _)) in chain.dofs.iter().enumerate() {
                     start[k] = self.previous.angles[i];
@@ -606,13 +604,7 @@ impl ContactConstraint {
                             _ if !tried[1].1 => 1,
                             _ => [2, 0].into_iter().filter(|&b| tried[b].1 && tried[b].0 > tried[1].0 + SWITCH_OVERLAP).max_by(|&a, &b| tried[a].0.total_cmp(&tried[b].0)).unwrap_or(1),
                         };
-                        for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                            start[k] = match next {
-                                0 => 0.0,
-                                1 => self.previous.angles[i],
-                                _ => self.tracked.angles[i],
-                            };
-                        }
+                        starting_angles(next, &chain.dofs, &self.previous, &self.tracked, &mut start);
                         if at == 2 {
                             break;
                         }
@@ -729,6 +721,18 @@ impl ContactConstraint {
     #[must_use]
     pub fn closure(&self) -> &[Closure; 5] {
         &self.closure
+    }
+}
+
+/// A finger's closing angles (`dofs`' pose indices) at start `kind` of its closure: 0 open,
+/// 1 as last rendered (`previous`), 2 the tracked angles.
+fn starting_angles(kind: usize, dofs: &[(usize, usize)], previous: &Pose, tracked: &Pose, start: &mut [f32; 4]) {
+    for (k, &(i, _)) in dofs.iter().enumerate() {
+        start[k] = match kind {
+            0 => 0.0,
+            1 => previous.angles[i],
+            _ => tracked.angles[i],
+        };
     }
 }
 

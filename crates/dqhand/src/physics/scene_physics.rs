@@ -68,17 +68,22 @@ impl PhysicsHooks for LetGo {
 /// next step moves it to, let more fingers through, and the teapot set down from the front,
 /// headset-tracked, settled 1.46 mm into them (0.80 mm so).
 fn in_the_way(colliders: &ColliderSet, object: ColliderHandle, proxy: ColliderHandle, drop: f32) -> Option<f32> {
-    let (a, b) = (&colliders[object], &colliders[proxy]);
-    let (at, b) = (b.position(), b.shape());
-    let gap = parry3d::query::distance(a.position(), a.shape(), at, b).ok()?.distance;
+    let gap = distance(colliders, object, proxy);
     if gap < CLEAR_M {
         return Some(CLEAR_M);
     }
-    // Cast only from apart: parry answers a cast that starts within the target distance with a
-    // contact query, a penetration query (which allocates) where the shapes overlap.
-    let options = ShapeCastOptions { max_time_of_impact: drop, target_distance: CLEAR_M, ..ShapeCastOptions::default() };
-    let hit = (drop > 0.0).then(|| parry3d::query::cast_shapes(a.position(), Vec3::NEG_Y, a.shape(), at, Vec3::ZERO, b, options));
-    hit?.ok().flatten().map(|_| gap + CLEAR_M)
+    (drop > 0.0 && falls_onto(colliders, object, proxy, CLEAR_M, drop).is_some()).then_some(gap + CLEAR_M)
+}
+
+/// How far collider `object` moves straight down before it comes within `target` of collider
+/// `other`, if it does within `drop` (m). Only from apart: parry answers a cast that starts
+/// within the target distance with a contact query, a penetration query (which allocates)
+/// where the shapes overlap.
+fn falls_onto(colliders: &ColliderSet, object: ColliderHandle, other: ColliderHandle, target: f32, drop: f32) -> Option<f32> {
+    let (a, b) = (&colliders[object], &colliders[other]);
+    let options = ShapeCastOptions { max_time_of_impact: drop, target_distance: target, ..ShapeCastOptions::default() };
+    let hit = parry3d::query::cast_shapes(a.position(), Vec3::NEG_Y, a.shape(), b.position(), Vec3::ZERO, b.shape(), options);
+    hit.ok().flatten().map(|hit| hit.time_of_impact)
 }
 
 /// How far apart colliders `a` and `b` of `colliders` are (0 where they overlap; infinite
@@ -212,18 +217,14 @@ impl ScenePhysics {
     /// hand, m (at most [`DROP_M`]); 0 where it touches anything (it rests on it, or the
     /// proxies within [`CLEAR_M`] are all that is let through).
     fn drop_height(&self, object: ColliderHandle) -> f32 {
-        let o = &self.world.colliders[object];
-        let mut path = o.compute_aabb();
+        let colliders = &self.world.colliders;
+        let mut path = colliders[object].compute_aabb();
         path.mins.y -= DROP_M;
         let hand = |h: ColliderHandle| self.hands.iter().flatten().any(|p| p.2 == h);
         let below = |&(h, c): &(ColliderHandle, &Collider)| h != object && !hand(h) && c.compute_aabb().intersects(&path);
-        let options = ShapeCastOptions::with_max_time_of_impact(DROP_M);
-        // As in `in_the_way`: cast only from apart (an object resting on the table falls 0).
-        let down = |(_, c): (ColliderHandle, &Collider)| match parry3d::query::distance(o.position(), o.shape(), c.position(), c.shape()) {
-            Ok(d) if d.distance <= 0.0 => Some(0.0),
-            _ => parry3d::query::cast_shapes(o.position(), Vec3::NEG_Y, o.shape(), c.position(), Vec3::ZERO, c.shape(), options).ok().flatten().map(|hit| hit.time_of_impact),
-        };
-        self.world.colliders.iter().filter(below).filter_map(down).fold(DROP_M, f32::min)
+        // Cast only from apart (`falls_onto`): an object touching something falls 0.
+        let down = |(h, _): (ColliderHandle, &Collider)| if distance(colliders, object, h) <= 0.0 { Some(0.0) } else { falls_onto(colliders, object, h, 0.0, DROP_M) };
+        colliders.iter().filter(below).filter_map(down).fold(DROP_M, f32::min)
     }
 
     /// Object `i`'s pose: rotation and translation.
@@ -266,7 +267,7 @@ impl ScenePhysics {
     /// hand stops at it whatever the physics does (the contact constraint).
     pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3, by: &[usize]) {
         let object = self.colliders[i];
-        let drop = self.drop_height(object);
+        let drop = if by.is_empty() { 0.0 } else { self.drop_height(object) };
         for (h, hand) in self.hands.iter().enumerate() {
             let drop = if by.contains(&h) { drop } else { 0.0 };
             for &(body, _, proxy) in hand {
