@@ -77,6 +77,18 @@ pub struct ManipulationLoop {
     reset_due: bool,
 }
 
+/// An object let go this frame: the sums of the velocities its hands gave it, how many of
+/// them moved it, and the physics' indices of the hands letting go of it.
+#[derive(Clone, Copy)]
+struct LetGo {
+    object: usize,
+    linvel: Vec3,
+    angvel: Vec3,
+    moved: f32,
+    hands: [usize; 2],
+    count: usize,
+}
+
 impl ManipulationLoop {
     /// A loop posing `model` with `joint_model` from records (as [`GestureLoop::new`]) in
     /// `scene`: one hand, which records of either side drive (the other side mirrored, as
@@ -273,26 +285,27 @@ impl ManipulationLoop {
     /// no hand holds any more leaves with the velocity its hands gave it (the mean of those
     /// that moved it: a still or lost hand gives none, and must not halve the other's throw).
     fn apply(&mut self, events: &HandEvents) {
-        // Per object let go: the sums of the velocities given, how many hands moved it, and
-        // the physics' indices of the hands letting go of it.
-        let mut released: [Option<(usize, Vec3, Vec3, f32, [usize; 2], usize)>; 2] = [None; 2];
+        let mut released: [Option<LetGo>; 2] = [None; 2];
         for (k, event) in events.iter() {
             match event {
                 GraspEvent::Grasp { object } => self.hands[k].constraint.grip(object, &self.objects.objects()[object].pose),
                 GraspEvent::Release { object, linvel, angvel } if self.hands.iter().all(|h| h.grasp.held() != Some(object)) => {
                     let moved = f32::from(u8::from(linvel != Vec3::ZERO));
                     let hand = self.hands[k].physics;
-                    match released.iter_mut().flatten().find(|r| r.0 == object) {
-                        Some(r) => *r = (object, r.1 + linvel, r.2 + angvel, r.3 + moved, [r.4[0], hand], 2),
-                        None => released[k] = Some((object, linvel, angvel, moved, [hand; 2], 1)),
+                    match released.iter_mut().flatten().find(|r| r.object == object) {
+                        Some(r) => {
+                            (r.linvel, r.angvel, r.moved) = (r.linvel + linvel, r.angvel + angvel, r.moved + moved);
+                            (r.hands[1], r.count) = (hand, 2);
+                        }
+                        None => released[k] = Some(LetGo { object, linvel, angvel, moved, hands: [hand; 2], count: 1 }),
                     }
                 }
                 GraspEvent::Release { .. } => {}
             }
         }
-        for (object, linvel, angvel, n, hands, count) in released.into_iter().flatten() {
-            let n = n.max(1.0);
-            self.physics.release(object, linvel / n, angvel / n, &hands[..count]);
+        for r in released.into_iter().flatten() {
+            let n = r.moved.max(1.0);
+            self.physics.release(r.object, r.linvel / n, r.angvel / n, &r.hands[..r.count]);
         }
         for hand in &self.hands {
             if let Some(held) = hand.grasp.held() {
