@@ -263,19 +263,27 @@ fn a_dropped_ball_bounces_and_rests_on_the_table_a_thrown_one_flies() {
     assert!((v.x - 2.0).abs() < 0.05 && p.x > 0.02, "keeps the hand's velocity: {v} at {p}");
 }
 
-#[test]
-fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
-    use dqhand::collision::{fit_proxies, pose_of, HandProxies, PROXY_MARGIN};
-    use parry3d::bounding_volume::BoundingVolume;
+/// A 4 cm ball on a table 70 cm high, its colliders, and the built-in hand's proxies.
+fn ball_on_table_and_proxies() -> (Scene, ObjectColliders, dqhand::collision::HandProxies) {
+    use dqhand::collision::{fit_proxies, HandProxies, PROXY_MARGIN};
     let scene = Scene::from_json(
         r#"{"table": {"height": 0.7}, "objects": [{"name": "ball", "shape": "sphere", "radius": 0.04, "position": [0, 0.74, 0], "mass": 0.15}]}"#,
-        "roll.json",
+        "ball.json",
         Path::new("."),
     )
     .unwrap();
     let objects = ObjectColliders::new(&scene).unwrap();
     let model = model();
     let proxies = HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), &model.skeleton);
+    (scene, objects, proxies)
+}
+
+#[test]
+fn a_rolling_ball_stops_at_the_hand_lying_on_the_table() {
+    use dqhand::collision::pose_of;
+    use parry3d::bounding_volume::BoundingVolume;
+    let (scene, objects, proxies) = ball_on_table_and_proxies();
+    let model = model();
     // The hand at rest (flat), moved to lie on the table 10 cm along +X from the ball.
     let rest = model.skeleton.rest_world();
     let boxes = proxies.colliders().iter().map(|p| p.shape.compute_aabb(&pose_of(&rest[p.joint])));
@@ -402,6 +410,56 @@ fn a_free_hand_lags_at_most_5_mm_at_half_a_metre_a_second_and_a_still_one_barely
 /// Issue 28: a ball let go by a still hand above the table, tracked as a headset tracks (2 mm
 /// joint jitter, lost records, 30 ms behind), falls straight: no more than 1 cm across by
 /// half way down, the opening fingers do not bat it away, and it lands where it was let go.
+/// Issue 28: a ball let go on an upturned palm, 30 cm above the table, stays on it: the palm
+/// under it holds it up. Before, every proxy within 2 mm of an object let go passed through
+/// it (so that opening fingers do not bat it away), the palm too, and the ball fell through
+/// the hand onto the table.
+#[test]
+fn a_ball_let_go_on_an_upturned_palm_stays_on_it() {
+    use dqhand::collision::{pose_of, HandPart};
+    use parry3d::bounding_volume::BoundingVolume;
+    let (scene, objects, proxies) = ball_on_table_and_proxies();
+    let model = model();
+    // The rest hand (flat, palm down, fingers along −Z) turned palm up about its length, the
+    // palm 30 cm above the table.
+    let rest = model.skeleton.rest_world();
+    let palm_box = |world: &[glam::Affine3A]| {
+        let boxes = proxies.colliders().iter().filter(|p| p.part == HandPart::Palm).map(|p| p.shape.compute_aabb(&pose_of(&world[p.joint])));
+        boxes.reduce(|a, b| a.merged(&b)).unwrap()
+    };
+    let upturned: Vec<glam::Affine3A> = rest.iter().map(|w| glam::Affine3A::from_rotation_z(core::f32::consts::PI) * *w).collect();
+    let palm = palm_box(&upturned);
+    let lift = Vec3::new(-palm.center().x, 1.0 - palm.mins.y, -palm.center().z);
+    let world: Vec<glam::Affine3A> = upturned.iter().map(|w| glam::Affine3A::from_translation(lift) * *w).collect();
+    let palm = palm_box(&world);
+    let ball = parry3d::shape::Ball::new(0.04);
+    // On the palm where the grasp left it (a fraction of a millimetre in, as held), over the
+    // middle of the palm's box.
+    let above = Vec3::new(0.0, palm.maxs.y + 0.05, 0.0);
+    let gap = proxies
+        .colliders()
+        .iter()
+        .filter(|p| p.part == HandPart::Palm)
+        .filter_map(|p| parry3d::query::distance(&parry3d::math::Pose::from_translation(above), &ball, &pose_of(&world[p.joint]), &*p.shape).ok().map(|d| d.distance))
+        .fold(f32::INFINITY, f32::min);
+    let start = above - Vec3::Y * (gap + 0.0003);
+    let mut physics = ScenePhysics::new(&scene, &objects);
+    physics.add_hand(&proxies);
+    physics.move_hand(0, Some(&world));
+    physics.hold(0, glam::Quat::IDENTITY, start);
+    physics.step(1.0 / 60.0);
+    physics.release(0, Vec3::ZERO, Vec3::ZERO, &[0]);
+    // A quarter of a second on the palm: a flat palm is no cup, and after that the ball rolls
+    // off it over the wrist.
+    let mut lowest = start.y;
+    for _ in 0..15 {
+        physics.move_hand(0, Some(&world));
+        physics.step(1.0 / 60.0);
+        lowest = lowest.min(physics.pose(0).1.y);
+    }
+    assert!(start.y - lowest < 0.002, "the ball fell {} mm from the palm in a quarter of a second", (start.y - lowest) * 1e3);
+}
+
 #[test]
 fn a_ball_let_go_by_a_still_jittering_hand_falls_straight() {
     let scene = scene("grasp");

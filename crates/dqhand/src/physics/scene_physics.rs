@@ -4,10 +4,10 @@ use glam::{Affine3A, Quat, Vec3};
 use rapier3d::prelude::{ActiveHooks, Collider, ColliderBuilder, ColliderHandle, ColliderSet, PairFilterContext, PhysicsHooks, RigidBodyBuilder, RigidBodyHandle, RigidBodyType, SolverFlags};
 use rapier3d::pipeline::PhysicsWorld;
 use parry3d::math::Pose;
-use parry3d::bounding_volume::BoundingVolume;
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::ShapeCastOptions;
 
-use crate::collision::{pose_of, HandProxies, ObjectColliders};
+use crate::collision::{pose_of, HandPart, HandProxies, ObjectColliders};
 use crate::scene::Scene;
 
 /// Gravity, m/s² along −Y.
@@ -75,6 +75,15 @@ fn in_the_way(colliders: &ColliderSet, object: ColliderHandle, proxy: ColliderHa
     (drop > 0.0 && falls_onto(colliders, object, proxy, CLEAR_M, drop).is_some()).then_some(gap + CLEAR_M)
 }
 
+/// Whether an object whose centre of mass is at `centre` rests on a palm whose proxies in
+/// its way ([`in_the_way`]) lie in box `palm`: under that centre (its top below it, its
+/// footprint round it), so the object's weight bears on them. A palm under an object let go
+/// holds it up; one beside or above it (the grasp from the side, from above) passes through
+/// it as the fingers do.
+fn rests_on(palm: &Aabb, centre: Vec3) -> bool {
+    palm.maxs.y < centre.y && (palm.mins.x..=palm.maxs.x).contains(&centre.x) && (palm.mins.z..=palm.maxs.z).contains(&centre.z)
+}
+
 /// How far collider `object` moves straight down before it comes within `target` of collider
 /// `other`, if it does within `drop` (m). Only from apart: parry answers a cast that starts
 /// within the target distance with a contact query, a penetration query (which allocates)
@@ -98,6 +107,17 @@ fn near(a: &Pose, b: &Pose) -> bool {
     a.translation.distance(b.translation) <= PLACED_M && 2.0 * (a.rotation.inverse() * b.rotation).xyz().length() <= PLACED_RAD
 }
 
+/// A hand's proxy in the simulation.
+#[derive(Clone, Copy)]
+struct ProxyBody {
+    body: RigidBodyHandle,
+    collider: ColliderHandle,
+    /// The joint it moves with.
+    joint: usize,
+    /// Whether it is the palm's ([`HandPart::Palm`]): a palm may hold up an object let go.
+    palm: bool,
+}
+
 /// The scene's free objects and table, simulated.
 pub struct ScenePhysics {
     world: PhysicsWorld,
@@ -113,7 +133,7 @@ pub struct ScenePhysics {
     /// Each rendered hand's proxies as kinematic bodies, with their joints: a free object
     /// meets the hands (a released ball rests on the fingers, a rolling one stops at them)
     /// instead of passing into them.
-    hands: Vec<Vec<(RigidBodyHandle, usize, ColliderHandle)>>,
+    hands: Vec<Vec<ProxyBody>>,
     /// The objects the last step put back, out of reach ([`REACH_M`], or under the floor).
     returned: Vec<usize>,
     /// The floor's height and the reach across, m (for this scene's objects).
@@ -166,7 +186,7 @@ impl ScenePhysics {
             .map(|p| {
                 let body = RigidBodyBuilder::kinematic_position_based().build();
                 let (body, collider) = self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build());
-                (body, p.joint, collider)
+                ProxyBody { body, collider, joint: p.joint, palm: p.part == HandPart::Palm }
             })
             .collect();
         self.hands.push(hand);
@@ -184,7 +204,7 @@ impl ScenePhysics {
     /// alone.
     pub fn move_hand(&mut self, hand: usize, world: Option<&[Affine3A]>) {
         // Rapier marks every body borrowed mutably as changed: only those that change are.
-        for &(h, joint, _) in &self.hands[hand] {
+        for &ProxyBody { body: h, joint, .. } in &self.hands[hand] {
             let placed = &self.world.bodies[h];
             let Some(world) = world else {
                 if placed.is_enabled() {
@@ -220,7 +240,7 @@ impl ScenePhysics {
         let colliders = &self.world.colliders;
         let mut path = colliders[object].compute_aabb();
         path.mins.y -= DROP_M;
-        let hand = |h: ColliderHandle| self.hands.iter().flatten().any(|p| p.2 == h);
+        let hand = |h: ColliderHandle| self.hands.iter().flatten().any(|p| p.collider == h);
         let below = |&(h, c): &(ColliderHandle, &Collider)| h != object && !hand(h) && c.compute_aabb().intersects(&path);
         // Cast only from apart (`falls_onto`): an object touching something falls 0.
         let down = |(h, _): (ColliderHandle, &Collider)| if distance(colliders, object, h) <= 0.0 { Some(0.0) } else { falls_onto(colliders, object, h, 0.0, DROP_M) };
@@ -263,16 +283,24 @@ impl ScenePhysics {
     /// letting go, `by` (their indices), below it in the path it may fall before anything else
     /// stops it ([`Self::drop_height`]): a ball let go 8 mm above the table by a
     /// headset-tracked hand landed on the little finger 4.5 mm below it and rolled 23 cm away.
-    /// The other proxies still hold it off (another hand under it catches it). The rendered
-    /// hand stops at it whatever the physics does (the contact constraint).
+    /// The other proxies still hold it off (another hand under it catches it), and so does a
+    /// palm it rests on ([`rests_on`]): a ball let go on an upturned palm fell through the
+    /// hand. The rendered hand stops at it whatever the physics does (the contact constraint).
     pub fn release(&mut self, i: usize, linvel: Vec3, angvel: Vec3, by: &[usize]) {
         let object = self.colliders[i];
         let drop = if by.is_empty() { 0.0 } else { self.drop_height(object) };
         for (h, hand) in self.hands.iter().enumerate() {
             let drop = if by.contains(&h) { drop } else { 0.0 };
-            for &(body, _, proxy) in hand {
-                if let Some(gap) = self.world.bodies[body].is_enabled().then(|| in_the_way(&self.world.colliders, object, proxy, drop)).flatten() {
-                    self.let_go.pairs.push((object, proxy, body, gap));
+            let colliders = &self.world.colliders;
+            let in_the_way = |p: &ProxyBody| self.world.bodies[p.body].is_enabled().then(|| in_the_way(colliders, object, p.collider, drop)).flatten();
+            let palm = hand.iter().filter(|p| p.palm && in_the_way(p).is_some()).map(|p| colliders[p.collider].compute_aabb()).reduce(|a, b| a.merged(&b));
+            let held_up = palm.is_some_and(|palm| rests_on(&palm, self.world.bodies[self.bodies[i]].center_of_mass()));
+            for p in hand {
+                if p.palm && held_up {
+                    continue;
+                }
+                if let Some(gap) = in_the_way(p) {
+                    self.let_go.pairs.push((object, p.collider, p.body, gap));
                 }
             }
         }
