@@ -80,7 +80,7 @@ pub struct ManipulationLoop {
 /// An object let go this frame: the sums of the velocities its hands gave it, how many of
 /// them moved it, and the physics' indices of the hands letting go of it.
 #[derive(Clone, Copy)]
-struct LetGo {
+struct Released {
     object: usize,
     linvel: Vec3,
     angvel: Vec3,
@@ -285,7 +285,7 @@ impl ManipulationLoop {
     /// no hand holds any more leaves with the velocity its hands gave it (the mean of those
     /// that moved it: a still or lost hand gives none, and must not halve the other's throw).
     fn apply(&mut self, events: &HandEvents) {
-        let mut released: [Option<LetGo>; 2] = [None; 2];
+        let mut released: [Option<Released>; 2] = [None; 2];
         for (k, event) in events.iter() {
             match event {
                 GraspEvent::Grasp { object } => self.hands[k].constraint.grip(object, &self.objects.objects()[object].pose),
@@ -297,7 +297,7 @@ impl ManipulationLoop {
                             (r.linvel, r.angvel, r.moved) = (r.linvel + linvel, r.angvel + angvel, r.moved + moved);
                             (r.hands[1], r.count) = (hand, 2);
                         }
-                        None => released[k] = Some(LetGo { object, linvel, angvel, moved, hands: [hand; 2], count: 1 }),
+                        None => released[k] = Some(Released { object, linvel, angvel, moved, hands: [hand; 2], count: 1 }),
                     }
                 }
                 GraspEvent::Release { .. } => {}

@@ -292,16 +292,25 @@ impl ScenePhysics {
         for (h, hand) in self.hands.iter().enumerate() {
             let drop = if by.contains(&h) { drop } else { 0.0 };
             let colliders = &self.world.colliders;
-            let in_the_way = |p: &ProxyBody| self.world.bodies[p.body].is_enabled().then(|| in_the_way(colliders, object, p.collider, drop)).flatten();
-            let palm = hand.iter().filter(|p| p.palm && in_the_way(p).is_some()).map(|p| colliders[p.collider].compute_aabb()).reduce(|a, b| a.merged(&b));
-            let held_up = palm.is_some_and(|palm| rests_on(&palm, self.world.bodies[self.bodies[i]].center_of_mass()));
+            let first = self.let_go.pairs.len();
             for p in hand {
-                if p.palm && held_up {
-                    continue;
-                }
-                if let Some(gap) = in_the_way(p) {
+                if let Some(gap) = self.world.bodies[p.body].is_enabled().then(|| in_the_way(colliders, object, p.collider, drop)).flatten() {
                     self.let_go.pairs.push((object, p.collider, p.body, gap));
                 }
+            }
+            // The palm's proxies among them hold it up if it rests on them.
+            let palm = |proxy: ColliderHandle| hand.iter().any(|p| p.palm && p.collider == proxy);
+            let boxes = self.let_go.pairs[first..].iter().filter(|q| palm(q.1)).map(|q| colliders[q.1].compute_aabb());
+            if boxes.reduce(|a, b| a.merged(&b)).is_some_and(|b| rests_on(&b, self.world.bodies[self.bodies[i]].center_of_mass())) {
+                let pairs = &mut self.let_go.pairs;
+                let mut kept = first;
+                for j in first..pairs.len() {
+                    if !palm(pairs[j].1) {
+                        pairs.swap(kept, j);
+                        kept += 1;
+                    }
+                }
+                pairs.truncate(kept);
             }
         }
         // The filter is asked only while the object has such pairs (rapier allocates more
