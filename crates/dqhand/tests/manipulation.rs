@@ -142,7 +142,7 @@ fn the_teapot_is_held_still_in_a_grip_that_stays_out_of_it() {
     // Joints (per frame) that stopped on the teapot and were followed to the next frame.
     let mut stopped_on = 0;
     let proxies = dqhand::collision::HandProxies::new(&dqhand::collision::fit_proxies(&model(), dqhand::collision::PROXY_MARGIN), &model().skeleton);
-    let query = dqhand::collision::ProxyMeshQuery::new(&proxies);
+    let mut query = dqhand::collision::ProxyMeshQuery::new(&proxies);
     let mut in_wrist: Option<glam::Quat> = None;
     // Where each joint touching the held teapot was last frame and the teapot's normal there,
     // in the teapot's frame.

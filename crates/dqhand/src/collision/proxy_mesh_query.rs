@@ -7,13 +7,20 @@
 //! first by a cheap bound, then measured exactly (a capsule) or in centimetres (a hull,
 //! [`UNIT`]): parry's own distance to a mesh runs GJK in metres, too long by up to 17 mm
 //! against millimetre triangles. Where only a lower bound is asked above some distance, what
-//! is nearly as near as the best found is passed over ([`SHORT_ABOVE`]).
+//! is nearly as near as the best found is passed over ([`SHORT_ABOVE`]). Each bound also
+//! takes the plane square to the direction from the proxy to the nearest point found, in this
+//! search or this proxy's last (`Placed::face`): nothing beyond it is nearer than its distance
+//! from the proxy's reach along that direction, and no overlap is deeper than how far it
+//! reaches past it. A palm lying on the teapot's millimetre triangles has dozens within a
+//! millimetre inside its hull's box, which the box bound could not tell from the nearest and
+//! GJK or EPA measured one by one (2–9 µs each); that plane tells most of them at a glance.
 //!
 //! The time of impact is conservative advancement (Mirtich 1996) over the triangles the proxy's sweep meets, each
 //! with its own lower bound of the distance: measured exactly at some time, it falls no faster
 //! than the proxy closes on the plane through the nearest point (square to the gap), which
 //! holds the triangle on its far side: the motion's speed along that normal plus what its
-//! turning adds. The search jumps to the earliest time a bound can reach [`TOLERANCE`] and
+//! turning adds; where they overlap, it deepens no faster either, since they would have to part
+//! by no more than the depth along that normal. The search jumps to the earliest time a bound can reach [`TOLERANCE`] and
 //! measures only the triangles due then, so a proxy sliding along a surface or moving away
 //! from it takes a few steps, where a bound from the proxy's whole speed would creep.
 //!
@@ -24,14 +31,17 @@
 //! away from it; then it may not stop the proxy until the proxy is clear of it by [`REARM`]
 //! (parry's "directional" cast: a finger resting on the lid may lift off it), but it still does
 //! if the proxy goes deeper into it than it started (a roll that lifts one end of a finger lying
-//! on it and sinks the other).
+//! on it and sinks the other): it is measured again only when its bound can reach that floor.
 
 use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
 use parry3d::query::NonlinearRigidMotion;
-use parry3d::query::details::contact_support_map_support_map;
+use parry3d::query::epa::EPA;
+use parry3d::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
+use parry3d::query::Contact;
 use parry3d::shape::{Shape, SupportMap, Triangle};
+use std::cell::Cell;
 use std::sync::Arc;
 
 use super::hull_support::HullSupport;
@@ -89,6 +99,10 @@ fn box_gap(a: &Aabb, b: &Aabb) -> f32 {
 pub struct ProxyMeshQuery {
     /// Per proxy of the hand, in [`HandProxies::colliders`]' order.
     shapes: Vec<QueryShape>,
+    /// Per proxy, the direction (its own frame) from it to the nearest point of the last mesh
+    /// searched: a plane square to it bounds most triangles near that point at once.
+    faced: Vec<Vec3>,
+    epa: Scratch,
     candidates: Vec<Candidate>,
 }
 
@@ -120,6 +134,16 @@ enum Convex {
     Other(Arc<dyn Shape>),
 }
 
+/// EPA's buffers, kept between queries (a new EPA allocates as it grows): a copy starts empty.
+#[derive(Default)]
+struct Scratch(EPA);
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
 impl Convex {
     /// The support function GJK asks.
     fn support(&self) -> &dyn SupportMap {
@@ -127,6 +151,26 @@ impl Convex {
             Self::Hull(hull) => hull,
             Self::Other(shape) => shape.as_support_map().expect("checked when made"),
         }
+    }
+
+    /// How far the shape reaches along the unit direction `n` (m, its own frame).
+    fn reach(&self, n: Vec3) -> f32 {
+        self.support().local_support_point_toward(n).dot(n) / UNIT
+    }
+
+    /// The closest points of the shape and `tri` (placed by `pos12` in the shape's frame), or
+    /// their deepest overlap: parry's `query::contact` between two support maps, with `epa`'s
+    /// buffers. `None` where EPA finds no answer (the shapes touch exactly).
+    fn contact(&self, pos12: &Pose, tri: &Triangle, epa: &mut EPA) -> Option<Contact> {
+        let support = self.support();
+        let mut simplex = VoronoiSimplex::new();
+        simplex.reset(CsoPoint::from_shapes(pos12, support, tri, pos12.translation.normalize_or(Vec3::X)));
+        let closest = match gjk::closest_points(pos12, support, tri, f32::MAX, true, &mut simplex) {
+            GJKResult::Intersection => epa.closest_points(pos12, support, tri, &simplex),
+            GJKResult::ClosestPoints(p1, p2, n) => Some((p1, p2, n)),
+            _ => None,
+        };
+        closest.map(|(point1, point2, normal1)| Contact::new(point1, pos12.inverse_transform_point(point2), normal1, pos12.rotation.inverse() * -normal1, (point2 - point1).dot(normal1)))
     }
 }
 
@@ -185,12 +229,22 @@ impl QueryShape {
             Self::Capsule { a, b, .. } => (pose * *a, pose * *b),
             Self::Scaled(..) => (pose.translation, pose.translation),
         };
-        Placed { shape: self, to_local: pose.inverse(), aabb: self.aabb(&pose), axis }
+        Placed { shape: self, pose, to_local: pose.inverse(), aabb: self.aabb(&pose), axis, reach: Cell::new((Vec3::ZERO, 0.0)) }
+    }
+
+    /// Whether a signed distance `distance` from [`Self::to_triangle`] came with a normal along
+    /// which the shapes part by it (a capsule's axis crossing the triangle has none).
+    fn parts_along_normal(&self, distance: f32) -> bool {
+        match self {
+            Self::Capsule { radius, .. } => distance > 1e-6 - radius,
+            Self::Scaled(..) => true,
+        }
     }
 
     /// The signed distance to `tri` (negative inside), the triangle's normal there towards the
-    /// proxy, and the proxy's point nearest the triangle, all in the mesh's frame, at `pose`.
-    fn to_triangle(&self, pose: &Pose, tri: &Triangle) -> (f32, Vec3, Vec3) {
+    /// proxy, and the proxy's point nearest the triangle, all in the mesh's frame, at `pose`
+    /// (a hull's overlaps through `epa`'s buffers).
+    fn to_triangle(&self, pose: &Pose, tri: &Triangle, epa: &mut EPA) -> (f32, Vec3, Vec3) {
         match self {
             Self::Capsule { a, b, radius } => {
                 let (p0, p1) = (*pose * *a, *pose * *b);
@@ -210,8 +264,7 @@ impl QueryShape {
             Self::Scaled(convex, _) => {
                 let pose = Pose::from_parts(pose.translation * UNIT, pose.rotation);
                 let tri = Triangle::new(tri.a * UNIT, tri.b * UNIT, tri.c * UNIT);
-                // As parry's `query::contact` between two support maps, with the hull's own.
-                let contact = contact_support_map_support_map(&pose.inverse(), convex.support(), &tri, f32::MAX).map(|mut c| {
+                let contact = convex.contact(&pose.inverse(), &tri, epa).map(|mut c| {
                     c.transform_by_mut(&pose, &Pose::identity());
                     c
                 });
@@ -230,15 +283,41 @@ impl QueryShape {
 /// A proxy at a pose (the mesh's frame), with what each bound needs made once.
 struct Placed<'a> {
     shape: &'a QueryShape,
+    pose: Pose,
     /// The pose's inverse.
     to_local: Pose,
     /// The box holding it.
     aabb: Aabb,
     /// A capsule's axis (the mesh's frame).
     axis: (Vec3, Vec3),
+    /// A unit direction (the mesh's frame) and how far the proxy reaches along it: no point
+    /// beyond that plane is nearer than its distance to it.
+    reach: Cell<(Vec3, f32)>,
 }
 
 impl Placed<'_> {
+    /// Takes `u` (unit, the mesh's frame, from the proxy towards the mesh) as the direction
+    /// of [`Self::along`].
+    fn face(&self, u: Vec3) {
+        let reach = match self.shape {
+            QueryShape::Capsule { radius, .. } => self.axis.0.dot(u).max(self.axis.1.dot(u)) + radius,
+            QueryShape::Scaled(convex, _) => convex.reach(self.to_local.rotation * u) + u.dot(self.pose.translation),
+        };
+        self.reach.set((u, reach));
+    }
+
+    /// A lower bound of the signed distance to anything whose least extent along the faced
+    /// direction is `least`: how far past the proxy's reach it is (no overlap can be deeper
+    /// either: the shapes would have to part by that much along it).
+    fn along(&self, least: impl FnOnce(Vec3) -> f32) -> f32 {
+        let (u, reach) = self.reach.get();
+        if u == Vec3::ZERO {
+            return f32::NEG_INFINITY;
+        }
+        let short = if matches!(self.shape, QueryShape::Scaled(..)) { GJK_ERROR } else { 1e-6 };
+        least(u) - reach - short
+    }
+
     /// A lower bound of the distance to anything in the tree's node `node`: the gap between
     /// the boxes, or where larger (a slanted finger's box holds much that the finger is far
     /// from) the proxy's distance to the node's centre less the node's half diagonal.
@@ -251,7 +330,8 @@ impl Placed<'_> {
                 (local.mins - c).max(c - local.maxs).max(Vec3::ZERO).length()
             }
         } - node.radius;
-        if boxes > 0.0 || centre_gap > 0.0 { boxes.max(centre_gap) } else { self.shape.deepest() }
+        let along = self.along(|u| u.dot(node.centre) - node.aabb.half_extents().dot(u.abs()));
+        if boxes > 0.0 || centre_gap > 0.0 { boxes.max(centre_gap).max(along) } else { self.shape.deepest().max(along) }
     }
 
     /// A lower bound of the distance to `tri`, far cheaper than the distance: for a capsule,
@@ -268,7 +348,8 @@ impl Placed<'_> {
                 let (n, a) = (tri.normal, tri.triangle.a);
                 let (dp, dq) = ((p - a).dot(n), (q - a).dot(n));
                 let plane = if dp * dq > 0.0 { dp.abs().min(dq.abs()) } else { 0.0 };
-                (segment_distance(tri.centroid, p, q) - tri.spread).max(plane) - radius
+                let t = &tri.triangle;
+                ((segment_distance(tri.centroid, p, q) - tri.spread).max(plane) - radius).max(self.along(|u| u.dot(t.a).min(u.dot(t.b)).min(u.dot(t.c))))
             }
             QueryShape::Scaled(_, aabb) => {
                 let t = &tri.triangle;
@@ -278,9 +359,11 @@ impl Placed<'_> {
                 let n = self.to_local.rotation * tri.normal;
                 let reach = (aabb.half_extents() * n.abs()).element_sum();
                 let along = (a - aabb.center()).dot(n).abs() - reach;
-                // Where both gaps close the hull may overlap the triangle: as deep as it can.
+                let faced = self.along(|u| u.dot(t.a).min(u.dot(t.b)).min(u.dot(t.c)));
+                // Where both gaps close the hull may overlap the triangle: as deep as it can,
+                // or as the faced plane allows.
                 let gap = boxes.max(along);
-                if gap > 0.0 { gap } else { self.shape.deepest() }
+                if gap > 0.0 { gap.max(faced) } else { self.shape.deepest().max(faced) }
             }
         }
     }
@@ -290,16 +373,17 @@ impl ProxyMeshQuery {
     /// The advancement for `proxies`.
     #[must_use]
     pub fn new(proxies: &HandProxies) -> Self {
-        Self { shapes: proxies.colliders().iter().map(|p| QueryShape::of(&*p.shape)).collect(), candidates: Vec::new() }
+        let shapes: Vec<QueryShape> = proxies.colliders().iter().map(|p| QueryShape::of(&*p.shape)).collect();
+        Self { faced: vec![Vec3::ZERO; shapes.len()], shapes, epa: Scratch::default(), candidates: Vec::new() }
     }
 
     /// The point of `mesh` (at `mesh_pose`) nearest proxy `proxy` (at `pose`), if it is nearer
     /// than `limit` (m).
     #[must_use]
-    pub fn nearest(&self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, limit: f32) -> Option<MeshNearest> {
+    pub fn nearest(&mut self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, limit: f32) -> Option<MeshNearest> {
         let query = &self.shapes[proxy];
         let local = mesh_pose.inv_mul(pose);
-        let near = Self::search(query, &local, mesh, limit, f32::INFINITY, 0.0)?;
+        let near = Self::search(query, &mut self.faced[proxy], &mut self.epa.0, &local, mesh, limit, f32::INFINITY, 0.0)?;
         Some(MeshNearest { distance: near.distance, normal: mesh_pose.rotation * near.normal, point: *mesh_pose * near.point })
     }
 
@@ -312,11 +396,11 @@ impl ProxyMeshQuery {
     /// hundreds of triangles within a millimetre of its distance, which it need not tell apart.
     #[allow(clippy::too_many_arguments)]
     #[must_use]
-    pub fn distance_at_least(&self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
+    pub fn distance_at_least(&mut self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
         let query = &self.shapes[proxy];
         // Nothing found within the limit: what was passed over may be a little nearer.
         let passed_over = limit - SHORT_ABOVE * (limit - exact_below).max(0.0);
-        Self::search(query, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
+        Self::search(query, &mut self.faced[proxy], &mut self.epa.0, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
     }
 
     /// The best-first search of the mesh's tree for the triangle nearest `query` at `pose` (the
@@ -324,12 +408,15 @@ impl ProxyMeshQuery {
     /// cheap bound is above `exact_below` counts as that far (with no normal or point). With
     /// `short` above 0, the distance found may be short of the true one by that share of its
     /// excess over `exact_below`: what is no nearer than that is not looked at.
-    fn search(query: &QueryShape, pose: &Pose, mesh: &TriangleTree, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
+    fn search(query: &QueryShape, faced: &mut Vec3, epa: &mut EPA, pose: &Pose, mesh: &TriangleTree, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
         let placed = query.at(*pose);
+        if *faced != Vec3::ZERO {
+            placed.face(pose.rotation * *faced);
+        }
         // What can still count, with `best` found: rising with `best`, so that it holds for
         // everything passed over on the way to the final `best`.
         let worth = |best: f32| best - short * (best - exact_below).max(0.0);
-        mesh.find_best(
+        let nearest = mesh.find_best(
             limit,
             |node| placed.node_gap(node),
             |tri, best| {
@@ -341,12 +428,16 @@ impl ProxyMeshQuery {
                 if bound > exact_below {
                     return Some((bound, (Vec3::ZERO, Vec3::ZERO)));
                 }
-                let (distance, normal, point) = query.to_triangle(pose, &tri.triangle);
+                let (distance, normal, point) = query.to_triangle(pose, &tri.triangle, epa);
+                if distance < best && normal != Vec3::ZERO {
+                    placed.face(-normal);
+                }
                 Some((distance, (normal, point - normal * distance)))
             },
             worth,
-        )
-        .map(|(distance, (normal, point))| MeshNearest { distance: worth(distance), normal, point })
+        );
+        *faced = placed.to_local.rotation * placed.reach.get().0;
+        nearest.map(|(distance, (normal, point))| MeshNearest { distance: worth(distance), normal, point })
     }
 
     /// The first time in `[0, end)` at which proxy `proxy`, moving by `motion`, comes within
@@ -380,8 +471,12 @@ impl ProxyMeshQuery {
             // The earliest time another triangle's bound can come down to the tolerance.
             let mut next = end;
             for c in &mut self.candidates {
-                if c.left.is_some() || c.bound - c.rate * (t - c.at) <= DUE * TOLERANCE {
-                    let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangles()[c.triangle as usize].triangle);
+                // A triangle left may not stop the proxy unless it goes deeper than it started
+                // (a turn can lift the touching point and sink another end of the proxy): its
+                // floor is what matters then, not the tolerance.
+                let level = c.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE);
+                if c.bound - c.rate * (t - c.at) <= level + (DUE - 1.0) * TOLERANCE {
+                    let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangles()[c.triangle as usize].triangle, &mut self.epa.0);
                     (c.bound, c.at) = (distance, t);
                     let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
                     if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
@@ -389,12 +484,12 @@ impl ProxyMeshQuery {
                         c.left = ((motion.linvel + motion.angvel.cross(x - pivot)).dot(n) >= 0.0).then_some(distance);
                     }
                     // The plane through its nearest point, square to `n`, holds the triangle on
-                    // its far side; the proxy closes on that plane no faster than this (when
-                    // they overlap there is no such plane: the whole speed).
-                    c.rate = if distance >= 0.0 { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
+                    // its far side; the proxy closes on that plane no faster than this. Where
+                    // they overlap, by no more than they would have to part along `n`, which
+                    // grows no faster (where a capsule's axis crosses the triangle there is no
+                    // such direction: the whole speed).
+                    c.rate = if cast.parts_along_normal(distance) { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
                     if let Some(start) = c.left {
-                        // Left, it may still not go deeper than it started (a turn can lift the
-                        // touching point and sink another end of the proxy).
                         let floor = start.min(0.0) - TOLERANCE;
                         if distance < floor {
                             return Some(t);
@@ -412,7 +507,8 @@ impl ProxyMeshQuery {
                     }
                 }
                 if c.rate > 0.0 {
-                    next = next.min(c.at + (c.bound - TOLERANCE) / c.rate);
+                    let level = c.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE);
+                    next = next.min(c.at + (c.bound - level) / c.rate);
                 }
             }
             if next >= end {
@@ -438,7 +534,7 @@ mod tests {
     }
 
     fn cast(shape: &SharedShape, from: Vec3, linvel: Vec3, angvel: Vec3) -> Option<f32> {
-        let mut cast = ProxyMeshQuery { shapes: vec![QueryShape::of(&**shape)], candidates: Vec::new() };
+        let mut cast = ProxyMeshQuery { shapes: vec![QueryShape::of(&**shape)], faced: vec![Vec3::ZERO], epa: Scratch::default(), candidates: Vec::new() };
         let start = Pose::from_translation(from);
         let motion = NonlinearRigidMotion::new(start, Vec3::ZERO, linvel, angvel);
         let extent = shape.compute_local_bounding_sphere().radius;
@@ -499,6 +595,27 @@ mod tests {
         }
     }
 
+    #[test]
+    fn a_hull_sunk_into_the_floor_slides_and_lifts_freely_and_stops_as_it_tips_deeper() {
+        // A 2 cm cube 1 mm into the floor (an object pressed into a palm, the other way round).
+        let cube = SharedShape::cuboid(0.01, 0.01, 0.01);
+        let sunk = Vec3::new(0.0, 0.009, 0.0);
+        // Along the floor it goes no deeper, and lifted it comes out: neither stops it.
+        assert!(cast(&cube, sunk, Vec3::new(0.05, 0.0, 0.0), Vec3::ZERO).is_none());
+        assert!(cast(&cube, sunk, Vec3::new(0.01, 0.03, 0.0), Vec3::ZERO).is_none());
+        // Pushed down, it stops at once.
+        assert_eq!(cast(&cube, sunk, Vec3::new(0.0, -0.02, 0.0), Vec3::ZERO), Some(0.0));
+        // Tipped about z, one bottom edge rises and the other sinks at once: it stops before
+        // that edge is deeper than the cube started by more than the advancement's slack
+        // (measured again only as its bound reaches the depth it started at).
+        for turn in [0.5, -0.5] {
+            let t = cast(&cube, sunk, Vec3::ZERO, Vec3::new(0.0, 0.0, turn)).expect("it stops");
+            let angle = turn * t;
+            let lowest = 0.009 - 0.01 * (angle.cos() + angle.sin().abs());
+            assert!(lowest >= -0.001 - GJK_ERROR - 2.0 * DUE * TOLERANCE, "turned {angle} rad, lowest point at {lowest}");
+        }
+    }
+
     /// The Utah teapot's triangles (data from outside the project), at the size the built-in
     /// scenes give it (scale 0.6: about 25 cm across, triangles of millimetres).
     fn teapot_triangles() -> Vec<Triangle> {
@@ -518,7 +635,7 @@ mod tests {
         let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
         let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
         let shapes = [SharedShape::capsule(a, b, radius), SharedShape::cuboid(0.04, 0.01, 0.03)];
-        let query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), candidates: Vec::new() };
+        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), candidates: Vec::new() };
         let mesh_pose = Pose::from_parts(Vec3::new(0.3, 0.8, -0.2), glam::Quat::from_rotation_y(0.7));
         let corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -0.04 } else { 0.04 }, if i & 2 == 0 { -0.01 } else { 0.01 }, if i & 4 == 0 { -0.03 } else { 0.03 })).collect();
         let (box_points, box_triangles) = parry3d::transformation::try_convex_hull(&corners).expect("a box's hull");
@@ -567,7 +684,7 @@ mod tests {
                     break;
                 }
                 exact_box = exact_box.min(polyhedron_triangle(&box_points, &box_triangles, &local, t));
-                each_box = each_box.min(query.shapes[1].to_triangle(&local, t).0);
+                each_box = each_box.min(query.shapes[1].to_triangle(&local, t, &mut EPA::new()).0);
             }
             let found = query.nearest(1, &pose, &mesh, &mesh_pose, 0.05);
             assert!(exact_box >= 0.05 || found.is_some(), "no box contact where a triangle is {exact_box} m off");
@@ -602,13 +719,13 @@ mod tests {
             let normal = face_normal(&tri);
             // Beside the triangle, 1–2 cm off along its normal, tilted by the triangle's index.
             let pose = Pose::from_parts(centre + normal * (0.01 + 0.01 * (k % 10) as f32 / 10.0), glam::Quat::from_rotation_x(k as f32 * 0.37));
-            let (reference, _, _) = exact.to_triangle(&pose, &tri);
+            let (reference, _, _) = exact.to_triangle(&pose, &tri, &mut EPA::new());
             if reference <= 0.0 {
                 continue;
             }
             let metres = parry3d::query::distance(&pose, &*capsule, &Pose::identity(), &tri).expect("a distance").distance;
             in_metres = in_metres.max((metres - reference).abs());
-            in_units = in_units.max((scaled.to_triangle(&pose, &tri).0 + GJK_ERROR - reference).abs());
+            in_units = in_units.max((scaled.to_triangle(&pose, &tri, &mut EPA::new()).0 + GJK_ERROR - reference).abs());
         }
         assert!(in_metres > 0.005, "parry in metres is off by {in_metres} m at most");
         assert!(in_units < GJK_ERROR, "parry in centimetres is off by {in_units} m");
@@ -664,7 +781,7 @@ mod tests {
                 let gap = 0.0002 + 0.0098 * (k % 13) as f32 / 12.0;
                 let pose = Pose::from_parts(centre + normal * gap - turn * Vec3::new(0.0, lowest, 0.0), turn);
                 let exact = polyhedron_triangle(points, triangles, &pose, tri);
-                let (queried, _, _) = cast.to_triangle(&pose, tri);
+                let (queried, _, _) = cast.to_triangle(&pose, tri, &mut EPA::new());
                 assert!(queried <= exact + 1e-6, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
                 assert!(exact - queried <= 2.0 * GJK_ERROR, "{name}, triangle {k}: {queried} m queried, {exact} m exact");
                 checked += 1;

@@ -133,7 +133,7 @@ impl TriangleTree {
     /// node whose bound is not below `worth(best)` (the best found so far; `worth` may not
     /// decrease) is passed over; `leaf_cost`, given the best so far, may give `None` for a
     /// triangle it judges not worth measuring.
-    pub fn find_best<T>(&self, limit: f32, node_cost: impl Fn(&TreeNode) -> f32, leaf_cost: impl Fn(&TreeTriangle, f32) -> Option<(f32, T)>, worth: impl Fn(f32) -> f32) -> Option<(f32, T)> {
+    pub fn find_best<T>(&self, limit: f32, node_cost: impl Fn(&TreeNode) -> f32, mut leaf_cost: impl FnMut(&TreeTriangle, f32) -> Option<(f32, T)>, worth: impl Fn(f32) -> f32) -> Option<(f32, T)> {
         let mut stack = [(0u32, 0.0f32); MAX_DEPTH + 1];
         let mut depth = 0;
         let mut best: Option<(f32, T)> = None;
