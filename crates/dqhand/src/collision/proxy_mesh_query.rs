@@ -20,7 +20,8 @@
 //! than the proxy closes on the plane through the nearest point (square to the gap), which
 //! holds the triangle on its far side: the motion's speed along that normal plus what its
 //! turning adds; where they overlap, it deepens no faster either, since they would have to part
-//! by no more than the depth along that normal. The search jumps to the earliest time a bound can reach [`TOLERANCE`] and
+//! by no more than the depth along that normal. The search jumps to the earliest time a bound can reach [`TOLERANCE`] (or a
+//! triangle left, below, its floor) and
 //! measures only the triangles due then, so a proxy sliding along a surface or moving away
 //! from it takes a few steps, where a bound from the proxy's whole speed would creep.
 //!
@@ -31,7 +32,9 @@
 //! away from it; then it may not stop the proxy until the proxy is clear of it by [`REARM`]
 //! (parry's "directional" cast: a finger resting on the lid may lift off it), but it still does
 //! if the proxy goes deeper into it than it started (a roll that lifts one end of a finger lying
-//! on it and sinks the other): it is measured again only when its bound can reach that floor.
+//! on it and sinks the other): it is measured again only when its bound can reach that floor, so
+//! one that started in an overlap, rose clear and comes back in the same motion stops at that
+//! depth, not at [`TOLERANCE`] (it never goes deeper than it started).
 
 use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
@@ -57,10 +60,14 @@ pub const TOLERANCE: f32 = 2e-5;
 /// How far a proxy must get from a triangle it started touching and left before the triangle
 /// can stop it again (m).
 const REARM: f32 = 1e-4;
+/// How far a capsule's axis must be from a triangle for the direction between them to be
+/// trusted as the normal the advancement's bound falls along (m): their closest points are
+/// rounded by about 1e-8 m, which turns it by 1e-4 rad here.
+const PARTING: f32 = 1e-4;
 /// Steps of the advancement before it stops where it got (short of any hit: conservative).
 const MAX_STEPS: usize = 128;
-/// A triangle whose bound is within this many tolerances is measured again (the bound reaches
-/// the tolerance itself at the step's time, up to rounding).
+/// A triangle whose bound is within half a tolerance of the tolerance (of its floor, for one left)
+/// is measured again (the bound reaches it at the step's time, up to rounding).
 const DUE: f32 = 1.5;
 
 /// One triangle the sweep meets.
@@ -99,8 +106,8 @@ fn box_gap(a: &Aabb, b: &Aabb) -> f32 {
 pub struct ProxyMeshQuery {
     /// Per proxy of the hand, in [`HandProxies::colliders`]' order.
     shapes: Vec<QueryShape>,
-    /// Per proxy, the direction (its own frame) from it to the nearest point of the last mesh
-    /// searched: a plane square to it bounds most triangles near that point at once.
+    /// Per proxy, the direction (its own frame) from it to the nearest point its searches last
+    /// measured: a plane square to it bounds most triangles near that point at once.
     faced: Vec<Vec3>,
     epa: Scratch,
     candidates: Vec<Candidate>,
@@ -233,10 +240,11 @@ impl QueryShape {
     }
 
     /// Whether a signed distance `distance` from [`Self::to_triangle`] came with a normal along
-    /// which the shapes part by it (a capsule's axis crossing the triangle has none).
+    /// which the shapes part by it (a capsule's axis crossing the triangle has none, and one
+    /// nearly crossing it a normal rounding may turn: [`PARTING`]).
     fn parts_along_normal(&self, distance: f32) -> bool {
         match self {
-            Self::Capsule { radius, .. } => distance > 1e-6 - radius,
+            Self::Capsule { radius, .. } => distance > PARTING - radius,
             Self::Scaled(..) => true,
         }
     }
@@ -299,6 +307,11 @@ impl Placed<'_> {
     /// Takes `u` (unit, the mesh's frame, from the proxy towards the mesh) as the direction
     /// of [`Self::along`].
     fn face(&self, u: Vec3) {
+        // (Turned between frames and back, a remembered direction drifts off unit length.)
+        let u = u.normalize_or_zero();
+        if u == Vec3::ZERO {
+            return;
+        }
         let reach = match self.shape {
             QueryShape::Capsule { radius, .. } => self.axis.0.dot(u).max(self.axis.1.dot(u)) + radius,
             QueryShape::Scaled(convex, _) => convex.reach(self.to_local.rotation * u) + u.dot(self.pose.translation),
@@ -407,7 +420,9 @@ impl ProxyMeshQuery {
     /// mesh's frame) within `limit` (the deepest, where it overlaps several); a triangle whose
     /// cheap bound is above `exact_below` counts as that far (with no normal or point). With
     /// `short` above 0, the distance found may be short of the true one by that share of its
-    /// excess over `exact_below`: what is no nearer than that is not looked at.
+    /// excess over `exact_below`: what is no nearer than that is not looked at. `faced` is the
+    /// proxy's remembered direction (its frame), which the search takes and leaves updated;
+    /// `epa`, the buffers of the hull queries.
     fn search(query: &QueryShape, faced: &mut Vec3, epa: &mut EPA, pose: &Pose, mesh: &TriangleTree, limit: f32, exact_below: f32, short: f32) -> Option<MeshNearest> {
         let placed = query.at(*pose);
         if *faced != Vec3::ZERO {
@@ -486,12 +501,12 @@ impl ProxyMeshQuery {
                     // The plane through its nearest point, square to `n`, holds the triangle on
                     // its far side; the proxy closes on that plane no faster than this. Where
                     // they overlap, by no more than they would have to part along `n`, which
-                    // grows no faster (where a capsule's axis crosses the triangle there is no
-                    // such direction: the whole speed).
-                    c.rate = if cast.parts_along_normal(distance) { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
+                    // grows no faster (where a capsule's axis crosses the triangle, or the query
+                    // gave no normal, there is no such direction: the whole speed).
+                    c.rate = if n != Vec3::ZERO && cast.parts_along_normal(distance) { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
                     if let Some(start) = c.left {
                         let floor = start.min(0.0) - TOLERANCE;
-                        if distance < floor {
+                        if distance <= floor {
                             return Some(t);
                         }
                         if distance <= REARM {

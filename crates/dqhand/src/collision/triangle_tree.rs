@@ -132,7 +132,8 @@ impl TriangleTree {
     /// nearest first: `node_cost` bounds the cost of anything under a node from below, and a
     /// node whose bound is not below `worth(best)` (the best found so far; `worth` may not
     /// decrease) is passed over; `leaf_cost`, given the best so far, may give `None` for a
-    /// triangle it judges not worth measuring.
+    /// triangle it judges not worth measuring. Both may tighten their bounds as the search
+    /// goes (a node stacked earlier keeps its looser bound, which is still a bound).
     pub fn find_best<T>(&self, limit: f32, node_cost: impl Fn(&TreeNode) -> f32, mut leaf_cost: impl FnMut(&TreeTriangle, f32) -> Option<(f32, T)>, worth: impl Fn(f32) -> f32) -> Option<(f32, T)> {
         let mut stack = [(0u32, 0.0f32); MAX_DEPTH + 1];
         let mut depth = 0;
