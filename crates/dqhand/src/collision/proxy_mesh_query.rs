@@ -83,6 +83,14 @@ struct Candidate {
     left: Option<f32>,
 }
 
+impl Candidate {
+    /// The distance at which it stops the proxy: the tolerance, or for one left, the depth it
+    /// started at less the tolerance (it may not go deeper than it started).
+    fn stops_at(&self) -> f32 {
+        self.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE)
+    }
+}
+
 /// The point of a mesh nearest a proxy (world frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshNearest {
@@ -352,6 +360,8 @@ impl Placed<'_> {
     /// triangle's plane; for a hull, the larger of the gap between its box and the triangle's
     /// box in the joint's frame and the gap along the triangle's normal.
     fn bound(&self, tri: &TreeTriangle) -> f32 {
+        let t = &tri.triangle;
+        let faced = self.along(|u| u.dot(t.a).min(u.dot(t.b)).min(u.dot(t.c)));
         match self.shape {
             QueryShape::Capsule { radius, .. } => {
                 let (p, q) = self.axis;
@@ -361,18 +371,15 @@ impl Placed<'_> {
                 let (n, a) = (tri.normal, tri.triangle.a);
                 let (dp, dq) = ((p - a).dot(n), (q - a).dot(n));
                 let plane = if dp * dq > 0.0 { dp.abs().min(dq.abs()) } else { 0.0 };
-                let t = &tri.triangle;
-                ((segment_distance(tri.centroid, p, q) - tri.spread).max(plane) - radius).max(self.along(|u| u.dot(t.a).min(u.dot(t.b)).min(u.dot(t.c))))
+                ((segment_distance(tri.centroid, p, q) - tri.spread).max(plane) - radius).max(faced)
             }
             QueryShape::Scaled(_, aabb) => {
-                let t = &tri.triangle;
                 let [a, b, c] = [self.to_local * t.a, self.to_local * t.b, self.to_local * t.c];
                 let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
                 let boxes = (aabb.mins - hi).max(lo - aabb.maxs).max(Vec3::ZERO).length();
                 let n = self.to_local.rotation * tri.normal;
                 let reach = (aabb.half_extents() * n.abs()).element_sum();
                 let along = (a - aabb.center()).dot(n).abs() - reach;
-                let faced = self.along(|u| u.dot(t.a).min(u.dot(t.b)).min(u.dot(t.c)));
                 // Where both gaps close the hull may overlap the triangle: as deep as it can,
                 // or as the faced plane allows.
                 let gap = boxes.max(along);
@@ -489,8 +496,7 @@ impl ProxyMeshQuery {
                 // A triangle left may not stop the proxy unless it goes deeper than it started
                 // (a turn can lift the touching point and sink another end of the proxy): its
                 // floor is what matters then, not the tolerance.
-                let level = c.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE);
-                if c.bound - c.rate * (t - c.at) <= level + (DUE - 1.0) * TOLERANCE {
+                if c.bound - c.rate * (t - c.at) <= c.stops_at() + (DUE - 1.0) * TOLERANCE {
                     let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangles()[c.triangle as usize].triangle, &mut self.epa.0);
                     (c.bound, c.at) = (distance, t);
                     let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
@@ -504,8 +510,8 @@ impl ProxyMeshQuery {
                     // grows no faster (where a capsule's axis crosses the triangle, or the query
                     // gave no normal, there is no such direction: the whole speed).
                     c.rate = if n != Vec3::ZERO && cast.parts_along_normal(distance) { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
-                    if let Some(start) = c.left {
-                        let floor = start.min(0.0) - TOLERANCE;
+                    if c.left.is_some() {
+                        let floor = c.stops_at();
                         if distance <= floor {
                             return Some(t);
                         }
@@ -522,8 +528,7 @@ impl ProxyMeshQuery {
                     }
                 }
                 if c.rate > 0.0 {
-                    let level = c.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE);
-                    next = next.min(c.at + (c.bound - level) / c.rate);
+                    next = next.min(c.at + (c.bound - c.stops_at()) / c.rate);
                 }
             }
             if next >= end {
