@@ -59,10 +59,10 @@ pub struct ProxyCollider {
 impl ProxyCollider {
     /// The shape's support function, as GJK between two convex shapes asks it.
     #[must_use]
-    pub fn support(&self) -> &dyn SupportMap {
+    pub fn support(&self) -> &(dyn SupportMap + Sync) {
         match &self.hull {
             Some(hull) => hull,
-            None => self.shape.as_support_map().expect("a capsule"),
+            None => self.shape.as_capsule().expect("a capsule"),
         }
     }
 

@@ -7,7 +7,8 @@
 //!   objects, which gives the rendered hand (it never sinks in) and its contacts;
 //! * [`ProxyMeshQuery`] — a proxy against a triangle mesh (the nearest triangle, the time of
 //!   impact), its own rather than parry's, whose GJK in metres is centimetres off there;
-//!   a hull proxy's support points by hill climbing (`hull_support`).
+//!   a hull proxy's support points by hill climbing (`hull_support`), which parry's casts
+//!   between hulls take through a dispatcher of their own (`support_pair`).
 //! * [`TriangleTree`] — a mesh object's triangles in a tree of its own, built once, which
 //!   those queries search.
 
@@ -17,6 +18,7 @@ mod hull_support;
 mod object_colliders;
 mod proxy;
 mod proxy_mesh_query;
+mod support_pair;
 mod triangle_tree;
 
 pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S, STOP_DISTANCE};

@@ -15,12 +15,12 @@ use std::sync::Arc;
 use glam::{Affine3A, Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query::details::NonlinearShapeCastMode;
-use parry3d::query::{self, DefaultQueryDispatcher, NonlinearRigidMotion};
+use parry3d::query::{self, NonlinearRigidMotion};
 use parry3d::shape::{SharedShape, SupportMap, TriMeshFlags};
 
 use super::hand_proxies::{pose_of, ProxyCollider};
 use super::hull_support::HullSupport;
+use super::support_pair::SupportPair;
 use super::triangle_tree::TriangleTree;
 use super::HandProxies;
 use crate::Warning;
@@ -96,20 +96,9 @@ impl ObjectCollider {
     pub fn misses_hull(&self, motion: &NonlinearRigidMotion, proxy: &ProxyCollider, end: f32) -> bool {
         let Some(hull) = self.hull() else { return false };
         let still = NonlinearRigidMotion::constant_position(self.pose);
-        let hit = match self.hull_support() {
-            Some(support) => Ok(query::details::cast_shapes_nonlinear_support_map_support_map(
-                &DefaultQueryDispatcher,
-                motion,
-                proxy.support(),
-                &*proxy.shape,
-                &still,
-                support,
-                &**hull,
-                0.0,
-                end,
-                NonlinearShapeCastMode::StopAtPenetration,
-            )),
-            None => query::cast_shapes_nonlinear(motion, &*proxy.shape, &still, &**hull, 0.0, end, true),
+        let hit = match &self.hull_support {
+            Some(support) => Ok(SupportPair { shapes: [&*proxy.shape, &**hull], supports: [proxy.support(), support] }.time_of_impact(motion, &still, end)),
+            None => query::cast_shapes_nonlinear(motion, &*proxy.shape, &still, &**hull, 0.0, end, true).map(|hit| hit.map(|hit| hit.time_of_impact)),
         };
         matches!(hit, Ok(None))
     }
