@@ -477,6 +477,17 @@ impl ProxyMeshQuery {
         }
         let local_pose = |t: f32| mesh_pose.inv_mul(&motion.position_at_time(t));
         let start = local_pose(0.0);
+        let pivot = motion.start * motion.local_center;
+        // Touching at the start and moving into it (as below): stopped at once, before the
+        // sweep's triangles are gathered (hundreds, while the hand is held back on the teapot).
+        // The search takes a copy of the proxy's faced direction: later searches are as before.
+        let mut faced = self.faced[proxy];
+        if let Some(n) = Self::search(cast, &mut faced, &mut self.epa.0, &start, mesh, TOLERANCE, TOLERANCE, 0.0) {
+            let (normal, at) = (mesh_pose.rotation * n.normal, *mesh_pose * (n.point + n.normal * n.distance));
+            if n.distance <= TOLERANCE && (normal == Vec3::ZERO || (motion.linvel + motion.angvel.cross(at - pivot)).dot(normal) < 0.0) {
+                return Some(0.0);
+            }
+        }
         let placed = cast.at(start);
         self.candidates.clear();
         let candidates = &mut self.candidates;
@@ -486,7 +497,6 @@ impl ProxyMeshQuery {
         });
         // Nearest first: a contact at the start is then found after few exact distances.
         self.candidates.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound));
-        let pivot = motion.start * motion.local_center;
         let mut t = 0.0;
         for _ in 0..MAX_STEPS {
             let pose = if t == 0.0 { start } else { local_pose(t) };
