@@ -484,7 +484,9 @@ impl ProxyMeshQuery {
         let mut faced = self.faced[proxy];
         if let Some(n) = Self::search(cast, &mut faced, &mut self.epa.0, &start, mesh, TOLERANCE, TOLERANCE, 0.0) {
             let (normal, at) = (mesh_pose.rotation * n.normal, *mesh_pose * (n.point + n.normal * n.distance));
-            if n.distance <= TOLERANCE && (normal == Vec3::ZERO || (motion.linvel + motion.angvel.cross(at - pivot)).dot(normal) < 0.0) {
+            // (Into it clearly: the point is rebuilt from the mesh's, a little off, so a motion
+            // along the surface is left to the full test.)
+            if n.distance <= TOLERANCE && (normal == Vec3::ZERO || (motion.linvel + motion.angvel.cross(at - pivot)).dot(normal) < -1e-6 * speed) {
                 return Some(0.0);
             }
         }

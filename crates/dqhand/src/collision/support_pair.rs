@@ -11,12 +11,14 @@
 use parry3d::math::{Pose, Real};
 use parry3d::query::details::{self, NonlinearShapeCastMode};
 use parry3d::query::{
-    ClosestPoints, Contact, NonlinearRigidMotion, QueryDispatcher, ShapeCastHit, ShapeCastOptions, ShapeDistance, ShapeIntersection, Unsupported,
+    ClosestPoints, Contact, DefaultQueryDispatcher, NonlinearRigidMotion, QueryDispatcher, ShapeCastHit, ShapeCastOptions, ShapeDistance, ShapeIntersection,
+    Unsupported,
 };
 use parry3d::shape::{Shape, SupportMap};
 
 /// Two shapes and the support functions that stand for them: the one query dispatcher of a
-/// cast between exactly these two (any other pair is [`Unsupported`]).
+/// cast between exactly these two (closest points of any other pair are parry's own; the cast
+/// asks for nothing else).
 pub struct SupportPair<'a> {
     pub shapes: [&'a dyn Shape; 2],
     pub supports: [&'a (dyn SupportMap + Sync); 2],
@@ -34,7 +36,7 @@ impl SupportPair<'_> {
         }
     }
 
-    /// The first time in `[0, end)` at which `shapes[0]` moving by `motion` touches
+    /// The first time in `[0, end]` at which `shapes[0]` moving by `motion` touches
     /// `shapes[1]` moving by `other` (starting in it is time 0), if any: parry's nonlinear
     /// cast between two support maps, stopping at penetration.
     #[must_use]
@@ -61,9 +63,11 @@ impl QueryDispatcher for SupportPair<'_> {
 
     fn closest_points(&self, pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, max_dist: Real) -> Result<ClosestPoints, Unsupported> {
         let [s1, s2] = self.supports;
-        match self.order(g1, g2).ok_or(Unsupported)? {
-            false => Ok(details::closest_points_support_map_support_map(pos12, s1, s2, max_dist)),
-            true => Ok(details::closest_points_support_map_support_map(pos12, s2, s1, max_dist)),
+        // (An answer refused would end the cast as a miss.)
+        match self.order(g1, g2) {
+            Some(false) => Ok(details::closest_points_support_map_support_map(pos12, s1, s2, max_dist)),
+            Some(true) => Ok(details::closest_points_support_map_support_map(pos12, s2, s1, max_dist)),
+            None => DefaultQueryDispatcher.closest_points(pos12, g1, g2, max_dist),
         }
     }
 
@@ -98,9 +102,15 @@ mod tests {
         ConvexPolyhedron::from_convex_hull(&points).expect("a hull")
     }
 
+    /// A lopsided hull: the ball's points stretched along x, sheared and moved off its origin.
+    fn lopsided_hull(r: f32) -> ConvexPolyhedron {
+        let points: Vec<Vec3> = ball_hull(r).points().iter().map(|p| Vec3::new(2.0 * p.x + 0.5 * p.y, p.y, 0.7 * p.z) + Vec3::new(0.01, -0.02, 0.005)).collect();
+        ConvexPolyhedron::from_convex_hull(&points).expect("a hull")
+    }
+
     #[test]
     fn the_cast_by_support_functions_meets_where_parrys_does() {
-        let (a, b) = (ball_hull(0.03), ball_hull(0.05));
+        let (a, b) = (lopsided_hull(0.03), ball_hull(0.05));
         let (sa, sb) = (HullSupport::new(&a, 1.0), HullSupport::new(&b, 1.0));
         let still = NonlinearRigidMotion::constant_position(Pose::from_translation(Vec3::new(0.0, 0.0, 0.0)));
         for (from, linvel, angvel, hits) in [
@@ -112,24 +122,31 @@ mod tests {
             (Vec3::new(0.05, 0.0, 0.0), Vec3::new(0.1, 0.0, 0.0), Vec3::ZERO, true),
         ] {
             let motion = NonlinearRigidMotion::new(Pose::from_translation(from), Vec3::ZERO, linvel, angvel);
-            let ours = SupportPair { shapes: [&a, &b], supports: [&sa, &sb] }.time_of_impact(&motion, &still, 1.0);
-            let parrys = details::cast_shapes_nonlinear_support_map_support_map(&DefaultQueryDispatcher, &motion, &a, &a, &still, &b, &b, 0.0, 1.0, NonlinearShapeCastMode::StopAtPenetration)
-                .map(|hit| hit.time_of_impact);
-            assert_eq!(ours.is_some(), hits, "from {from}: {ours:?}");
-            match (ours, parrys) {
-                (Some(x), Some(y)) => assert!((x - y).abs() < 1e-4, "from {from}: {x} against parry's {y}"),
-                (x, y) => assert_eq!(x.is_some(), y.is_some(), "from {from}: {x:?} against parry's {y:?}"),
+            // Either hull moving, either first: parry's cast swaps them by size.
+            let (sa, sb): (&(dyn SupportMap + Sync), &(dyn SupportMap + Sync)) = (&sa, &sb);
+            let cases: [(&ConvexPolyhedron, _, &ConvexPolyhedron, _); 2] = [(&a, sa, &b, sb), (&b, sb, &a, sa)];
+            for (moving, moving_support, other, other_support) in cases {
+                let ours = SupportPair { shapes: [moving, other], supports: [moving_support, other_support] }.time_of_impact(&motion, &still, 1.0);
+                let parrys = details::cast_shapes_nonlinear_support_map_support_map(&DefaultQueryDispatcher, &motion, moving, moving, &still, other, other, 0.0, 1.0, NonlinearShapeCastMode::StopAtPenetration)
+                    .map(|hit| hit.time_of_impact);
+                assert_eq!(parrys.is_some(), hits, "from {from}: parry's {parrys:?}");
+                match (ours, parrys) {
+                    (Some(x), Some(y)) => assert!((x - y).abs() < 1e-4, "from {from}: {x} against parry's {y}"),
+                    (x, y) => assert_eq!(x.is_some(), y.is_some(), "from {from}: {x:?} against parry's {y:?}"),
+                }
             }
         }
-        // Head on along x, where both hulls have a vertex on their sphere: 12 cm apart, closing
-        // at 0.3 a unit of time; starting in it is time 0.
+        // Head on along x, where both balls' hulls have a vertex on their sphere: 12 cm apart,
+        // closing at 0.3 a unit of time; starting in it is time 0.
+        let (a, sa) = (ball_hull(0.03), HullSupport::new(&ball_hull(0.03), 1.0));
         let pair = SupportPair { shapes: [&a, &b], supports: [&sa, &sb] };
         let head_on = NonlinearRigidMotion::new(Pose::from_translation(Vec3::new(0.2, 0.0, 0.0)), Vec3::ZERO, Vec3::new(-0.3, 0.0, 0.0), Vec3::ZERO);
         let t = pair.time_of_impact(&head_on, &still, 1.0).expect("it hits");
         assert!((0.399..0.41).contains(&t), "{t}");
         let inside = NonlinearRigidMotion::new(Pose::from_translation(Vec3::new(0.05, 0.0, 0.0)), Vec3::ZERO, Vec3::X, Vec3::ZERO);
         assert_eq!(pair.time_of_impact(&inside, &still, 1.0), Some(0.0));
-        // The pair answers only for its own two shapes.
-        assert!(pair.closest_points(&Pose::identity(), &b, &b, 1.0).is_err());
+        // Another pair's closest points are parry's own.
+        let apart = Pose::from_translation(Vec3::new(0.2, 0.0, 0.0));
+        assert_eq!(pair.closest_points(&apart, &b, &b, 1.0).ok(), DefaultQueryDispatcher.closest_points(&apart, &b, &b, 1.0).ok());
     }
 }
