@@ -96,11 +96,10 @@ impl ObjectCollider {
     pub fn misses_hull(&self, motion: &NonlinearRigidMotion, proxy: &ProxyCollider, end: f32) -> bool {
         let Some(hull) = self.hull() else { return false };
         let still = NonlinearRigidMotion::constant_position(self.pose);
-        let hit = match &self.hull_support {
-            Some(support) => Ok(SupportPair { shapes: [&*proxy.shape, &**hull], supports: [proxy.support(), support] }.time_of_impact(motion, &still, end)),
-            None => query::cast_shapes_nonlinear(motion, &*proxy.shape, &still, &**hull, 0.0, end, true).map(|hit| hit.map(|hit| hit.time_of_impact)),
-        };
-        matches!(hit, Ok(None))
+        match &self.hull_support {
+            Some(support) => SupportPair { shapes: [&*proxy.shape, &**hull], supports: [proxy.support(), support] }.time_of_impact(motion, &still, end).is_none(),
+            None => matches!(query::cast_shapes_nonlinear(motion, &*proxy.shape, &still, &**hull, 0.0, end, true), Ok(None)),
+        }
     }
 
     /// The distance from `proxy` at `pose` to the surface, or a lower bound of it above

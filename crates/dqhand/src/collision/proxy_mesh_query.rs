@@ -478,6 +478,9 @@ impl ProxyMeshQuery {
         let local_pose = |t: f32| mesh_pose.inv_mul(&motion.position_at_time(t));
         let start = local_pose(0.0);
         let pivot = motion.start * motion.local_center;
+        // How fast the proxy's point `x` (world) moves along `n`: into a surface of normal `n`
+        // where negative.
+        let along = |x: Vec3, n: Vec3| (motion.linvel + motion.angvel.cross(x - pivot)).dot(n);
         // Touching at the start and moving into it (as below): stopped at once, before the
         // sweep's triangles are gathered (hundreds, while the hand is held back on the teapot).
         // The search takes a copy of the proxy's faced direction: later searches are as before.
@@ -486,7 +489,7 @@ impl ProxyMeshQuery {
             let (normal, at) = (mesh_pose.rotation * n.normal, *mesh_pose * (n.point + n.normal * n.distance));
             // (Into it clearly: the point is rebuilt from the mesh's, a little off, so a motion
             // along the surface is left to the full test.)
-            if n.distance <= TOLERANCE && (normal == Vec3::ZERO || (motion.linvel + motion.angvel.cross(at - pivot)).dot(normal) < -1e-6 * speed) {
+            if n.distance <= TOLERANCE && (normal == Vec3::ZERO || along(at, normal) < -1e-6 * speed) {
                 return Some(0.0);
             }
         }
@@ -514,7 +517,7 @@ impl ProxyMeshQuery {
                     let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
                     if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
                         // Its touching point moves off it: a proxy may leave what it rests on.
-                        c.left = ((motion.linvel + motion.angvel.cross(x - pivot)).dot(n) >= 0.0).then_some(distance);
+                        c.left = (along(x, n) >= 0.0).then_some(distance);
                     }
                     // The plane through its nearest point, square to `n`, holds the triangle on
                     // its far side; the proxy closes on that plane no faster than this. Where

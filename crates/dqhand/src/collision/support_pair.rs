@@ -112,7 +112,7 @@ mod tests {
     fn the_cast_by_support_functions_meets_where_parrys_does() {
         let (a, b) = (lopsided_hull(0.03), ball_hull(0.05));
         let (sa, sb) = (HullSupport::new(&a, 1.0), HullSupport::new(&b, 1.0));
-        let still = NonlinearRigidMotion::constant_position(Pose::from_translation(Vec3::new(0.0, 0.0, 0.0)));
+        let still = NonlinearRigidMotion::constant_position(Pose::identity());
         for (from, linvel, angvel, hits) in [
             (Vec3::new(0.2, 0.01, 0.0), Vec3::new(-0.3, 0.0, 0.0), Vec3::ZERO, true),
             (Vec3::new(0.0, 0.15, 0.02), Vec3::new(0.0, -0.2, 0.01), Vec3::new(0.0, 0.0, 3.0), true),
