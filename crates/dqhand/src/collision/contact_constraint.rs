@@ -111,8 +111,9 @@ struct FingerChain {
     /// them too.
     others: Vec<usize>,
     /// Its proxies: (index in [`HandProxies::colliders`], the last DOF (position in `dofs`)
-    /// that moves it, and per DOF an upper bound of the distance of its points from that
-    /// DOF's joint, 0 where the DOF does not move it).
+    /// that moves it, and per DOF an upper bound of the distance of its core's points (a
+    /// capsule's segment: its distance falls no faster than they move) from that DOF's
+    /// joint, 0 where the DOF does not move it).
     proxies: Vec<(usize, usize, Vec<f32>)>,
     /// The largest distance of any of its proxies' points from its first DOF's joint.
     reach: f32,
@@ -229,9 +230,9 @@ impl ContactConstraint {
                 .iter()
                 .enumerate()
                 .filter_map(|(i, p)| {
-                    let levers: Vec<f32> = dofs.iter().map(|&(_, j)| if is_ancestor(j, p.joint) { chain_length(j, p.joint) + p.extent } else { 0.0 }).collect();
+                    let levers: Vec<f32> = dofs.iter().map(|&(_, j)| if is_ancestor(j, p.joint) { chain_length(j, p.joint) + p.lever } else { 0.0 }).collect();
                     let last = levers.iter().rposition(|&l| l > 0.0)?;
-                    reach = reach.max(levers[0]);
+                    reach = reach.max(levers[0] + p.extent - p.lever);
                     Some((i, last, levers))
                 })
                 .collect::<Vec<_>>();

@@ -49,6 +49,11 @@ pub struct ProxyCollider {
     /// The largest distance of a point of the shape from the joint's origin (m): bounds how
     /// fast the shape moves when the joint turns.
     pub extent: f32,
+    /// The largest distance of a point of the shape's core from the joint's origin (m): a
+    /// capsule's segment, a hull's vertices. A capsule's distance to anything is its
+    /// segment's less its radius, so it falls no faster than the segment's points move:
+    /// the lever of a turn is this, not [`Self::extent`].
+    pub lever: f32,
     /// A hull's support function by hill climbing (parry's tries every vertex: 957 on the
     /// wrist's).
     hull: Option<HullSupport>,
@@ -105,19 +110,20 @@ impl HandProxies {
         let colliders = proxies
             .iter()
             .filter_map(|p| {
-                let (shape, extent, hull) = match &p.shape {
+                let (shape, lever, extent, hull) = match &p.shape {
                     ProxyShape::Capsule { start, end, radius } => {
-                        (SharedShape::capsule(*start, *end, *radius), start.length().max(end.length()) + radius, None)
+                        let lever = start.length().max(end.length());
+                        (SharedShape::capsule(*start, *end, *radius), lever, lever + radius, None)
                     }
                     ProxyShape::ConvexHull { points, triangles } => {
                         let extent = points.iter().map(|q| q.length()).fold(0.0, f32::max);
                         let shape = SharedShape::convex_mesh(points.clone(), triangles)?;
                         let hull = shape.as_convex_polyhedron().map(|h| HullSupport::new(h, 1.0));
-                        (shape, extent, hull)
+                        (shape, extent, extent, hull)
                     }
                 };
                 let local_aabb = shape.compute_local_aabb();
-                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent, hull, local_aabb })
+                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent, lever, hull, local_aabb })
             })
             .collect();
         Self { colliders }
