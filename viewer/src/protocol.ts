@@ -12,8 +12,10 @@ export const FLAG_DISTORTION = 1;
 export const FLAG_SECOND_HAND = 2;
 export const STATE_PLAYING = 1;
 export const STATE_LIMITS = 2;
-export const METHODS = ['lb', 'qb', 'dqb'] as const;
+export const METHODS = ['lb', 'qb', 'dqb', 'cor'] as const;
 export type Method = (typeof METHODS)[number];
+/** The paper's three, which the split view shows side by side (a frame holds at most three meshes). */
+export const PAPER_METHODS: readonly Method[] = ['lb', 'qb', 'dqb'];
 
 export class ProtocolError extends Error {}
 

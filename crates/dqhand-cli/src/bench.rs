@@ -109,6 +109,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let model = Arc::new(model);
     let mesh = &model.mesh;
     let best = Kernel::best();
+    // CoR's precomputation, timed alone (the first CoR deformer below computes the mesh's
+    // own, once).
+    let centres_ms = {
+        let start = std::time::Instant::now();
+        std::hint::black_box(dqhand::skin::centres_of_rotation(mesh));
+        start.elapsed().as_secs_f64() * 1e3
+    };
     // The run-time choice, made before the timed variants' deformers are built (the first
     // deformer of each method measures; the rest reuse the choice).
     let chosen = Method::ALL.map(|m| Deformer::new(m, mesh).strategy());
@@ -210,6 +217,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "cores": cores,
         "kernel": best.name(),
         "kernels": kernels.iter().map(|k| k.name()).collect::<Vec<_>>(),
+        "cor_centres_ms": centres_ms,
         "methods": Method::ALL.iter().map(|&m| (m.as_str().to_owned(), json!({ "us_per_frame": table3(m), "fps": 1e6 / table3(m) }))).collect::<serde_json::Map<_, _>>(),
         "ratios": { "dqb_over_lb": table3(Method::Dqb) / table3(Method::Lb), "dqb_over_qb": table3(Method::Dqb) / table3(Method::Qb) },
         "strategies": strategies.iter().map(|s| s.name()).collect::<Vec<_>>(),
@@ -240,15 +248,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("{:<6} {med:>10.1} {p10:>10.1} {p90:>10.1} {:>12.0}", m.as_str().to_uppercase(), 1e6 / med);
     }
     println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", table3(Method::Dqb) / table3(Method::Lb), table3(Method::Dqb) / table3(Method::Qb));
+    println!("CoR/DQB {:.3}   (target ≤ 1.2); CoR's centres of rotation computed in {centres_ms:.0} ms on {cores} threads", table3(Method::Cor) / table3(Method::Dqb));
+    let heads = Method::ALL.map(|m| format!("{:>8}", m.as_str().to_uppercase())).join(" ");
     println!("\nkernels: one thread; positions and normals | positions only");
-    println!("{:<9} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}", "kernel", "LB", "QB", "DQB", "LB", "QB", "DQB");
+    println!("{:<9} {heads} | {heads}", "kernel");
     for &k in &kernels {
         let cell = |normals| Method::ALL.map(|m| format!("{:>8.1}", us(m, k, 1, normals))).join(" ");
         println!("{:<9} {} | {}", k.name(), cell(true), cell(false));
     }
     if !strategies.is_empty() {
         println!("\nAVX-512 lookup strategies: one thread; positions and normals | positions only");
-        println!("{:<9} {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8}", "strategy", "LB", "QB", "DQB", "LB", "QB", "DQB");
+        println!("{:<9} {heads} | {heads}", "strategy");
         for &s in &strategies {
             let cell = |normals| Method::ALL.map(|m| format!("{:>8.1}", by_strategy(m, s, normals))).join(" ");
             println!("{:<9} {} | {}", s.name(), cell(true), cell(false));

@@ -51,7 +51,7 @@ enum Command {
     Hand(hand::Args),
     /// Pose a mesh with LB, QB or DQB and write it with normals (.ply, .obj or .glb).
     Skin(skin::Args),
-    /// Time LB, QB and DQB interleaved in one run (the paper's Table 3 on this machine).
+    /// Time LB, QB, DQB and CoR interleaved in one run (the paper's Table 3 on this machine, and CoR beyond it).
     Bench(bench::Args),
     /// The viewer server under load and abuse, measured: 1, 10 and 64 viewers, a malformed
     /// flood, slowloris, a slow reader.

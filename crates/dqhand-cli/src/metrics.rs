@@ -37,12 +37,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     } else if args.markdown {
         print!("{}", report.markdown());
     } else {
-        println!("{}: {} vertices; LB, QB and DQB on {} sweeps", args.mesh, report.vertices, report.sweeps.len());
+        println!("{}: {} vertices; LB, QB, DQB and CoR on {} sweeps", args.mesh, report.vertices, report.sweeps.len());
         let w = report.headline().iter().map(|h| h.0.chars().count()).max().unwrap_or(0);
-        println!("{:<w$}  {:>9} {:>9} {:>9}", "measure", "LB", "QB", "DQB");
+        println!("{:<w$}  {:>9} {:>9} {:>9} {:>9}", "measure", "LB", "QB", "DQB", "CoR");
         for (label, v) in report.headline() {
-            let [lb, qb, dqb] = v.map(dqhand::metrics::format_value);
-            println!("{label:<w$}  {lb:>9} {qb:>9} {dqb:>9}");
+            let [lb, qb, dqb, cor] = v.map(dqhand::metrics::format_value);
+            println!("{label:<w$}  {lb:>9} {qb:>9} {dqb:>9} {cor:>9}");
         }
     }
     Ok(())

@@ -12,7 +12,8 @@ use dqhand::skin::{Method, SkinnedMesh};
 /// What a frame needs.
 #[derive(Clone, Copy, Debug)]
 pub struct Work {
-    /// Bytes read: rest positions (and normals), joints (u16) and weights (f32) of every slot.
+    /// Bytes read: rest positions (and normals; CoR's centres), joints (u16) and weights (f32)
+    /// of every slot.
     pub read: f64,
     /// Bytes written: deformed positions (and normals).
     pub written: f64,
@@ -26,18 +27,22 @@ impl Work {
     pub fn of(mesh: &SkinnedMesh, method: Method, normals: bool) -> Self {
         let n = mesh.vertex_count() as f64;
         let components = if normals { 6.0 } else { 3.0 };
-        let (read, written) = (n * (components * 4.0 + mesh.influences_per_vertex() as f64 * 6.0), n * components * 4.0);
+        let inputs = components + if method == Method::Cor { 3.0 } else { 0.0 };
+        let (read, written) = (n * (inputs * 4.0 + mesh.influences_per_vertex() as f64 * 6.0), n * components * 4.0);
         let influences: f64 = mesh.influence_histogram().iter().enumerate().map(|(k, &count)| (k * count) as f64).sum();
-        // Per influence: a multiply-add per parameter read (LB 12, QB 7, DQB 8), and the
-        // quaternion methods' sign. Per vertex, the finish as the kernel computes it:
+        // Per influence: a multiply-add per parameter read (LB 12, QB 7, DQB 8, CoR 16), and
+        // the quaternion methods' sign. Per vertex, the finish as the kernel computes it:
         // LB 3 four-term dots (21), its normal's cofactor rows (27), their products with the
         // normal (15), its length and the determinant (10), the scale (5); QB the norm (8), a
         // rotation (31) and the translation (3), a rotation per normal; DQB the norm (8), a
-        // rotation, eq. (5)'s translation (28), a rotation per normal.
+        // rotation, eq. (5)'s translation (28), a rotation per normal; CoR the norm (8), the
+        // offset from the centre (3), a rotation, the blended matrix's 3 four-term dots at the
+        // centre (21) and their sum (3), a rotation per normal.
         let (per_influence, finish, per_normal) = match method {
             Method::Lb => (24.0, 21.0, 57.0),
             Method::Qb => (15.0, 42.0, 31.0),
             Method::Dqb => (17.0, 67.0, 31.0),
+            Method::Cor => (33.0, 66.0, 31.0),
         };
         Self { read, written, flops: influences * per_influence + n * (finish + if normals { per_normal } else { 0.0 }) }
     }

@@ -13,7 +13,7 @@
 //! 0  u32 magic "DQHF"   4 u16 version   6 u16 flags (bit 0: distortion arrays follow;
 //!                                                   bit 1: of the second hand)
 //! 8  u32 sequence number   12 u32 vertex count   16 u32 joint count   20 u32 DOF count
-//! 24 u8 mesh count (1–3)   25 u8 method per mesh (0 LB, 1 QB, 2 DQB; 255 unused) ×3
+//! 24 u8 mesh count (1–3)   25 u8 method per mesh (0 LB, 1 QB, 2 DQB, 3 CoR; 255 unused) ×3
 //! 28 f32 engine time of this frame (pose + skin + distortion), µs
 //! 32 f32 frames per second the engine is sending   36 f32 timeline time, s
 //! 40 f32 timeline duration, s (0: no timeline)     44 u32 state (bit 0: playing; bit 1: limits on)

@@ -60,7 +60,7 @@ pub struct Session {
 struct ShownHand {
     engine: Engine,
     /// One distortion buffer per method, in [`Method::ALL`] order.
-    distortion: [Vec<f32>; 3],
+    distortion: [Vec<f32>; 4],
     vertex_distortion: VertexDistortion,
     joints: Vec<[f32; 3]>,
 }
@@ -321,8 +321,9 @@ impl Session {
     }
 
     /// Applies a gesture command to the view: `next_method` shows the method after the first
-    /// one in view alone, `split_view` shows LB, QB and DQB side by side, `toggle_heatmap`
-    /// turns the distortion heat map on or off.
+    /// one in view alone (of all four), `split_view` shows the paper's LB, QB and DQB side by
+    /// side (a frame holds three meshes), `toggle_heatmap` turns the distortion heat map on or
+    /// off.
     pub fn act(&mut self, action: Action) {
         match action {
             Action::NextMethod => {
@@ -330,7 +331,7 @@ impl Session {
                 let next = Method::ALL[(first.index() + 1) % Method::ALL.len()];
                 self.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
             }
-            Action::SplitView => self.set_methods(MethodSet::ALL),
+            Action::SplitView => self.set_methods(MethodSet::PAPER),
             Action::ToggleHeatmap => self.heatmap = !self.heatmap,
         }
     }

@@ -335,7 +335,7 @@ fn hello_describes_the_model_and_its_controls() {
     let pip = dofs.iter().find(|d| d["name"] == "index-finger-phalanx-intermediate.flex").unwrap();
     assert_eq!((pip["min_deg"].as_f64(), pip["max_deg"].as_f64()), (Some(0.0), Some(110.0)));
     assert_eq!(hello["gestures"].as_array().unwrap().len(), GESTURES.len());
-    assert_eq!(hello["methods"], serde_json::json!(["lb", "qb", "dqb"]));
+    assert_eq!(hello["methods"], serde_json::json!(["lb", "qb", "dqb", "cor"]));
     let topology = Topology::parse(&s.topologies()[0].encode()).unwrap();
     assert_eq!(topology.indices.len(), 3 * HAND.mesh.triangle_count());
     assert_eq!(topology.parents.iter().filter(|p| p.is_none()).count(), 1);
@@ -409,19 +409,20 @@ fn following_an_input_of_another_joint_model_takes_the_shared_angles() {
     assert_eq!(frame(&mut s).header.state & STATE_PLAYING, 0);
 }
 
-/// Gesture commands change the view: the next method alone (cycling), all three, the heat map.
+/// Gesture commands change the view: the next method alone (cycling through all four), the
+/// paper's three side by side, the heat map.
 #[test]
 fn gesture_commands_change_the_view() {
     use dqhand_stream::Action;
     let mut s = paused();
     let shown = |s: &Session| s.methods().as_slice().to_vec();
     assert_eq!(shown(&s), [Method::Dqb]);
-    for expected in [Method::Lb, Method::Qb, Method::Dqb] {
+    for expected in [Method::Cor, Method::Lb, Method::Qb, Method::Dqb] {
         s.act(Action::NextMethod);
         assert_eq!(shown(&s), [expected]);
     }
     s.act(Action::SplitView);
-    assert_eq!(shown(&s), Method::ALL);
+    assert_eq!(shown(&s), Method::PAPER);
     s.act(Action::NextMethod);
     assert_eq!(shown(&s), [Method::Qb], "after the first of the split view");
     assert!(!s.heatmap());

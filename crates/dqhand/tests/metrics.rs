@@ -60,13 +60,20 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
     let report = measure(std::sync::Arc::new(model)).unwrap();
     let h = report.headline();
     let row = |label: &str| h.iter().find(|r| r.0.starts_with(label)).unwrap_or_else(|| panic!("no row {label}")).1.map(Option::unwrap);
-    let [lb, _, dqb] = row("skin-to-bone distance at 90° PIP, smallest");
+    let [lb, _, dqb, _] = row("skin-to-bone distance at 90° PIP, smallest");
     assert!(lb < 0.6 && dqb > lb + 0.1, "collapse at 90° PIP: LB {lb}, DQB {dqb}");
-    let [lb, _, dqb] = row("section radius at 180° PIP twist");
+    let [lb, _, dqb, _] = row("section radius at 180° PIP twist");
     assert!(lb < 0.3 && dqb > 0.9, "candy wrapper at 180°: LB {lb}, DQB {dqb}");
-    let [_, qb, dqb] = row("skin-to-bone distance at 90° PIP, largest");
+    let [_, qb, dqb, cor] = row("skin-to-bone distance at 90° PIP, largest");
     assert!(qb > 2.0 && dqb < 1.3, "QB's rotation-centre artifact: QB {qb}, DQB {dqb}");
-    let [lb, _, dqb] = row("volume in a full fist");
+    // CoR turns each vertex about its own centre: less of DQB's bulge at the bent joint
+    // (Le and Hodgins' claim), and no more collapse.
+    assert!(cor < dqb - 0.03, "bulge at 90° PIP: DQB {dqb}, CoR {cor}");
+    let [lb, _, dqb, cor] = row("skin-to-bone distance at 90° PIP, smallest");
+    assert!(cor > lb + 0.1 && cor >= dqb - 0.02, "collapse at 90° PIP: LB {lb}, DQB {dqb}, CoR {cor}");
+    let [_, _, _, cor] = row("volume at 90° index PIP flexion");
+    assert!((cor - 1.0).abs() < 0.01, "CoR's volume at 90° PIP: {cor}");
+    let [lb, _, dqb, _] = row("volume in a full fist");
     // LB loses volume in a fist; DQB loses none (it bulges a little instead, as published).
     assert!(lb < 1.0 && dqb > 0.99 && dqb > lb, "fist volume: LB {lb}, DQB {dqb}");
     let fist = report.intersections.iter().find(|(g, _)| *g == "fist").unwrap().1;
@@ -89,7 +96,7 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
     assert!(report.sweep("index-pip").unwrap().frames[2].iter().all(|f| f.self_contact.is_none()));
     // At rest every method reproduces the mesh: ratios 1, no distortion, no jump.
     for s in &report.sweeps {
-        for m in 0..3 {
+        for m in 0..4 {
             let f = s.frames[m][0];
             assert!((f.min_distance - 1.0).abs() < 1e-3 && (f.max_distance - 1.0).abs() < 1e-3, "{} rest: {f:?}", s.name);
             assert!(f.distortion_max < 1e-4 && f.jump == 0.0 && (f.volume.unwrap() - 1.0).abs() < 1e-5, "{} rest: {f:?}", s.name);

@@ -1,6 +1,8 @@
-//! LB, QB and DQB against an independent reference: plain `f64` code written from the
-//! definitions (design.md, paper section 4.4, Kavan et al. 2008), sharing nothing with the
-//! kernel — not its parameter layout, not its sign alignment, not its normalisation.
+//! LB, QB, DQB and CoR against an independent reference: plain `f64` code written from the
+//! definitions (design.md, paper section 4.4, Kavan et al. 2008, Le and Hodgins 2016),
+//! sharing nothing with the kernel — not its parameter layout, not its sign alignment, not
+//! its normalisation. CoR's centres are random here, given with the mesh: its precomputation
+//! has its own reference (tests/centres_of_rotation.rs).
 //!
 //! Regression for issue 9 bug 1: QB's sign alignment used to flip the translation with the
 //! rotation, so a vertex whose influences lay in opposite quaternion hemispheres got
@@ -21,6 +23,8 @@ struct Case {
     normals: Vec<[f32; 3]>,
     /// Per vertex, (joint, weight) influences; weights not normalised.
     influences: Vec<Vec<(u32, f32)>>,
+    /// Per vertex, its centre of rotation (CoR).
+    centres: Vec<[f32; 3]>,
     skinning: Vec<Affine3A>,
     flips: Vec<bool>,
 }
@@ -45,6 +49,7 @@ fn case_of(joints: usize, max_influences: usize) -> impl Strategy<Value = Case> 
             inf.dedup_by_key(|i| i.0);
             inf
         }),
+        (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0),
     );
     let bone = (
         (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0).prop_filter("axis", |a| a.0.abs() + a.1.abs() + a.2.abs() > 0.2),
@@ -53,8 +58,9 @@ fn case_of(joints: usize, max_influences: usize) -> impl Strategy<Value = Case> 
         any::<bool>(),
     );
     (proptest::collection::vec(vertex, 1..72), proptest::collection::vec(bone, joints)).prop_map(|(vs, bones)| {
-        let mut c = Case { positions: vec![], normals: vec![], influences: vec![], skinning: vec![], flips: vec![] };
-        for (p, n, inf) in vs {
+        let mut c = Case { positions: vec![], normals: vec![], influences: vec![], centres: vec![], skinning: vec![], flips: vec![] };
+        for (p, n, inf, centre) in vs {
+            c.centres.push([centre.0, centre.1, centre.2]);
             c.positions.push([p.0, p.1, p.2]);
             let n = Vec3::new(n.0, n.1, n.2).normalize();
             c.normals.push(n.to_array());
@@ -84,7 +90,7 @@ fn mesh(c: &Case, stride: usize) -> SkinnedMesh {
             data.weights.push(w);
         }
     }
-    SkinnedMesh::new(data).expect("valid mesh").0
+    SkinnedMesh::new(data).expect("valid mesh").0.with_centres_of_rotation(&c.centres).expect("one centre per vertex")
 }
 
 /// A bone's rotation and translation in `f64`, read off the matrix by Shepperd's method
@@ -156,7 +162,7 @@ fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> 
             let frobenius = |m: DMat3| (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt();
             Some((r * p + t, (r.inverse().transpose() * n).normalize(), frobenius(r) * frobenius(r.inverse())))
         }
-        Method::Qb | Method::Dqb => {
+        Method::Qb | Method::Dqb | Method::Cor => {
             let bones: Vec<(usize, f64, [f64; 4], DVec3)> = inf
                 .iter()
                 .map(|&(j, w)| {
@@ -170,18 +176,23 @@ fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> 
                 return None;
             }
             let sign = |q: [f64; 4]| if dot(q) < 0.0 { -1.0 } else { 1.0 };
-            if method == Method::Qb {
-                // q = normalise(Σ wᵢ sᵢ qᵢ), t = Σ wᵢ tᵢ, v' = q v q* + t.
+            if method != Method::Dqb {
+                // q = normalise(Σ wᵢ sᵢ qᵢ). QB: t = Σ wᵢ tᵢ, v' = q v q* + t. CoR, about
+                // the centre c: v' = q (v − c) q* + Σ wᵢ (qᵢ c qᵢ* + tᵢ).
                 let mut q = [0.0; 4];
                 let mut t = DVec3::ZERO;
+                let mut moved_centre = DVec3::ZERO;
+                let centre = Vec3::from(c.centres[v]).as_dvec3();
                 for &(_, w, qi, ti) in &bones {
                     let s = sign(qi);
                     (0..4).for_each(|k| q[k] += w * s * qi[k]);
                     t += ti * w;
+                    moved_centre += (rotate(qi, centre) + ti) * w;
                 }
                 let len = q.iter().map(|x| x * x).sum::<f64>().sqrt();
                 let q = q.map(|x| x / len);
-                Some((rotate(q, p) + t, rotate(q, n), 1.0))
+                let position = if method == Method::Qb { rotate(q, p) + t } else { rotate(q, p - centre) + moved_centre };
+                Some((position, rotate(q, n), 1.0))
             } else {
                 // b̂ = Σ wᵢ sᵢ q̂ᵢ with q̂ = q + ε ½ t q; b̂ / ‖b₀‖;
                 // v' = b₀ v b₀* + 2 vec(b_ε b₀*) (paper eq. 3–6).
@@ -271,6 +282,7 @@ fn qb_translation_is_not_flipped_with_the_rotation() {
         positions: vec![[0.0; 3]],
         normals: vec![[0.0, 1.0, 0.0]],
         influences: vec![vec![(0, 0.5), (1, 0.5)]],
+        centres: vec![[0.0; 3]],
         skinning: vec![
             Affine3A::from_rotation_translation(Quat::from_rotation_y(170f32.to_radians()), Vec3::X),
             Affine3A::from_rotation_translation(Quat::from_rotation_y(-89f32.to_radians()), Vec3::Z),

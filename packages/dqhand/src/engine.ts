@@ -9,8 +9,11 @@ import { simdSupported } from './simd.js';
 import { type Point, type Side, type Vec3, placeLandmarks, SideFilter, userSide } from './landmarks.js';
 import { XRJoints } from './xr.js';
 
-/** A skinning method: linear (LB), quaternion (QB) or dual quaternion blending (DQB, the default). */
-export type Method = 'lb' | 'qb' | 'dqb';
+/**
+ * A skinning method: linear (LB), quaternion (QB) or dual quaternion blending (DQB, the default),
+ * or optimized centres of rotation (CoR, Le and Hodgins 2016; its centres are computed when first set).
+ */
+export type Method = 'lb' | 'qb' | 'dqb' | 'cor';
 
 /** Which build to load: `'auto'` picks the SIMD one where the browser validates SIMD. */
 export type Build = 'auto' | 'simd' | 'plain';

@@ -39,15 +39,15 @@ class Hand:
     def influences(self) -> Tuple[npt.NDArray[np.uint32], npt.NDArray[np.float32]]: ...
     @overload
     def skin(
-        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: Literal[False] = False, limits: bool = True
+        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb", "cor"] = "dqb", *, normals: Literal[False] = False, limits: bool = True
     ) -> npt.NDArray[np.float32]: ...
     @overload
     def skin(
-        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: Literal[True], limits: bool = True
+        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb", "cor"] = "dqb", *, normals: Literal[True], limits: bool = True
     ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
     @overload
     def skin(
-        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb"] = "dqb", *, normals: bool, limits: bool = True
+        self, angles: _Angles, wrist: _Wrist = None, method: Literal["dqb", "qb", "lb", "cor"] = "dqb", *, normals: bool, limits: bool = True
     ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]: ...
     def joints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
     def keypoints(self, angles: _Angles, wrist: _Wrist = None, limits: bool = True) -> npt.NDArray[np.float32]: ...
@@ -112,7 +112,7 @@ class Hand:
         self,
         angles: _Angles,
         wrist: _Wrist = None,
-        method: Literal["dqb", "qb", "lb"] = "dqb",
+        method: Literal["dqb", "qb", "lb", "cor"] = "dqb",
         *,
         joint: str = "index-finger-phalanx-intermediate",
         next: Optional[str] = None,
@@ -137,7 +137,7 @@ class Hand:
         path: Union[str, PathLike[str]],
         angles: npt.ArrayLike,
         wrist: Optional[npt.ArrayLike] = None,
-        method: Literal["dqb", "qb", "lb"] = "dqb",
+        method: Literal["dqb", "qb", "lb", "cor"] = "dqb",
         *,
         limits: bool = True,
     ) -> None:

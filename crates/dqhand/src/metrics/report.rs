@@ -12,7 +12,7 @@ use crate::geometry::{check_closed, edges, enclosed_volume};
 use crate::gesture::{gesture, GESTURES};
 use crate::kinematics::{HandRig, JointModel, KinematicsLayer, Limits, Pose, Transform};
 use crate::model::Model;
-use crate::skin::{Method, MethodSet, SkinLayer};
+use crate::skin::{Deformed, Deformer, Method};
 use crate::{Error, Result};
 
 /// What one sweep moves.
@@ -93,7 +93,7 @@ pub struct Sweep {
     /// The joint whose skin is measured.
     pub joint: &'static str,
     /// Per method (in [`Method::ALL`] order), one entry per value.
-    pub frames: [Vec<FrameMetrics>; 3],
+    pub frames: [Vec<FrameMetrics>; 4],
 }
 
 /// Everything `dqhand metrics` reports.
@@ -108,12 +108,12 @@ pub struct Report {
     /// Intersecting triangle pairs of the rest mesh.
     pub rest_intersections: usize,
     /// Intersecting triangle pairs per gesture, per method (in [`Method::ALL`] order).
-    pub intersections: Vec<(&'static str, [usize; 3])>,
+    pub intersections: Vec<(&'static str, [usize; 4])>,
     /// Skin inside skin between the fingers and the palm at rest (`None` for a mesh that is not
     /// closed, whose winding numbers mean nothing).
     pub rest_self_contact: Option<SelfContact>,
     /// The same in every gesture of the library, per method (none for a mesh not closed).
-    pub self_contact: Vec<(&'static str, [SelfContact; 3])>,
+    pub self_contact: Vec<(&'static str, [SelfContact; 4])>,
 }
 
 /// Each vertex's part of the hand, for [`self_contact`]: its heaviest joint's finger (0 the
@@ -135,8 +135,8 @@ fn hand_parts(model: &Model) -> Vec<u8> {
 /// headline (every gesture's is in the report).
 const INTERSECTION_GESTURES: [&str; 5] = ["fist", "ok", "pinch", "victory", "thumbs_up"];
 
-/// Measures LB, QB and DQB on every sweep, each frame posed once by the kinematics layer
-/// and deformed by each method of the skin layer.
+/// Measures LB, QB, DQB and CoR on every sweep, each frame posed once by the kinematics
+/// layer and deformed by each method.
 ///
 /// # Errors
 /// [`Error::MissingJoint`] or [`Error::JointFrame`] if the model lacks the WebXR hand joints
@@ -145,7 +145,13 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     let mut hand = model.hand_kinematics(JointModel::Full)?;
     // The sweeps turn joints by local transforms of the rig's chain, the gestures by angles.
     let mut layer = KinematicsLayer::new(hand.skeleton().clone(), model.mesh.inverse_bind());
-    let mut skin = SkinLayer::new(Arc::clone(&model.mesh), MethodSet::ALL);
+    let mut deformers = Method::ALL.map(|m| Deformer::new(m, &model.mesh));
+    let mut outputs = Method::ALL.map(|_| Deformed::new(&model.mesh));
+    let mut deform = |bones: &KinematicsLayer, outputs: &mut [Deformed; 4]| {
+        for (d, o) in deformers.iter_mut().zip(outputs) {
+            d.deform(&model.mesh, bones, o);
+        }
+    };
     let rig = hand.rig().clone();
     let skeleton = rig.skeleton();
     let mesh = &model.mesh;
@@ -166,14 +172,14 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
             mark
         };
         let region_edges: Vec<[u32; 2]> = all_edges.iter().copied().filter(|e| e.iter().all(|&v| in_region[v as usize])).collect();
-        let mut frames: [Vec<FrameMetrics>; 3] = Default::default();
-        let mut previous: [Option<Vec<[f32; 3]>>; 3] = Default::default();
+        let mut frames: [Vec<FrameMetrics>; 4] = Default::default();
+        let mut previous: [Option<Vec<[f32; 3]>>; 4] = Default::default();
         for &value in &spec.values {
             pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
             layer.pose_locals(&locals);
-            skin.deform(&layer);
+            deform(&layer, &mut outputs);
             for m in Method::ALL {
-                let posed = skin.deformed(m).expect("every method is in the set").positions();
+                let posed = outputs[m.index()].positions();
                 let world = layer.world();
                 let (min_distance, max_distance) = region.distance_ratios(mesh, &bind_world, world, posed);
                 let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
@@ -199,8 +205,8 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     let mut contact = Vec::new();
     for g in &GESTURES {
         hand.pose(&g.pose(JointModel::Full));
-        skin.deform(hand.layer());
-        let posed = |m: Method| skin.deformed(m).expect("every method is in the set").positions();
+        deform(hand.layer(), &mut outputs);
+        let posed = |m: Method| outputs[m.index()].positions();
         if INTERSECTION_GESTURES.contains(&g.name) {
             intersections.push((g.name, Method::ALL.map(|m| count_self_intersections(posed(m), mesh.indices()))));
         }
@@ -282,13 +288,13 @@ impl Report {
             "sweeps": sweeps,
             "self_intersections": {
                 "rest": self.rest_intersections,
-                "gestures": self.intersections.iter().map(|(g, c)| json!({ "gesture": g, "lb": c[0], "qb": c[1], "dqb": c[2] })).collect::<Vec<_>>(),
+                "gestures": self.intersections.iter().map(|(g, c)| json!({ "gesture": g, "lb": c[0], "qb": c[1], "dqb": c[2], "cor": c[3] })).collect::<Vec<_>>(),
             },
             "self_contact": {
                 "rest": self.rest_self_contact.as_ref().map(contact_json),
-                "gestures": self.self_contact.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]) })).collect::<Vec<_>>(),
+                "gestures": self.self_contact.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]), "cor": contact_json(&c[3]) })).collect::<Vec<_>>(),
             },
-            "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2] })).collect::<Vec<_>>(),
+            "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2], "cor": v[3] })).collect::<Vec<_>>(),
         })
     }
 
@@ -317,19 +323,19 @@ impl Report {
         Ok(())
     }
 
-    /// The headline numbers: `(measure, [LB, QB, DQB])`, `None` where undefined.
+    /// The headline numbers: `(measure, [LB, QB, DQB, CoR])`, `None` where undefined.
     #[must_use]
-    pub fn headline(&self) -> Vec<(String, [Option<f32>; 3])> {
-        let at = |sweep: &str, value: f32, pick: fn(&FrameMetrics) -> Option<f32>| -> [Option<f32>; 3] {
+    pub fn headline(&self) -> Vec<(String, [Option<f32>; 4])> {
+        let at = |sweep: &str, value: f32, pick: fn(&FrameMetrics) -> Option<f32>| -> [Option<f32>; 4] {
             let s = self.sweep(sweep);
             let i = s.and_then(|s| s.values.iter().position(|&v| v == value));
-            [0, 1, 2].map(|m| s.zip(i).and_then(|(s, i)| pick(&s.frames[m][i])))
+            [0, 1, 2, 3].map(|m| s.zip(i).and_then(|(s, i)| pick(&s.frames[m][i])))
         };
-        let worst = |sweep: &str, pick: fn(&FrameMetrics) -> f32| -> [Option<f32>; 3] {
+        let worst = |sweep: &str, pick: fn(&FrameMetrics) -> f32| -> [Option<f32>; 4] {
             let s = self.sweep(sweep);
-            [0, 1, 2].map(|m| s.map(|s| s.frames[m].iter().map(pick).fold(0.0, f32::max)))
+            [0, 1, 2, 3].map(|m| s.map(|s| s.frames[m].iter().map(pick).fold(0.0, f32::max)))
         };
-        let mut rows: Vec<(String, [Option<f32>; 3])> = vec![
+        let mut rows: Vec<(String, [Option<f32>; 4])> = vec![
             ("volume at 90° index PIP flexion (rest = 1)".into(), at("index-pip", 90.0, |f| f.volume)),
             ("skin-to-bone distance at 90° PIP, smallest (collapse < 1)".into(), at("index-pip", 90.0, |f| Some(f.min_distance))),
             ("skin-to-bone distance at 90° PIP, largest (bulge > 1)".into(), at("index-pip", 90.0, |f| Some(f.max_distance))),
@@ -357,9 +363,9 @@ impl Report {
     /// The headline numbers as a markdown table.
     #[must_use]
     pub fn markdown(&self) -> String {
-        let mut s = String::from("| measure | LB | QB | DQB |\n|---|---|---|---|\n");
+        let mut s = String::from("| measure | LB | QB | DQB | CoR |\n|---|---|---|---|---|\n");
         for (label, v) in self.headline() {
-            let _ = writeln!(s, "| {label} | {} | {} | {} |", format_value(v[0]), format_value(v[1]), format_value(v[2]));
+            let _ = writeln!(s, "| {label} | {} | {} | {} | {} |", format_value(v[0]), format_value(v[1]), format_value(v[2]), format_value(v[3]));
         }
         s
     }

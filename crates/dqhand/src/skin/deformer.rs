@@ -1,4 +1,4 @@
-//! The one interface to the three deformers: LB, QB and DQB (paper section 4.4).
+//! The one interface to the deformers: LB, QB and DQB (paper section 4.4), and CoR.
 
 use glam::Affine3A;
 
@@ -13,7 +13,7 @@ use super::kernel::{self, Frame, FrameTable, Kernel};
 use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
 use super::strategy::Strategy;
 use super::Method;
-use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
+use super::{centre_of_rotation_blend as cor, dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
 use crate::kinematics::KinematicsLayer;
 use crate::math::DualQuat;
 
@@ -97,6 +97,10 @@ pub enum VertexBuffers<'a> {
     Interleaved(&'a mut [f32]),
 }
 
+/// Parameters per joint of LB and CoR.
+const WIDE: usize = lb::W;
+const _: () = assert!(cor::W == WIDE && qb::W == dqb::W);
+
 /// Vertices below which a deformation is not split across threads (a split costs a few µs
 /// of waking and joining; the built-in hand's 8,668 vertices take ~10 µs on one core).
 pub const MIN_VERTICES_PER_THREAD: usize = 2048;
@@ -128,10 +132,12 @@ pub const MIN_VERTICES_PER_THREAD: usize = 2048;
 #[derive(Clone, Debug)]
 pub struct Deformer {
     method: Method,
-    lb: Vec<[f32; lb::W]>,
+    /// Sixteen parameters per joint: LB's matrix rows, or CoR's rotation and rows.
+    wide: Vec<[f32; WIDE]>,
+    /// Eight per joint: QB's rotation and translation, or DQB's dual quaternion.
     quat: Vec<[f32; dqb::W]>,
     signs: Vec<f32>,
-    lb_table: FrameTable<{ lb::W }>,
+    wide_table: FrameTable<WIDE>,
     quat_table: FrameTable<{ dqb::W }>,
     kernel: Kernel,
     strategy: Strategy,
@@ -146,19 +152,28 @@ impl Deformer {
     /// that is set to a strategy's name (other values are ignored), else the fastest on this
     /// mesh: the first deformer of a method and mesh shape in the process times each
     /// strategy for a few frames (about a millisecond for the built-in hand), later ones
-    /// reuse its choice.
+    /// reuse its choice. CoR's centres of rotation are computed here if the mesh does not
+    /// have them yet.
     #[must_use]
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
+        if method == Method::Cor {
+            mesh.centres();
+        }
         let forced = std::env::var(Strategy::ENV).ok().and_then(|name| Strategy::named(&name));
         let strategy = forced.unwrap_or_else(|| if Kernel::best() == Kernel::Avx512 { fastest_strategy(method, mesh) } else { Strategy::Permute });
         let joints = mesh.inverse_bind().len();
-        let (lbn, qn, sn) = if method == Method::Lb { (joints, 0, 0) } else { (0, joints, mesh.pairs.len() + 1) };
+        let signs = mesh.pairs.len() + 1;
+        let (wn, qn, sn) = match method {
+            Method::Lb => (joints, 0, 0),
+            Method::Cor => (joints, 0, signs),
+            Method::Qb | Method::Dqb => (0, joints, signs),
+        };
         Self {
             method,
-            lb: vec![[0.0; lb::W]; lbn],
+            wide: vec![[0.0; WIDE]; wn],
             quat: vec![[0.0; dqb::W]; qn],
             signs: vec![1.0; sn],
-            lb_table: FrameTable::new(lbn, strategy),
+            wide_table: FrameTable::new(wn, strategy),
             quat_table: FrameTable::new(qn, strategy),
             kernel: Kernel::best(),
             strategy,
@@ -178,8 +193,8 @@ impl Deformer {
     /// 32 joints, gathers; every strategy gives the same bits: tests/skin.rs).
     #[must_use]
     pub fn with_strategy(self, strategy: Strategy) -> Self {
-        let (lbn, qn) = (self.lb.len(), self.quat.len());
-        Self { strategy, lb_table: FrameTable::new(lbn, strategy), quat_table: FrameTable::new(qn, strategy), ..self }
+        let (wn, qn) = (self.wide.len(), self.quat.len());
+        Self { strategy, wide_table: FrameTable::new(wn, strategy), quat_table: FrameTable::new(qn, strategy), ..self }
     }
 
     /// The same deformer splitting each deformation across `crew`'s threads (started once:
@@ -206,15 +221,16 @@ impl Deformer {
     /// none).
     #[must_use]
     pub fn strategy(&self) -> Option<Strategy> {
-        (self.kernel() == Kernel::Avx512).then(|| if self.strategy.serves(self.lb.len().max(self.quat.len())) { self.strategy } else { Strategy::Gather })
+        (self.kernel() == Kernel::Avx512).then(|| if self.strategy.serves(self.wide.len().max(self.quat.len())) { self.strategy } else { Strategy::Gather })
     }
 
     /// Deforms `mesh` by the bones' transforms into `out` (positions and normals, or
     /// positions only, as `out` was made).
     ///
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
-    /// and translation, or dual quaternion: the kinematics layer's own, where `bones` carries
-    /// them), and for the quaternion methods one sign per pair of joints that share a vertex,
+    /// and translation, dual quaternion: the kinematics layer's own, where `bones` carries
+    /// them, or quaternion and rows), and for the quaternion methods one sign per pair of
+    /// joints that share a vertex,
     /// aligning the other joint's rotation to the hemisphere of the heaviest one. Steps 2–6:
     /// every vertex is blended, split across the crew's threads if there is one. Allocates
     /// nothing.
@@ -285,13 +301,16 @@ impl Deformer {
         // Only the AVX-512 loop reads the lookup table (the same choice as `kernel::deform`'s).
         let avx512 = self.kernel() == Kernel::Avx512;
         match self.method {
-            Method::Lb => {
-                assert_eq!(self.lb.len(), skinning.len(), "deformer made for another joint count");
-                for (d, m) in self.lb.iter_mut().zip(skinning) {
-                    *d = lb::params(m);
+            Method::Lb | Method::Cor => {
+                assert_eq!(self.wide.len(), skinning.len(), "deformer made for another joint count");
+                let convert = if self.method == Method::Lb { lb::params } else { cor::params };
+                for (d, m) in self.wide.iter_mut().zip(skinning) {
+                    *d = convert(m);
                 }
+                let pairs: &[(u16, u16)] = if self.method == Method::Lb { &[] } else { &mesh.pairs };
+                pair_signs(&self.wide, pairs, &mut self.signs);
                 if avx512 {
-                    self.lb_table.update(&self.lb, &[], &[]);
+                    self.wide_table.update(&self.wide, pairs, &self.signs);
                 }
             }
             Method::Qb | Method::Dqb => {
@@ -310,12 +329,7 @@ impl Deformer {
                         }
                     }
                 }
-                assert_eq!(self.signs.len(), mesh.pairs.len() + 1, "deformer made for another mesh");
-                for (sign, &(h, j)) in self.signs[1..].iter_mut().zip(&mesh.pairs) {
-                    let (a, b) = (&self.quat[usize::from(h)], &self.quat[usize::from(j)]);
-                    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-                    *sign = if dot < 0.0 { -1.0 } else { 1.0 };
-                }
+                pair_signs(&self.quat, &mesh.pairs, &mut self.signs);
                 if avx512 {
                     self.quat_table.update(&self.quat, &mesh.pairs, &self.signs);
                 }
@@ -369,9 +383,10 @@ impl Deformer {
     fn run(&self, mesh: &SkinnedMesh, first: usize, positions: &mut [[f32; 3]], normals: &mut [[f32; 3]]) {
         let (kernel, strategy) = (self.kernel, self.strategy);
         match self.method {
-            Method::Lb => kernel::deform::<{ lb::W }, lb::Lb>(mesh, &Frame { params: &self.lb, signs: &[], table: &self.lb_table, kernel, strategy }, first, positions, normals),
-            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel, strategy }, first, positions, normals),
-            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Lb => kernel::deform::<WIDE, lb::Lb>(mesh, &Frame { params: &self.wide, signs: &[], centres: &[], table: &self.wide_table, kernel, strategy }, first, positions, normals),
+            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Cor => kernel::deform::<WIDE, cor::Cor>(mesh, &Frame { params: &self.wide, signs: &self.signs, centres: mesh.centres(), table: &self.wide_table, kernel, strategy }, first, positions, normals),
         }
     }
 
@@ -390,5 +405,23 @@ impl Deformer {
         pool.install(|| {
             out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
         });
+    }
+}
+
+/// One sign per pair of joints sharing a vertex (`signs[1 + i]` for `pairs[i]`, `signs[0]`
+/// the heaviest joint's own, +1): −1 where the other joint's rotation (the first four
+/// `params`) is in the other hemisphere than the heaviest's. Nothing for no pairs (LB).
+///
+/// # Panics
+/// If there are pairs and not one sign more than pairs.
+fn pair_signs<const W: usize>(params: &[[f32; W]], pairs: &[(u16, u16)], signs: &mut [f32]) {
+    if pairs.is_empty() {
+        return;
+    }
+    assert_eq!(signs.len(), pairs.len() + 1, "deformer made for another mesh");
+    for (sign, &(h, j)) in signs[1..].iter_mut().zip(pairs) {
+        let (a, b) = (&params[usize::from(h)], &params[usize::from(j)]);
+        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+        *sign = if dot < 0.0 { -1.0 } else { 1.0 };
     }
 }

@@ -13,7 +13,7 @@ use super::kernel::{self, Blend, Frame, FrameTable, Kernel};
 use super::skinned_mesh::SkinnedMesh;
 use super::strategy::Strategy;
 use super::Method;
-use super::{dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
+use super::{centre_of_rotation_blend as cor, dual_quaternion_blend as dqb, linear_blend as lb, quaternion_blend as qb};
 
 /// What the choice depends on: the method and the mesh's vertices, joints, slots and pairs.
 type Key = (Method, usize, usize, usize, usize);
@@ -34,6 +34,7 @@ pub(crate) fn fastest_strategy(method: Method, mesh: &SkinnedMesh) -> Strategy {
         Method::Lb => measure::<{ lb::W }, lb::Lb>(mesh, lb::params),
         Method::Qb => measure::<{ qb::W }, qb::Qb>(mesh, qb::params),
         Method::Dqb => measure::<{ dqb::W }, dqb::Dqb>(mesh, dqb::params),
+        Method::Cor => measure::<{ cor::W }, cor::Cor>(mesh, cor::params),
     })
 }
 
@@ -58,7 +59,8 @@ fn measure<const W: usize, B: Blend<W>>(mesh: &SkinnedMesh, params: fn(&Affine3A
     for round in 0..ROUNDS {
         for i in 0..candidates.len() {
             let (strategy, table) = &candidates[(round + i) % candidates.len()];
-            let frame = Frame { params: &rows, signs: &signs, table, kernel: Kernel::Avx512, strategy: *strategy };
+            let centres = if B::CENTRED { &mesh.centres()[..] } else { &[] };
+            let frame = Frame { params: &rows, signs: &signs, centres, table, kernel: Kernel::Avx512, strategy: *strategy };
             let t = Instant::now();
             kernel::deform::<W, B>(mesh, &frame, 0, &mut positions, &mut normals);
             let seconds = t.elapsed().as_secs_f64();

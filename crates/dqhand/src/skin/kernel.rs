@@ -101,17 +101,18 @@ const SIMD128: u8 = 3;
 #[repr(C, align(64))]
 pub(crate) struct Aligned<T>(pub T);
 
-/// Rest or deformed geometry of one chunk of `L` vertices: positions then normals, x/y/z
-/// lanes each.
+/// Rest or deformed geometry of one chunk of `L` vertices: positions, normals and (rest, for
+/// the CoR method only) centres of rotation, x/y/z lanes each.
 #[repr(C, align(64))]
 pub(crate) struct Chunk<const L: usize> {
     pub p: [[f32; L]; 3],
     pub n: [[f32; L]; 3],
+    pub c: [[f32; L]; 3],
 }
 
 impl<const L: usize> Chunk<L> {
     fn new() -> Self {
-        Self { p: [[0.0; L]; 3], n: [[0.0; L]; 3] }
+        Self { p: [[0.0; L]; 3], n: [[0.0; L]; 3], c: [[0.0; L]; 3] }
     }
 }
 
@@ -127,6 +128,9 @@ pub(crate) trait Blend<const W: usize> {
     /// skips): LB 12, QB 7, DQB 8.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const USED: usize;
+    /// Whether `finish` reads the vertices' centres of rotation (`Chunk::c`, from
+    /// [`Frame::centres`]).
+    const CENTRED: bool = false;
     /// Finishes a chunk of `L` vertices from the blended parameters `b[component][lane]`:
     /// positions, and normals when `NORMALS` (else `out.n` is left alone); products summed
     /// by [`mad`] for instruction set `ISA`.
@@ -139,6 +143,9 @@ pub(crate) struct Frame<'a, const W: usize> {
     pub params: &'a [[f32; W]],
     /// ±1 per sign index of `SkinnedMesh::slot_pairs` (unused when `SIGNED` is 0).
     pub signs: &'a [f32],
+    /// The mesh's centres of rotation where the method reads them (`Blend::CENTRED`), else
+    /// empty.
+    pub centres: &'a [Vec<f32>],
     /// `params` and `signs` as the AVX-512 loop looks them up, updated for this frame.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub table: &'a FrameTable<W>,
@@ -249,15 +256,16 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
     // and sign lookup in bounds.
     assert_eq!(frame.params.len(), mesh.inverse_bind().len(), "one parameter row per joint");
     assert!(B::SIGNED == 0 || frame.signs.len() == mesh.pairs.len() + 1, "one sign per joint pair");
+    assert!(!B::CENTRED || frame.centres.len() == 3 && frame.centres.iter().all(|c| c.len() == mesh.pos[0].len()), "one centre per vertex");
     let mut c = 0;
     #[cfg(target_arch = "x86_64")]
     if ISA == AVX512 {
         // SAFETY: `ISA` is AVX512 only inside `deform_avx512`, entered after feature detection.
         c = unsafe {
             match (frame.strategy, frame.table.table.as_deref()) {
-                (Strategy::Permute, Some(table)) => blocks::<W, K, B, NORMALS>(table, mesh, first, positions, normals),
-                (Strategy::Broadcast, _) => blocks::<W, K, B, NORMALS>(&avx512::Runs { params: frame.params, signs: frame.signs }, mesh, first, positions, normals),
-                _ => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, first, positions, normals),
+                (Strategy::Permute, Some(table)) => blocks::<W, K, B, NORMALS>(table, mesh, frame.centres, first, positions, normals),
+                (Strategy::Broadcast, _) => blocks::<W, K, B, NORMALS>(&avx512::Runs { params: frame.params, signs: frame.signs }, mesh, frame.centres, first, positions, normals),
+                _ => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, frame.centres, first, positions, normals),
             }
         };
     }
@@ -267,7 +275,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
         let chunk = first + c;
         let kc = usize::from(mesh.chunk_influences[chunk]);
         blend::<W, K, B, ISA>(frame, kc, Slots::of(mesh, chunk * LANES), &mut b.0);
-        run::<W, B, LANES, NORMALS, ISA>(mesh, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        run::<W, B, LANES, NORMALS, ISA>(mesh, frame.centres, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 1;
     }
 }
@@ -279,6 +287,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
 unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: bool>(
     blender: &impl avx512::Blender<W>,
     mesh: &SkinnedMesh,
+    centres: &[Vec<f32>],
     first: usize,
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
@@ -294,17 +303,19 @@ unsafe fn blocks<const W: usize, const K: usize, B: Blend<W>, const NORMALS: boo
         let kc = mesh.chunk_influences[chunk].max(mesh.chunk_influences[chunk + 1]);
         // SAFETY: joint indices are below the parameter rows (asserted in `chunks`).
         blender.blend::<K, B>(mesh, chunk / 2, usize::from(kc), &mut b.0);
-        run::<W, B, BLOCK, NORMALS, AVX512>(mesh, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
+        run::<W, B, BLOCK, NORMALS, AVX512>(mesh, centres, &b.0, chunk * LANES, &mut rest, &mut out, positions, normals, c * LANES);
         c += 2;
     }
     c
 }
 
-/// Finishes `L` vertices from mesh vertex `base` and writes them at `at` of the outputs.
+/// Finishes `L` vertices from mesh vertex `base` (their `centres` of rotation, for a
+/// method that reads them) and writes them at `at` of the outputs.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn run<const W: usize, B: Blend<W>, const L: usize, const NORMALS: bool, const ISA: u8>(
     mesh: &SkinnedMesh,
+    centres: &[Vec<f32>],
     b: &[[f32; L]; W],
     base: usize,
     rest: &mut Chunk<L>,
@@ -318,6 +329,9 @@ fn run<const W: usize, B: Blend<W>, const L: usize, const NORMALS: bool, const I
         rest.p[c] = lanes(&mesh.pos[c]);
         if NORMALS {
             rest.n[c] = lanes(&mesh.nrm[c]);
+        }
+        if B::CENTRED {
+            rest.c[c] = lanes(&centres[c]);
         }
     }
     B::finish::<L, NORMALS, ISA>(b, rest, out);

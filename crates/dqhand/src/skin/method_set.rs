@@ -3,7 +3,7 @@
 use super::Method;
 use crate::{Error, Result};
 
-/// One to three distinct skinning methods in display order.
+/// One to three distinct skinning methods (of the four) in display order.
 ///
 /// A gap or a repeat cannot be represented, so whatever holds one (a viewer's view, a frame
 /// header) always describes 1–3 meshes.
@@ -30,7 +30,7 @@ impl MethodSet {
     /// DQB alone: the paper's method.
     pub const DQB: Self = Self { methods: [Method::Dqb; 3], len: 1 };
     /// LB, QB and DQB, in the paper's order.
-    pub const ALL: Self = Self { methods: Method::ALL, len: 3 };
+    pub const PAPER: Self = Self { methods: Method::PAPER, len: 3 };
 
     /// The methods given, in that order.
     ///
@@ -51,7 +51,7 @@ impl MethodSet {
         Ok(set)
     }
 
-    /// The methods named (`lb`, `qb`, `dqb`, in any case), in that order.
+    /// The methods named (`lb`, `qb`, `dqb`, `cor`, in any case), in that order.
     ///
     /// # Errors
     /// [`Error::UnknownName`] for a name that is no method, else as [`Self::new`].

@@ -1,6 +1,9 @@
-//! Skin layer (paper 4.1, 4.4): the skinned mesh, the LB, QB and DQB deformers, and the
-//! [`SkinLayer`] that runs a set of them on the kinematics layer's transforms.
+//! Skin layer (paper 4.1, 4.4): the skinned mesh, the LB, QB and DQB deformers (and CoR,
+//! beyond the paper), and the [`SkinLayer`] that runs a set of them on the kinematics
+//! layer's transforms.
 
+mod centre_of_rotation_blend;
+mod centres_of_rotation;
 mod crew;
 mod deformer;
 mod dual_quaternion_blend;
@@ -14,6 +17,7 @@ mod skin_layer;
 mod skinned_mesh;
 mod strategy;
 
+pub use centres_of_rotation::{centres_of_rotation, SIMILARITY_SIGMA};
 pub use crew::Crew;
 pub use deformer::{Bones, Deformed, Deformer, VertexBuffers, MIN_VERTICES_PER_THREAD};
 pub use kernel::Kernel;

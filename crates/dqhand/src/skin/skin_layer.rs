@@ -25,7 +25,7 @@ use super::{Bones, Deformed, Deformer, Method, MethodSet, SkinnedMesh, VertexBuf
 /// })?;
 /// // The bones' skinning transforms (or a `KinematicsLayer`, which carries them).
 /// let skinning = vec![Affine3A::IDENTITY, Affine3A::from_rotation_translation(Quat::from_rotation_z(0.8), Vec3::Y * 0.05)];
-/// let mut skin = SkinLayer::new(Arc::new(mesh), MethodSet::ALL);
+/// let mut skin = SkinLayer::new(Arc::new(mesh), MethodSet::PAPER);
 /// skin.deform(&skinning); // into the layer's own buffers, one per method
 /// let mut positions = vec![0.0f32; 3 * 3]; // #V × 3: a renderer's vertex buffer, say
 /// skin.deform_into(Method::Dqb, &skinning, VertexBuffers::Separate { positions: &mut positions, normals: None });
@@ -39,9 +39,9 @@ pub struct SkinLayer {
     mesh: Arc<SkinnedMesh>,
     methods: MethodSet,
     /// Per method, in [`Method::ALL`] order: its deformer, once it has been used.
-    deformers: [Option<Deformer>; 3],
+    deformers: [Option<Deformer>; 4],
     /// Per method: its output, once it has been in the set.
-    outputs: [Option<Deformed>; 3],
+    outputs: [Option<Deformed>; 4],
 }
 
 impl SkinLayer {
@@ -49,7 +49,7 @@ impl SkinLayer {
     /// kernel this CPU runs, on the calling thread.
     #[must_use]
     pub fn new(mesh: Arc<SkinnedMesh>, methods: MethodSet) -> Self {
-        let mut layer = Self { mesh, methods, deformers: [None, None, None], outputs: [None, None, None] };
+        let mut layer = Self { mesh, methods, deformers: Default::default(), outputs: Default::default() };
         layer.set_methods(methods);
         layer
     }

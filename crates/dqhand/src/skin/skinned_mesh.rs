@@ -1,5 +1,7 @@
 //! A skinned triangle mesh stored for speed: structure of arrays, influences packed per vertex.
 
+use std::sync::OnceLock;
+
 use glam::{Affine3A, Vec3};
 
 use crate::Warning;
@@ -153,6 +155,9 @@ pub struct SkinnedMesh {
     /// run with one broadcast of each parameter).
     pub(crate) block_runs: Vec<Run>,
     pub(crate) block_run_start: Vec<u32>,
+    /// The optimized centres of rotation (module `centres_of_rotation`), x/y/z arrays padded
+    /// like `pos`: computed on first use, or given with the mesh.
+    pub(crate) centres: OnceLock<[Vec<f32>; 3]>,
     max_influences: usize,
     uvs: Vec<[f32; 2]>,
     indices: Vec<u32>,
@@ -342,6 +347,7 @@ impl SkinnedMesh {
             block_weights,
             block_runs,
             block_run_start,
+            centres: OnceLock::new(),
             max_influences,
             uvs: data.uvs,
             indices: data.indices,
@@ -447,6 +453,56 @@ impl SkinnedMesh {
     #[must_use]
     pub fn inverse_bind(&self) -> &[Affine3A] {
         &self.inverse_bind
+    }
+
+    /// The centres of rotation of the `cor` method, x/y/z arrays padded to whole chunks: those
+    /// given by [`Self::with_centres_of_rotation`], else computed here once (the built-in
+    /// hand's in a fraction of a second, split across rayon's threads).
+    pub(crate) fn centres(&self) -> &[Vec<f32>; 3] {
+        self.centres.get_or_init(|| {
+            let centres = super::centres_of_rotation::centres_of_rotation(self);
+            [0, 1, 2].map(|c| self.padded_column(centres.iter().map(|p| p[c])))
+        })
+    }
+
+    /// Vertex `v`'s centre of rotation (bind space, m; computed on first use, as
+    /// [`crate::skin::Method::Cor`] needs them).
+    #[must_use]
+    pub fn centre_of_rotation(&self, v: usize) -> Vec3 {
+        let c = self.centres();
+        Vec3::new(c[0][v], c[1][v], c[2][v])
+    }
+
+    /// Whether the centres of rotation are known already (given, or computed by an earlier
+    /// use): an export writes them only then, or asks for them.
+    #[must_use]
+    pub fn has_centres_of_rotation(&self) -> bool {
+        self.centres.get().is_some()
+    }
+
+    /// The same mesh with its centres of rotation given (read from a file that stored them),
+    /// #V, not computed.
+    ///
+    /// # Errors
+    /// [`Error::Mesh`] if there is not one finite centre per vertex.
+    pub fn with_centres_of_rotation(self, centres: &[[f32; 3]]) -> Result<Self> {
+        if centres.len() != self.vertex_count {
+            return Err(Error::Mesh(format!("{} centres of rotation for {} vertices", centres.len(), self.vertex_count)));
+        }
+        if let Some(v) = centres.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(Error::Mesh(format!("vertex {v} has a non-finite centre of rotation {:?}", centres[v])));
+        }
+        let columns = [0, 1, 2].map(|c| self.padded_column(centres.iter().map(|p| p[c])));
+        let centres = OnceLock::new();
+        let _ = centres.set(columns);
+        Ok(Self { centres, ..self })
+    }
+
+    /// One component per vertex, padded with zeros to whole chunks.
+    fn padded_column(&self, values: impl Iterator<Item = f32>) -> Vec<f32> {
+        let mut col: Vec<f32> = values.collect();
+        col.resize(self.pos[0].len(), 0.0);
+        col
     }
 
     /// Number of joints that influence at least one vertex (the paper's "bones").

@@ -1,0 +1,52 @@
+//! Skinning with optimized centres of rotation (CoR; Le and Hodgins 2016): the
+//! rotation blended as quaternions, the translation by LB of each vertex's centre.
+//!
+//! `q = normalize(Σ wᵢ sᵢ qᵢ)`, `v' = q (v − p*) q* + Σ wᵢ Mᵢ p*` for the vertex's centre of
+//! rotation `p*` (module `centres_of_rotation`), normals `n' = q n q*`. Like QB the blended
+//! rotation is a true rotation, so nothing collapses; unlike QB it turns about `p*`, a point
+//! among the vertex's own joints, not about the model origin, and LB of that one point is
+//! close to rigid: DQB's bulge at a bent joint, which comes from blending the translations
+//! through the dual part, is gone.
+
+use glam::Affine3A;
+
+use super::kernel::{dot, recip, rotate, Blend, Chunk};
+
+/// Blend parameters: the rotation `(x, y, z, w)`, then the rows of the 3×4 matrix `[R | t]`.
+pub(crate) const W: usize = 16;
+
+/// The rotation quaternion of a skinning matrix's rigid part, and the matrix's rows.
+pub(crate) fn params(m: &Affine3A) -> [f32; W] {
+    let (_, q, _) = m.to_scale_rotation_translation();
+    let q = q.normalize();
+    let (c, t) = (m.matrix3, m.translation);
+    [q.x, q.y, q.z, q.w, c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x, c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y, c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z]
+}
+
+pub(crate) struct Cor;
+
+impl Blend<W> for Cor {
+    const SIGNED: usize = 4;
+    const USED: usize = W;
+    const CENTRED: bool = true;
+
+    #[inline(always)]
+    fn finish<const L: usize, const NORMALS: bool, const ISA: u8>(b: &[[f32; L]; W], rest: &Chunk<L>, out: &mut Chunk<L>) {
+        for l in 0..L {
+            let q = [b[0][l], b[1][l], b[2][l], b[3][l]];
+            let inv_sq = recip(dot::<ISA, 4>(q, q));
+            let c = [rest.c[0][l], rest.c[1][l], rest.c[2][l]];
+            let turned = rotate::<ISA>(q, inv_sq, [0, 1, 2].map(|i| rest.p[i][l] - c[i]));
+            for i in 0..3 {
+                let row = [b[4 + 4 * i][l], b[5 + 4 * i][l], b[6 + 4 * i][l], b[7 + 4 * i][l]];
+                out.p[i][l] = turned[i] + dot::<ISA, 4>(row, [c[0], c[1], c[2], 1.0]);
+            }
+            if NORMALS {
+                let n = rotate::<ISA>(q, inv_sq, [rest.n[0][l], rest.n[1][l], rest.n[2][l]]);
+                for i in 0..3 {
+                    out.n[i][l] = n[i];
+                }
+            }
+        }
+    }
+}
