@@ -1,5 +1,5 @@
 //! `dqhand demo`: the live viewer (a local server for the browser page), or with `--out` the
-//! gesture library posed with LB, QB and DQB and written as files.
+//! gesture library posed with LB, QB, DQB and CoR and written as files.
 
 use std::net::{IpAddr, SocketAddr, TcpListener, UdpSocket};
 use std::path::{Path, PathBuf};
@@ -56,7 +56,7 @@ pub struct Args {
     /// ../share/dqhand/viewer, or the checkout's viewer/dist for target/release/dqhand).
     #[arg(long)]
     viewer: Option<PathBuf>,
-    /// Instead of serving, write the gesture library posed with LB, QB and DQB (GLB), its
+    /// Instead of serving, write the gesture library posed with LB, QB, DQB and CoR (GLB), its
     /// pose files and the rigged hand into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -348,7 +348,7 @@ fn write_gestures(out: &Path) -> anyhow::Result<()> {
     println!("{}", model.description);
     println!("rigged, skinned hand: {}", rigged.display());
     let mut engine = Engine::new(model.clone(), JointModel::Full)?;
-    println!("{:<10} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs");
+    println!("{:<10} {:>9} {:>9} {:>9} {:>9}  files", "gesture", "LB µs", "QB µs", "DQB µs", "CoR µs");
     for (i, g) in GESTURES.iter().enumerate() {
         let pose = g.pose(JointModel::Full);
         let stem = format!("{i:02}-{}", g.name);
@@ -364,7 +364,7 @@ fn write_gestures(out: &Path) -> anyhow::Result<()> {
             let path = out.join(format!("{stem}.{m}.glb"));
             dqhand::io::write_posed(&path, posed.positions(), posed.normals(), model.mesh.uvs(), model.mesh.indices())?;
         }
-        println!("{:<10} {:>9.1} {:>9.1} {:>9.1}  {stem}.{{lb,qb,dqb}}.glb, {stem}.pose.json", g.name, times[0], times[1], times[2]);
+        println!("{:<10} {:>9.1} {:>9.1} {:>9.1} {:>9.1}  {stem}.{{lb,qb,dqb,cor}}.glb, {stem}.pose.json", g.name, times[0], times[1], times[2], times[3]);
     }
     println!("(single frames, cold; `dqhand bench` gives medians over many frames)");
     Ok(())

@@ -34,7 +34,7 @@ mod train_gestures;
 
 use clap::{Parser, Subcommand};
 
-/// Dual quaternion virtual hand: LB, QB and DQB skinning of the built-in hand or any
+/// Dual quaternion virtual hand: LB, QB, DQB and CoR skinning of the built-in hand or any
 /// skinned glTF 2.0 file.
 #[derive(Parser)]
 #[command(name = "dqhand", version, about, long_about = None)]
@@ -49,7 +49,7 @@ enum Command {
     Info(info::Args),
     /// Build the anatomical hand for given measurements and write it as a rigged glTF.
     Hand(hand::Args),
-    /// Pose a mesh with LB, QB or DQB and write it with normals (.ply, .obj or .glb).
+    /// Pose a mesh with LB, QB, DQB or CoR and write it with normals (.ply, .obj or .glb).
     Skin(skin::Args),
     /// Time LB, QB, DQB and CoR interleaved in one run (the paper's Table 3 on this machine, and CoR beyond it).
     Bench(bench::Args),
@@ -60,9 +60,9 @@ enum Command {
     /// dqhand's LB and DQB output and timing, for other implementations to compare (make bench-peers).
     ExportSkinning(peers::Args),
     /// The live viewer: a local server for the browser page that poses the hand and compares
-    /// LB, QB and DQB (with --out: write the gesture library as meshes instead).
+    /// LB, QB, DQB and CoR (with --out: write the gesture library as meshes instead).
     Demo(demo::Args),
-    /// Realism metrics of LB, QB and DQB: volume, collapse and bulge, candy wrapper,
+    /// Realism metrics of LB, QB, DQB and CoR: volume, collapse and bulge, candy wrapper,
     /// distortion and continuity over joint sweeps.
     Metrics(metrics::Args),
     /// Play a recording (glove CSV, joints or landmarks JSON lines) through the gesture loop

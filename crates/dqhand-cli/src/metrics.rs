@@ -1,4 +1,4 @@
-//! `dqhand metrics`: the realism metrics of LB, QB and DQB on one hand.
+//! `dqhand metrics`: the realism metrics of LB, QB, DQB and CoR on one hand.
 
 use std::path::PathBuf;
 use std::sync::Arc;

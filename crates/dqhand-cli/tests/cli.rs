@@ -353,11 +353,11 @@ fn metrics_json_and_csv_cover_every_sweep_and_method() {
     for name in ["index-pip", "index-mcp", "fist", "index-pip-twist", "wrist-twist"] {
         let s = &sweeps[name];
         let n = s["values"].as_array().unwrap().len();
-        for m in ["lb", "qb", "dqb"] {
+        for m in ["lb", "qb", "dqb", "cor"] {
             assert_eq!(s[m]["volume"].as_array().unwrap().len(), n, "{name} {m}");
         }
         let csv = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
-        assert_eq!(csv.lines().count(), 1 + 3 * n, "{name}.csv");
+        assert_eq!(csv.lines().count(), 1 + 4 * n, "{name}.csv");
     }
 }
 

@@ -3,7 +3,7 @@
 //!
 //! A batch of poses is skinned on every core with the GIL released, each pose into its own slice
 //! of the array that is returned (no copy after): per pose, one forward kinematics pass (the
-//! paper's kinematics layer) and one deformation (its skin layer: LB, QB or DQB, Eq. 6–8).
+//! paper's kinematics layer) and one deformation (its skin layer: LB, QB, DQB or CoR, Eq. 6–8).
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -303,7 +303,7 @@ impl Hand {
     }
 
     /// The posed hands' skin: `angles` (B, D) radians, `wrist` (B, 4, 4) rigid transforms or
-    /// None (the rest wrist), `method` "dqb", "qb" or "lb", `limits` whether angles are clamped
+    /// None (the rest wrist), `method` "dqb", "qb", "lb" or "cor", `limits` whether angles are clamped
     /// to their anatomical ranges. Returns the positions (B, V, 3), m, or with `normals` the
     /// positions and the unit normals.
     #[pyo3(signature = (angles, wrist = None, method = "dqb", *, normals = false, limits = true))]
@@ -426,7 +426,7 @@ impl Hand {
         metrics::joint_region(self, py, joint, next)
     }
 
-    /// `dqhand metrics --json` of this hand: LB, QB and DQB on the sweeps, self-intersections
+    /// `dqhand metrics --json` of this hand: LB, QB, DQB and CoR on the sweeps, self-intersections
     /// in gestures and the headline numbers, as dicts and lists.
     fn realism_report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         metrics::report(self, py)

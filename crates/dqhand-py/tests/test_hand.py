@@ -176,13 +176,14 @@ def read_ply(path):
     return np.frombuffer(body[: 24 * count], dtype="<f4").reshape(count, 6)[:, :3]
 
 
-def test_the_same_poses_give_the_command_lines_vertices(hand, tmp_path):
+@pytest.mark.parametrize("method", ["dqb", "cor"])
+def test_the_same_poses_give_the_command_lines_vertices(hand, tmp_path, method):
     binary = os.environ.get("DQHAND_BIN")
     if not binary:
         pytest.fail("DQHAND_BIN must name the dqhand binary (make test sets it)")
     angles = random_angles(hand, 3, seed=5)
     wrists = random_wrists(3, seed=6)
-    skinned = hand.skin(angles, wrists)
+    skinned = hand.skin(angles, wrists, method)
     for b in range(3):
         rotation = quaternion(wrists[b, :3, :3])
         pose = {
@@ -191,7 +192,7 @@ def test_the_same_poses_give_the_command_lines_vertices(hand, tmp_path):
             "angles_deg": dict(zip(hand.dof_names, np.degrees(angles[b]).tolist())),
         }
         (tmp_path / "pose.json").write_text(json.dumps(pose))
-        subprocess.run([binary, "skin", "--pose", str(tmp_path / "pose.json"), "--method", "dqb", "--out", str(tmp_path / "posed.ply")], check=True, capture_output=True)
+        subprocess.run([binary, "skin", "--pose", str(tmp_path / "pose.json"), "--method", method, "--out", str(tmp_path / "posed.ply")], check=True, capture_output=True)
         np.testing.assert_allclose(skinned[b], read_ply(tmp_path / "posed.ply"), atol=2e-6)
 
 

@@ -1,5 +1,5 @@
 //! dqhand's engine for JavaScript, in WebAssembly, with no server: the built-in anatomical
-//! hand posed by joint angles and skinned with LB, QB or DQB ([`Hand`]: paper Figure 1, the
+//! hand posed by joint angles and skinned with LB, QB, DQB or CoR ([`Hand`]: paper Figure 1, the
 //! kinematics and skin layers), its skin alone under transforms of one's own ([`Skinner`]), and
 //! both interaction loops, one or two hands driven by tracked hands in a scene or none
 //! ([`Interaction`]). The same library as the native `dqhand`, compiled for
@@ -114,7 +114,7 @@ impl Hand {
         self.engine.model().mesh.indices().to_vec()
     }
 
-    /// Skins with `"lb"`, `"qb"` or `"dqb"` from the next [`Self::step`] on (and now).
+    /// Skins with `"lb"`, `"qb"`, `"dqb"` or `"cor"` from the next [`Self::step`] on (and now).
     ///
     /// # Errors
     /// Another name.
@@ -252,7 +252,7 @@ impl Skinner {
         self.mesh.influences_per_vertex()
     }
 
-    /// Deforms with `"lb"`, `"qb"` or `"dqb"` and kernel `kernel` (one of [`Self::kernels`])
+    /// Deforms with `"lb"`, `"qb"`, `"dqb"` or `"cor"` and kernel `kernel` (one of [`Self::kernels`])
     /// from the next [`Self::deform`] on.
     ///
     /// # Errors
@@ -452,7 +452,7 @@ impl Interaction {
         self.skin(k).mesh().indices().to_vec()
     }
 
-    /// Skins with `"lb"`, `"qb"` or `"dqb"` from now on. Allocates the method's buffers the
+    /// Skins with `"lb"`, `"qb"`, `"dqb"` or `"cor"` from now on. Allocates the method's buffers the
     /// first time: take views of the memory again after it.
     ///
     /// # Errors

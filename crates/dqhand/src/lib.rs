@@ -4,7 +4,7 @@
 //! A pose goes through the paper's two stages, each usable alone: the **kinematics layer**
 //! ([`kinematics::HandKinematics`] for joint angles, [`kinematics::KinematicsLayer`] for any
 //! skeleton: one forward kinematics pass, each bone's skinning transform and its unit dual
-//! quaternion) and the **skin layer** ([`skin::SkinLayer`]: LB, QB or DQB on those transforms,
+//! quaternion) and the **skin layer** ([`skin::SkinLayer`]: LB, QB, DQB or CoR on those transforms,
 //! into its own buffers or the caller's). [`engine::Engine`] holds one of each for a hand; the
 //! interaction loops ([`interaction::GestureLoop`], [`interaction::ManipulationLoop`]) hold
 //! only kinematics.
@@ -15,7 +15,7 @@
 //! * [`geometry`] — mesh helpers: normals, edges, closed surfaces, volume, winding number;
 //! * [`kinematics`] — skeleton, joint models (`paper` 18 DOF, `full`), limits, poses, FK, and
 //!   the kinematics layer;
-//! * [`skin`] — the skinned mesh, the LB, QB and DQB deformers and the skin layer;
+//! * [`skin`] — the skinned mesh, the LB, QB, DQB and CoR deformers and the skin layer;
 //! * [`model`] — a skeleton and the mesh bound to it;
 //! * [`gltf_file`] — a glTF 2.0 file opened safely, for the importer and scene meshes;
 //! * [`scene`] — the objects and table of the manipulation loop, from scene files;
@@ -32,7 +32,7 @@
 //! * [`interaction`] — the gesture interaction loop: records → pose → recognised gestures;
 //!   synthetic labelled sequences, and the loop's measures on them; the manipulation loop:
 //!   records → pose → contacts → grasp → physics, and scripted grasp recordings;
-//! * [`metrics`] — realism metrics of LB, QB and DQB.
+//! * [`metrics`] — realism metrics of LB, QB, DQB and CoR.
 //!
 //! # Features
 //! All on by default; without them (`default-features = false`) the core is `math`,

@@ -132,6 +132,14 @@ enum Fault {
     ZeroCount,
     /// POSITION with a `count` whose byte size overflows 64 bits.
     HugeCount,
+    /// An application's own attribute `_BATCHID` (glTF allows names starting with `_`).
+    ForeignAttribute,
+    /// The CoR centres of rotation, given (one per vertex).
+    Centres,
+    /// The CoR centres of rotation declared VEC2.
+    CentresAsVec2,
+    /// The CoR centres of rotation, one short of the vertices.
+    CentresShort,
 }
 
 const FLOAT: u32 = 5126;
@@ -203,6 +211,14 @@ fn minimal_gltf(dir: &Path, fault: Fault) -> PathBuf {
         bin.accessors[position]["max"] = json!(bound(f32::max, f32::NEG_INFINITY));
         attributes["POSITION"] = json!(position);
     }
+    let centres = [[0.5f32, 0.25, 0.0]; 4];
+    match fault {
+        Fault::ForeignAttribute => attributes["_BATCHID"] = json!(bin.floats(&[[0.0f32]; 4], "SCALAR")),
+        Fault::Centres => attributes[io::CENTRE_OF_ROTATION] = json!(bin.floats(&centres, "VEC3")),
+        Fault::CentresAsVec2 => attributes[io::CENTRE_OF_ROTATION] = json!(bin.floats(&[[0.5f32, 0.25]; 4], "VEC2")),
+        Fault::CentresShort => attributes[io::CENTRE_OF_ROTATION] = json!(bin.floats(&centres[1..], "VEC3")),
+        _ => {}
+    }
     let indices = bin.shorts(&[0u16, 1, 2, 0, 2, 3].map(|i| [i]), "SCALAR");
     let ibm = bin.floats(&inverse_bind.map(|m| m.to_cols_array()), "MAT4");
     let position = attributes["POSITION"].as_u64().map(|i| &mut bin.accessors[i as usize]);
@@ -264,6 +280,11 @@ fn assert_same_model(original: &Model, loaded: &Model) {
         }
     }
     assert_eq!(b.uvs().len(), a.uvs().len());
+    // CoR's centres ride in the file: read, not computed again, and the same.
+    assert!(b.has_centres_of_rotation(), "the centres of rotation were not read");
+    for v in 0..a.vertex_count() {
+        assert_eq!(a.centre_of_rotation(v), b.centre_of_rotation(v), "centre of rotation of vertex {v}");
+    }
 
     let joints = |m: &Model| m.skeleton.joints().iter().map(|j| (j.name.clone(), j.parent)).collect::<Vec<_>>();
     assert_eq!(joints(loaded), joints(original));
@@ -605,6 +626,22 @@ fn buffer_view_past_end_of_buffer_is_an_error() {
 #[test]
 fn joints_stored_as_floats_is_an_error() {
     expect_load_error(&faulty_gltf("joints-float", Fault::JointsAsFloats), &["JOINTS_0"]);
+}
+
+#[test]
+fn an_applications_own_attribute_is_ignored_and_given_centres_are_kept() {
+    let foreign = io::load_gltf(&faulty_gltf("foreign-attribute", Fault::ForeignAttribute)).expect("an attribute named _BATCHID is allowed");
+    assert_eq!(foreign.mesh.vertex_count(), 4);
+    assert!(!foreign.mesh.has_centres_of_rotation(), "none in the file: computed when first used");
+    let given = io::load_gltf(&faulty_gltf("given-centres", Fault::Centres)).expect("centres of rotation load");
+    assert!(given.mesh.has_centres_of_rotation());
+    assert_eq!(given.mesh.centre_of_rotation(3).to_array(), [0.5, 0.25, 0.0]);
+}
+
+#[test]
+fn centres_of_rotation_of_the_wrong_type_or_count_are_an_error() {
+    expect_load_error(&faulty_gltf("centres-vec2", Fault::CentresAsVec2), &["_CENTRE_OF_ROTATION"]);
+    expect_load_error(&faulty_gltf("centres-short", Fault::CentresShort), &["_CENTRE_OF_ROTATION", "count"]);
 }
 
 #[test]

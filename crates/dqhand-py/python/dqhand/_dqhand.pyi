@@ -129,7 +129,7 @@ class Hand:
     def joint_region(self, joint: str, next: Optional[str] = None) -> Dict[str, Union[npt.NDArray[np.uint32], float]]:
         """The skin ``realism`` measures around ``joint``: ``vertices``, ``joints`` (parent, joint, next), ``radius``, ``min_radius`` (m, bind pose)."""
     def realism_report(self) -> Dict[str, Any]:
-        """``dqhand metrics --json`` of this hand: LB, QB and DQB on the sweeps, self-intersections, headline numbers."""
+        """``dqhand metrics --json`` of this hand: LB, QB, DQB and CoR on the sweeps, self-intersections, headline numbers."""
     def export_gltf(self, path: Union[str, PathLike[str]]) -> None:
         """Write this hand as the rigged, skinned GLB ``dqhand hand`` writes (a ``.glb`` name); ``Hand.load`` reads it back."""
     def export_posed(

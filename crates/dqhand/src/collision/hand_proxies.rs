@@ -46,8 +46,8 @@ pub struct ProxyCollider {
     pub shape: SharedShape,
     /// Which part of the hand.
     pub part: HandPart,
-    /// The largest distance of a point of the shape from the joint's origin (m): bounds how
-    /// fast the shape moves when the joint turns.
+    /// The largest distance of a point of the shape from the joint's origin (m): the radius
+    /// of a sphere about the joint that holds the shape in any turn.
     pub extent: f32,
     /// The largest distance of a point of the shape's core from the joint's origin (m): a
     /// capsule's segment, a hull's vertices. A capsule's distance to anything is its

@@ -97,6 +97,11 @@ impl Glb {
     }
 }
 
+/// The vertex attribute holding each vertex's centre of rotation (VEC3, float, bind space):
+/// an application-specific attribute, which glTF 2.0 lets a name starting with `_` be
+/// (loaders that do not know it ignore it; the validator accepts it).
+pub const CENTRE_OF_ROTATION: &str = "_CENTRE_OF_ROTATION";
+
 /// A skin-toned, slightly rough PBR material.
 fn skin_material() -> Value {
     json!([{ "name": "skin", "pbrMetallicRoughness": { "baseColorFactor": [0.87, 0.67, 0.56, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6 } }])
@@ -105,7 +110,9 @@ fn skin_material() -> Value {
 /// Writes the model as a rigged, skinned GLB in its rest pose, which three.js and Blender load
 /// and animate: the joint hierarchy as nodes (rest TRS), one skin with the inverse bind
 /// matrices, one primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
-/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences). Built with the
+/// JOINTS_1/WEIGHTS_1 for vertices with more than four influences), and the CoR method's
+/// centres of rotation as [`CENTRE_OF_ROTATION`] (computed here if the mesh has none yet), so
+/// that whoever loads the file does not compute them again. Built with the
 /// `interaction` feature, each joint node with vertices of its own carries its collision proxy
 /// (`collision::fit_proxies`) in the node's frame as `extras.dqhand_collision`:
 /// `{"capsule": {"start", "end", "radius"}}` or `{"convex_hull": {"points", "triangles"}}`.
@@ -130,6 +137,8 @@ pub fn skinned_glb(model: &Model) -> Vec<u8> {
     if !mesh.uvs().is_empty() {
         attributes["TEXCOORD_0"] = json!(glb.floats(mesh.uvs(), "VEC2", Some(ARRAY_BUFFER)));
     }
+    let centres: Vec<[f32; 3]> = (0..positions.len()).map(|v| mesh.centre_of_rotation(v).to_array()).collect();
+    attributes[CENTRE_OF_ROTATION] = json!(glb.floats(&centres, "VEC3", Some(ARRAY_BUFFER)));
     let sets = if mesh.max_influences() > 4 { 2 } else { 1 };
     for set in 0..sets {
         let mut joints = Vec::with_capacity(positions.len() * 8);

@@ -2,7 +2,9 @@
 //!
 //! Reads the node hierarchy (the skin's joints and their ancestors), inverse bind matrices,
 //! and every triangle primitive of the meshes bound to the first skin: POSITION, NORMAL,
-//! TEXCOORD_0, JOINTS_0/1 and WEIGHTS_0/1. Primitives are concatenated in file order, so
+//! TEXCOORD_0, JOINTS_0/1 and WEIGHTS_0/1, and the CoR method's centres of rotation where
+//! dqhand wrote them ([`super::CENTRE_OF_ROTATION`]; computed when first used where any
+//! primitive lacks them). Primitives are concatenated in file order, so
 //! vertex order and count are kept. Every accessor is bounds-checked before it is read, so a
 //! truncated or inconsistent file gives an error, never a panic.
 
@@ -13,6 +15,7 @@ use glam::{Affine3A, Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::Semantic;
 
+use super::CENTRE_OF_ROTATION;
 use crate::Warning;
 use crate::gltf_file::{self, check_accessor};
 use crate::kinematics::{Joint, Skeleton, Transform};
@@ -152,6 +155,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             primitives.push((mesh.name().unwrap_or("mesh").to_owned(), prim));
         }
     }
+    // CoR's centres, kept only if every primitive has them (else computed when first used).
+    let mut all_centres: Vec<[f32; 3]> = Vec::new();
     for (name, prim) in &primitives {
         let where_ = format!("mesh {name:?} primitive {}", prim.index());
         let sets = influence_sets(prim, name)?;
@@ -166,6 +171,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             kinds.push((Semantic::Joints(set), labels[0], (Dimensions::Vec4, small_uint)));
             kinds.push((Semantic::Weights(set), labels[1], (Dimensions::Vec4, uv)));
         }
+        let centre = Semantic::Extras(CENTRE_OF_ROTATION[1..].to_owned());
+        kinds.push((centre.clone(), CENTRE_OF_ROTATION, (Dimensions::Vec3, vec3)));
         for (semantic, label, kind) in kinds {
             check_accessor(prim.get(&semantic), &format!("{where_} {label}"), kind, &buffers)?;
         }
@@ -197,10 +204,11 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             }
         }
         let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(Iterator::collect);
+        let centres: Option<Vec<[f32; 3]>> = prim.get(&centre).and_then(|a| gltf::accessor::Iter::new(a, get)).map(Iterator::collect);
         let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
         let indices = gltf_file::vertex_order(&reader, n, &where_)?;
-        if normals.as_ref().is_some_and(|v| v.len() != n) || uvs.as_ref().is_some_and(|v| v.len() != n) {
-            return Err(bad(format!("{where_}: NORMAL or TEXCOORD_0 count differs from POSITION ({n})")));
+        if normals.as_ref().is_some_and(|v| v.len() != n) || uvs.as_ref().is_some_and(|v| v.len() != n) || centres.as_ref().is_some_and(|v| v.len() != n) {
+            return Err(bad(format!("{where_}: NORMAL, TEXCOORD_0 or {CENTRE_OF_ROTATION} count differs from POSITION ({n})")));
         }
         let start = data.indices.len();
         data.parts.push(Part { name: name.clone(), vertices: base as usize..base as usize + n, indices: start..start + indices.len() });
@@ -214,6 +222,10 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             Some(v) if data.uvs.len() == base as usize => data.uvs.extend(v),
             _ => data.uvs.clear(),
         }
+        match centres {
+            Some(v) if all_centres.len() == base as usize => all_centres.extend(v),
+            _ => all_centres.clear(),
+        }
         data.positions.extend(positions);
         data.joints.extend(influences.iter().map(|i| i.0));
         data.weights.extend(influences.iter().map(|i| i.1));
@@ -225,7 +237,11 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
         data.uvs.clear();
     }
     data.stride = stride.max(1);
-    let (mesh, mesh_warnings) = SkinnedMesh::new(data)?;
+    let n = data.positions.len();
+    let (mut mesh, mesh_warnings) = SkinnedMesh::new(data)?;
+    if all_centres.len() == n {
+        mesh = mesh.with_centres_of_rotation(&all_centres).map_err(|e| bad(format!("{CENTRE_OF_ROTATION}: {e}")))?;
+    }
     warnings.extend(mesh_warnings);
     let name = path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into_owned());
     // A named mesh says what the file holds (dqhand names it with the model's description);

@@ -8,7 +8,7 @@ mod pose_file;
 
 use std::path::Path;
 
-pub use gltf_export::{skinned_glb, write_posed_glb, write_skinned_glb};
+pub use gltf_export::{skinned_glb, write_posed_glb, write_skinned_glb, CENTRE_OF_ROTATION};
 pub use gltf_import::{load_gltf, load_gltf_slice};
 pub use obj::write_obj;
 pub use ply::write_ply;

@@ -1,4 +1,4 @@
-//! Realism metrics: how LB, QB and DQB deform the same hand (the paper's claim, measured).
+//! Realism metrics: how LB, QB, DQB and CoR deform the same hand (the paper's claim, measured).
 //!
 //! Volume against rest, collapse and bulge near a bent joint, the candy wrapper of a twisted
 //! joint, edge-length distortion, the continuity of sweeps, and self-intersections and

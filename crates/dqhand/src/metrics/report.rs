@@ -1,4 +1,4 @@
-//! The realism report: LB, QB and DQB measured on the same sweeps of the same hand.
+//! The realism report: LB, QB, DQB and CoR measured on the same sweeps of the same hand.
 
 use std::fmt::Write as _;
 use std::path::Path;

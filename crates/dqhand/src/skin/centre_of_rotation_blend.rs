@@ -3,10 +3,12 @@
 //!
 //! `q = normalize(Σ wᵢ sᵢ qᵢ)`, `v' = q (v − p*) q* + Σ wᵢ Mᵢ p*` for the vertex's centre of
 //! rotation `p*` (module `centres_of_rotation`), normals `n' = q n q*`. Like QB the blended
-//! rotation is a true rotation, so nothing collapses; unlike QB it turns about `p*`, a point
-//! among the vertex's own joints, not about the model origin, and LB of that one point is
-//! close to rigid: DQB's bulge at a bent joint, which comes from blending the translations
-//! through the dual part, is gone.
+//! rotation is a true rotation; unlike QB it turns about `p*`, a point of the rest mesh
+//! weighted like the vertex (near the joints it blends), not about the model origin, and LB
+//! moves only that one point. At a bent joint this bulges less than DQB, which blends the
+//! translations through the dual part (`dqhand metrics`: 1.15× the rest distance at 90° PIP
+//! against 1.23); where LB of the centre itself collapses (a centre off a twist's axis) CoR
+//! shrinks as well (docs/realism.md).
 
 use glam::Affine3A;
 

@@ -11,9 +11,10 @@
 //!
 //! A term needs both joints `j`, `k` to weigh on the vertex and on the triangle, so the sums
 //! run over the triangles of each pair of the vertex's joints only (a list per pair, built
-//! once): linear in the mesh for a hand's sparse weights, where the definition's sum over all
-//! triangles is quadratic. A vertex with one joint, or whose pairs no triangle shares, has no
-//! centre of its own: it moves rigidly, whatever the centre, and takes its rest position.
+//! once): the vertices of a pair's region times its triangles, where the definition sums over
+//! every triangle for every vertex. A vertex with one joint moves rigidly whatever its centre
+//! and takes its rest position; so does one whose pairs no triangle shares, which then moves
+//! as LB moves it.
 //! The paper subdivides the mesh first so that triangles are small against the weights'
 //! changes; a mesh made for skinning (the built-in hand's 8,668 vertices) is used as it is.
 

@@ -153,7 +153,8 @@ impl Deformer {
     /// mesh: the first deformer of a method and mesh shape in the process times each
     /// strategy for a few frames (about a millisecond for the built-in hand), later ones
     /// reuse its choice. CoR's centres of rotation are computed here if the mesh does not
-    /// have them yet.
+    /// have them yet (another mesh deformed by this deformer computes its own at its first
+    /// deformation, which then allocates).
     #[must_use]
     pub fn new(method: Method, mesh: &SkinnedMesh) -> Self {
         if method == Method::Cor {

@@ -1,4 +1,4 @@
-//! The shared vertex loop of the three deformers.
+//! The shared vertex loop of the four deformers.
 //!
 //! Each deformer turns a bone transform into `W` floats once per frame. Per chunk of
 //! vertices the loop blends those floats per vertex (`Σ wᵢ pᵢ`, contiguous loads, one fused
@@ -116,16 +116,16 @@ impl<const L: usize> Chunk<L> {
     }
 }
 
-/// What differs between LB, QB and DQB.
+/// What differs between LB, QB, DQB and CoR.
 pub(crate) trait Blend<const W: usize> {
     /// How many leading parameters are sign-aligned to the heaviest influence before
     /// blending: the quaternion parts, since `q` and `−q` are the same rotation but blend
-    /// differently. QB aligns its rotation (4) but not its translation, which is blended as
-    /// is; DQB aligns the whole dual quaternion (8), whose dual part changes sign with the
-    /// real part; LB aligns nothing (0).
+    /// differently. QB and CoR align their rotation (4) but not their translation or matrix
+    /// rows, which are blended as they are; DQB aligns the whole dual quaternion (8), whose
+    /// dual part changes sign with the real part; LB aligns nothing (0).
     const SIGNED: usize;
     /// How many leading parameters `finish` reads (the rest is padding the AVX-512 blend
-    /// skips): LB 12, QB 7, DQB 8.
+    /// skips): LB 12, QB 7, DQB 8, CoR 16.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const USED: usize;
     /// Whether `finish` reads the vertices' centres of rotation (`Chunk::c`, from

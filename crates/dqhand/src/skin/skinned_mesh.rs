@@ -467,14 +467,19 @@ impl SkinnedMesh {
 
     /// Vertex `v`'s centre of rotation (bind space, m; computed on first use, as
     /// [`crate::skin::Method::Cor`] needs them).
+    ///
+    /// # Panics
+    /// If `v` is not a vertex of the mesh.
     #[must_use]
     pub fn centre_of_rotation(&self, v: usize) -> Vec3 {
+        assert!(v < self.vertex_count, "vertex {v} of {}", self.vertex_count);
         let c = self.centres();
         Vec3::new(c[0][v], c[1][v], c[2][v])
     }
 
     /// Whether the centres of rotation are known already (given, or computed by an earlier
-    /// use): an export writes them only then, or asks for them.
+    /// use). Part of the mesh's equality: a mesh whose centres are known is not equal to the
+    /// same mesh before they were.
     #[must_use]
     pub fn has_centres_of_rotation(&self) -> bool {
         self.centres.get().is_some()
