@@ -222,7 +222,7 @@ fn bench_json_reports_every_method() {
     assert_eq!(report["mesh"], "builtin");
     assert_eq!(report["vertices"], BUILTIN_VERTICES);
     assert_eq!(report["bones"], 20);
-    for method in ["lb", "qb", "dqb"] {
+    for method in ["lb", "qb", "dqb", "cor"] {
         positive_number(&report, &format!("/methods/{method}/us_per_frame"));
         positive_number(&report, &format!("/methods/{method}/fps"));
     }
@@ -231,7 +231,8 @@ fn bench_json_reports_every_method() {
     // Issue 33: the lookup strategy each method's deformer chose (on the AVX-512 kernel only),
     // and the roofline.
     let avx512 = dqhand::skin::Kernel::best() == dqhand::skin::Kernel::Avx512;
-    for method in ["lb", "qb", "dqb"] {
+    positive_number(&report, "/cor_centres_ms");
+    for method in ["lb", "qb", "dqb", "cor"] {
         let chosen = &report["chosen_strategy"][method];
         match chosen.as_str() {
             Some(name) => assert!(avx512 && dqhand::skin::Strategy::named(name).is_some(), "{method}: {chosen} is not a strategy, or there is no AVX-512 kernel"),
@@ -242,7 +243,7 @@ fn bench_json_reports_every_method() {
         positive_number(&report, &format!("/machine/{key}"));
     }
     let rows = report["roofline"].as_array().expect("roofline rows");
-    assert_eq!(rows.len(), 6, "a row per method, with and without normals");
+    assert_eq!(rows.len(), 8, "a row per method, with and without normals");
     for i in 0..rows.len() {
         for key in ["bytes_read", "bytes_written", "flops", "bound_us", "over_bound"] {
             positive_number(&report, &format!("/roofline/{i}/{key}"));
