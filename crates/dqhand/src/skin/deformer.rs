@@ -402,6 +402,12 @@ impl Deformer {
     pub fn deform_batch(&self, pool: &rayon::ThreadPool, mesh: &SkinnedMesh, skinning: &[Affine3A], out: &mut [Deformed]) {
         let joints = mesh.inverse_bind().len();
         assert_eq!(skinning.len(), joints * out.len(), "one pose's transforms per output");
+        // CoR's centres, computed here, not by the first pose's job: that computation runs on
+        // rayon too, and a thread waiting for its pieces may take up another pose's job,
+        // which would then wait for the computation under way on that very thread.
+        if self.method == Method::Cor {
+            mesh.centres();
+        }
         let single = Self { crew: None, ..self.clone() };
         pool.install(|| {
             out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
