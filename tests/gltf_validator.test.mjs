@@ -51,7 +51,7 @@ test('the rigged, skinned hand is valid glTF 2.0 with one skin and 25 joints', a
 
 test('every posed mesh of the demo is valid glTF 2.0', async () => {
   const files = readdirSync(out).filter((f) => f.endsWith('.glb') && f !== 'hand.glb');
-  assert.equal(files.length, 11 * 3); // the 11 library gestures, each with LB, QB, DQB
+  assert.equal(files.length, 11 * 4); // the 11 library gestures, each with LB, QB, DQB, CoR
   for (const f of files) {
     const { info } = await validate(path.join(out, f));
     assert.deepEqual([info.hasSkins, info.drawCallCount, info.totalVertexCount], [false, 1, 8668], f);

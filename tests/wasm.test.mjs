@@ -91,7 +91,7 @@ test('bad input is a one-line Error naming it, and the hand keeps its last pose'
   const nan = a.slice();
   nan[4] = NaN;
   assert.throws(() => hand.step(nan), /^Error: angles\[4\] \(NaN\): not a finite number$/);
-  assert.throws(() => hand.setMethod('cor'), (e) => e instanceof Error && e.message.includes('cor') && !e.message.includes('\n'));
+  assert.throws(() => hand.setMethod('blend'), (e) => e instanceof Error && e.message.includes('blend') && !e.message.includes('\n'));
   assert.throws(() => Hand.builtin(0.19, 0.085, 'middle', 'full'), /side "middle"/);
   assert.throws(() => Hand.builtin(-1, 0.085, 'left', 'full'), (e) => e instanceof Error && !e.message.includes('\n'));
   const after = new Float32Array(wasmMemory().buffer, hand.positionsPtr(), 3 * hand.vertexCount);
