@@ -62,7 +62,7 @@ test('the WASM hand is the native built-in hand: its joint model, vertices and t
   assert.equal(hand.indices().length % 3, 0);
 });
 
-for (const method of ['lb', 'qb', 'dqb']) {
+for (const method of ['lb', 'qb', 'dqb', 'cor']) {
   test(`${method}: positions and normals agree with the native engine's to 1e-5 over seeded poses`, () => {
     hand.setMethod(method);
     for (const seed of [1, 2, 3]) {
