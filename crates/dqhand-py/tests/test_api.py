@@ -507,7 +507,7 @@ def test_bad_metric_arguments_are_refused(hand):
     assert one_line(e).startswith('unknown joint "index-knuckle"; valid: wrist, ')
     with pytest.raises(ValueError, match='^next: joint "wrist" has 5 children'):
         hand.realism(angles, joint="wrist")
-    with pytest.raises(ValueError, match='^unknown skinning method "xyz"; valid: lb, qb, dqb$'):
+    with pytest.raises(ValueError, match='^unknown skinning method "xyz"; valid: lb, qb, dqb, cor$'):
         hand.realism(angles, method="xyz")
     with pytest.raises(ValueError, match=r"^angles: expected an array of shape \(B, 23\)"):
         hand.realism(np.zeros((1, 5)))

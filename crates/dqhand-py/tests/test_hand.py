@@ -247,7 +247,7 @@ def test_a_left_hand_is_built_as_a_left_hand():
         (lambda h: h.skin(np.zeros(23)), ValueError, ["angles", "(B, 23)"]),
         (lambda h: h.skin([["a"] * 23]), ValueError, ["angles"]),
         (lambda h: h.skin(np.full((1, 23), np.nan)), ValueError, ["angles", "not finite"]),
-        (lambda h: h.skin(np.zeros((1, 23)), method="cubic"), ValueError, ["cubic", "lb, qb, dqb"]),
+        (lambda h: h.skin(np.zeros((1, 23)), method="cubic"), ValueError, ["cubic", "lb, qb, dqb, cor"]),
         (lambda h: h.skin(np.zeros((2, 23)), wrist=np.zeros((1, 4, 4))), ValueError, ["wrist", "(2, 4, 4)", "(1, 4, 4)"]),
         (lambda h: h.skin(np.zeros((1, 23)), wrist=np.eye(4)), ValueError, ["wrist", "(1, 4, 4)", "got shape (4, 4)"]),
         (lambda h: h.skin(np.zeros((1, 23)), wrist=np.eye(4)[None] * 2), ValueError, ["wrist[0]", "rigid"]),
