@@ -13,16 +13,16 @@
 use glam::Affine3A;
 
 use super::kernel::{dot, recip, rotate, Blend, Chunk};
+use super::{linear_blend as lb, quaternion_blend as qb};
 
 /// Blend parameters: the rotation `(x, y, z, w)`, then the rows of the 3×4 matrix `[R | t]`.
 pub(crate) const W: usize = 16;
 
-/// The rotation quaternion of a skinning matrix's rigid part, and the matrix's rows.
+/// The rotation quaternion of a skinning matrix's rigid part (QB's), and the matrix's rows
+/// (LB's).
 pub(crate) fn params(m: &Affine3A) -> [f32; W] {
-    let (_, q, _) = m.to_scale_rotation_translation();
-    let q = q.normalize();
-    let (c, t) = (m.matrix3, m.translation);
-    [q.x, q.y, q.z, q.w, c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x, c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y, c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z]
+    let (q, rows) = (qb::params(m), lb::params(m));
+    core::array::from_fn(|i| if i < 4 { q[i] } else { rows[i - 4] })
 }
 
 pub(crate) struct Cor;

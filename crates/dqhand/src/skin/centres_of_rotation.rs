@@ -75,7 +75,7 @@ impl Triangles {
             }
             for (x, &(j, wj)) in weights.iter().enumerate() {
                 for &(k, wk) in &weights[x + 1..] {
-                    let (key, w) = if j < k { ((j, k), (wj, wk)) } else { ((k, j), (wk, wj)) };
+                    let (key, w) = ordered((j, wj), (k, wk));
                     pairs.entry(key).or_default().push(Share { area, centroid, w });
                 }
             }
@@ -90,7 +90,7 @@ impl Triangles {
         let (mut sum, mut total) = ([0.0f64; 3], 0.0f64);
         for (x, &(j, wj)) in inf.iter().enumerate() {
             for &(k, wk) in &inf[x + 1..] {
-                let (key, (vj, vk)) = if j < k { ((j as u16, k as u16), (wj, wk)) } else { ((k as u16, j as u16), (wk, wj)) };
+                let (key, (vj, vk)) = ordered((j as u16, wj), (k as u16, wk));
                 let Some(shares) = self.pairs.get(&key) else { continue };
                 for s in shares {
                     let (tj, tk) = s.w;
@@ -111,4 +111,10 @@ impl Triangles {
             mesh.position(v).to_array()
         }
     }
+}
+
+/// A pair of (joint, weight) as the key of [`Triangles::pairs`], the lower joint first, and
+/// the weights in the same order.
+fn ordered(a: (u16, f32), b: (u16, f32)) -> ((u16, u16), (f32, f32)) {
+    if a.0 < b.0 { ((a.0, b.0), (a.1, b.1)) } else { ((b.0, a.0), (b.1, a.1)) }
 }

@@ -323,11 +323,6 @@ impl SkinnedMesh {
             }
             normals
         };
-        let column = |src: &[[f32; 3]], c: usize| {
-            let mut col: Vec<f32> = src.iter().map(|p| p[c]).collect();
-            col.resize(padded, 0.0);
-            col
-        };
         let parts = if data.parts.is_empty() {
             vec![Part { name: "mesh".into(), vertices: 0..n, indices: 0..data.indices.len() }]
         } else {
@@ -335,8 +330,8 @@ impl SkinnedMesh {
         };
         let mesh = Self {
             vertex_count: n,
-            pos: [0, 1, 2].map(|c| column(&data.positions, c)),
-            nrm: [0, 1, 2].map(|c| column(&normals, c)),
+            pos: columns(&data.positions, padded),
+            nrm: columns(&normals, padded),
             k,
             joints,
             weights,
@@ -461,7 +456,7 @@ impl SkinnedMesh {
     pub(crate) fn centres(&self) -> &[Vec<f32>; 3] {
         self.centres.get_or_init(|| {
             let centres = super::centres_of_rotation::centres_of_rotation(self);
-            [0, 1, 2].map(|c| self.padded_column(centres.iter().map(|p| p[c])))
+            columns(&centres, self.pos[0].len())
         })
     }
 
@@ -497,17 +492,7 @@ impl SkinnedMesh {
         if let Some(v) = centres.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
             return Err(Error::Mesh(format!("vertex {v} has a non-finite centre of rotation {:?}", centres[v])));
         }
-        let columns = [0, 1, 2].map(|c| self.padded_column(centres.iter().map(|p| p[c])));
-        let centres = OnceLock::new();
-        let _ = centres.set(columns);
-        Ok(Self { centres, ..self })
-    }
-
-    /// One component per vertex, padded with zeros to whole chunks.
-    fn padded_column(&self, values: impl Iterator<Item = f32>) -> Vec<f32> {
-        let mut col: Vec<f32> = values.collect();
-        col.resize(self.pos[0].len(), 0.0);
-        col
+        Ok(Self { centres: OnceLock::from(columns(centres, self.pos[0].len())), ..self })
     }
 
     /// Number of joints that influence at least one vertex (the paper's "bones").
@@ -519,4 +504,14 @@ impl SkinnedMesh {
         }
         used.iter().filter(|&&u| u).count()
     }
+}
+
+/// Per-vertex triples as x, y and z arrays, padded with zeros to `padded` vertices (whole
+/// chunks).
+fn columns(values: &[[f32; 3]], padded: usize) -> [Vec<f32>; 3] {
+    [0, 1, 2].map(|c| {
+        let mut col: Vec<f32> = values.iter().map(|p| p[c]).collect();
+        col.resize(padded, 0.0);
+        col
+    })
 }
