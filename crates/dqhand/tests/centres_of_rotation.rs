@@ -114,3 +114,41 @@ fn centres_given_with_a_mesh_are_kept_and_bad_ones_are_refused() {
     let bad = mesh.with_centres_of_rotation(&nan).unwrap_err().to_string();
     assert!(bad.contains("vertex 7 has a non-finite centre of rotation"), "{bad}");
 }
+
+/// The WebXR generic right hand (a mesh the project did not make): `DQHAND_WEBXR_HAND`, else
+/// the npm asset under third_party/ (`make test` installs it).
+fn webxr_hand() -> dqhand::model::Model {
+    let path = std::env::var_os("DQHAND_WEBXR_HAND").map_or_else(
+        || std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"),
+        std::path::PathBuf::from,
+    );
+    assert!(path.is_file(), "the WebXR generic hand {} is missing: run `make test`, or set DQHAND_WEBXR_HAND", path.display());
+    dqhand::io::load_gltf(&path).expect("the WebXR generic hand loads")
+}
+
+#[test]
+fn on_the_webxr_generic_hand_the_centres_are_the_definitions() {
+    let model = webxr_hand();
+    let mesh = &model.mesh;
+    // The same mesh as plain data for the reference: positions, triangles, weights.
+    let n = mesh.vertex_count();
+    let k = mesh.influences_per_vertex();
+    let mut data = MeshData { positions: mesh.positions(), indices: mesh.indices().to_vec(), stride: k, inverse_bind: mesh.inverse_bind().to_vec(), ..MeshData::default() };
+    for v in 0..n {
+        let inf: Vec<(usize, f32)> = mesh.influences(v).collect();
+        for s in 0..k {
+            let (j, w) = inf.get(s).copied().unwrap_or((0, 0.0));
+            data.joints.push(j as u32);
+            data.weights.push(w);
+        }
+    }
+    let centres = centres_of_rotation(mesh);
+    let blended: Vec<usize> = (0..n).filter(|&v| mesh.influences(v).count() >= 2).collect();
+    assert!(blended.len() > 100, "{} of {n} vertices blend joints", blended.len());
+    // Ten vertices spread over those that blend joints (the dense sum is slow).
+    for &v in blended.iter().step_by(blended.len() / 10) {
+        let want = reference(&data, v);
+        let got = Vec3::from(centres[v]).as_dvec3();
+        assert!(got.distance(want) < 1e-6, "vertex {v}: centre {got} but the definition gives {want}");
+    }
+}
