@@ -38,7 +38,7 @@ use parry3d::query::{self, NonlinearRigidMotion};
 use super::proxy_mesh_query::{ProxyMeshQuery, TOLERANCE};
 use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectCollider, ObjectColliders, FINGERS};
-use crate::kinematics::{forward_kinematics, HandKinematics, Motion, Pose, Transform};
+use crate::kinematics::{forward_kinematics, forward_kinematics_of, HandKinematics, Motion, Pose, Transform};
 use crate::math::DualQuat;
 
 /// Proxies closer than this to an object touch it (m).
@@ -110,6 +110,11 @@ struct FingerChain {
     /// The rest of its DOFs (abduction, twist), indices in the pose: a gripping finger keeps
     /// them too.
     others: Vec<usize>,
+    /// The joints its closure moves (its first DOF's joint and all below it), parents first,
+    /// and every DOF turning them (ascending indices in the pose): what each step of its
+    /// advancement poses again.
+    joints: Vec<usize>,
+    turns: Vec<usize>,
     /// Its proxies: (index in [`HandProxies::colliders`], the last DOF (position in `dofs`)
     /// that moves it, and per DOF an upper bound of the distance of its core's points (a
     /// capsule's segment: its distance falls no faster than they move) from that DOF's
@@ -237,7 +242,11 @@ impl ContactConstraint {
                 })
                 .collect::<Vec<_>>();
             let bounds = vec![UNMEASURED; proxies.len()];
-            FingerChain { dofs, others, proxies, reach, bounds }
+            let root = dofs.first().map(|&(_, j)| j);
+            let moved = |j: usize| root.is_some_and(|r| is_ancestor(r, j));
+            let joints = skeleton.order().iter().copied().filter(|&j| moved(j)).collect();
+            let turns = rig.dofs().iter().enumerate().filter(|(_, r)| moved(r.joint)).map(|(i, _)| i).collect();
+            FingerChain { dofs, others, joints, turns, proxies, reach, bounds }
         });
         let n = skeleton.len();
         let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
@@ -361,6 +370,14 @@ impl ContactConstraint {
         let rig = self.kinematics.rig();
         rig.locals(&self.rendered, self.kinematics.limits(), &mut self.trial_locals);
         forward_kinematics(rig.skeleton(), &self.trial_locals, &mut self.trial_world);
+    }
+
+    /// [`Self::forward_trial`] of only `chain`'s joints, the rest as the last trial left them:
+    /// a step of its closure, which turns nothing else.
+    fn forward_trial_of(&mut self, chain: &FingerChain) {
+        let rig = self.kinematics.rig();
+        rig.locals_of(&self.rendered, self.kinematics.limits(), &chain.joints, &chain.turns, &mut self.trial_locals);
+        forward_kinematics_of(rig.skeleton(), &chain.joints, &self.trial_locals, &mut self.trial_world);
     }
 
     /// Stage 1: the first time of impact of the palm on its way to `target`.
@@ -557,7 +574,7 @@ impl ContactConstraint {
             chain.bounds.fill(UNMEASURED);
             for _ in 0..MAX_ADVANCES {
                 set(&mut self.rendered.angles, active, s, &start, &target);
-                self.forward_trial();
+                self.forward_trial_of(&chain);
                 // The nearest proxy measured (its distance, last DOF and the object), and the
                 // largest step no point of any can overrun. A proxy is measured only where its
                 // bound may have come down to the stop distance: the others cannot stop the

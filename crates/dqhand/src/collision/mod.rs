@@ -9,6 +9,8 @@
 //!   impact), its own rather than parry's, whose GJK in metres is centimetres off there;
 //!   a hull proxy's support points by hill climbing (`hull_support`), which parry's casts
 //!   between hulls take through a dispatcher of their own (`support_pair`).
+//! * `simulated_hull` — what the physics simulates a hull proxy as: fewer vertices, rounded
+//!   to hold the whole proxy.
 //! * [`TriangleTree`] — a mesh object's triangles in a tree of its own, built once, which
 //!   those queries search.
 
@@ -18,6 +20,7 @@ mod hull_support;
 mod object_colliders;
 mod proxy;
 mod proxy_mesh_query;
+mod simulated_hull;
 mod support_pair;
 mod triangle_tree;
 

@@ -12,12 +12,21 @@ use super::{Skeleton, Transform};
 /// # Panics
 /// If the slice lengths differ from the skeleton's joint count.
 pub fn forward_kinematics(skeleton: &Skeleton, locals: &[Transform], world: &mut [Affine3A]) {
+    forward_kinematics_of(skeleton, skeleton.order(), locals, world);
+}
+
+/// [`forward_kinematics`] of only the joints `joints` (each after its parent), whose parents
+/// outside them keep their world transforms: one finger of a hand whose palm has not moved.
+///
+/// # Panics
+/// If the slice lengths differ from the skeleton's joint count.
+pub fn forward_kinematics_of(skeleton: &Skeleton, joints: &[usize], locals: &[Transform], world: &mut [Affine3A]) {
     assert_eq!(locals.len(), skeleton.len(), "locals: one transform per joint");
     assert_eq!(world.len(), skeleton.len(), "world: one transform per joint");
-    let joints = skeleton.joints();
-    for &j in skeleton.order() {
+    let all = skeleton.joints();
+    for &j in joints {
         let local = locals[j].to_affine();
-        world[j] = match joints[j].parent {
+        world[j] = match all[j].parent {
             Some(p) => world[p] * local,
             None => local,
         };

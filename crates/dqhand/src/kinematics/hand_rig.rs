@@ -178,7 +178,28 @@ impl HandRig {
             let local = self.wrist_parent_inverse * Affine3A::from_rotation_translation(rotation, translation);
             locals[self.wrist] = Transform { scale: locals[self.wrist].scale, ..Transform::from_affine(&local) };
         }
-        for (&a, d) in pose.angles.iter().zip(&self.dofs) {
+        self.turn(pose, limits, 0..self.dofs.len(), locals);
+    }
+
+    /// [`Self::locals`] of only the joints `joints` (none of them the wrist), which `dofs`
+    /// (ascending indices into the pose) are all the DOFs of: a closing finger's, whose other
+    /// joints keep what they were. Allocates nothing.
+    ///
+    /// # Panics
+    /// If `locals` or `pose.angles` have the wrong length.
+    pub fn locals_of(&self, pose: &Pose, limits: Limits, joints: &[usize], dofs: &[usize], locals: &mut [Transform]) {
+        assert_eq!(pose.angles.len(), self.dofs.len(), "pose angle count");
+        assert_eq!(locals.len(), self.skeleton.len(), "locals: one per joint");
+        for &j in joints {
+            locals[j] = self.skeleton.joints()[j].rest;
+        }
+        self.turn(pose, limits, dofs.iter().copied(), locals);
+    }
+
+    /// Turns each joint of DOFs `dofs` (ascending) by its angle in `pose`: `rest · R(abd) · R(flex)`.
+    fn turn(&self, pose: &Pose, limits: Limits, dofs: impl Iterator<Item = usize>, locals: &mut [Transform]) {
+        for i in dofs {
+            let (a, d) = (pose.angles[i], &self.dofs[i]);
             let angle = match limits {
                 Limits::Anatomical => a.clamp(d.min, d.max),
                 Limits::Off => a,

@@ -16,7 +16,7 @@ mod skinning_transforms;
 mod transform;
 pub mod webxr;
 
-pub use forward_kinematics::forward_kinematics;
+pub use forward_kinematics::{forward_kinematics, forward_kinematics_of};
 pub use hand_kinematics::{ClampedAngle, HandKinematics};
 pub use hand_rig::{HandRig, Limits, RigDof};
 pub use joint_model::{Dof, JointModel, Motion};

@@ -177,15 +177,16 @@ impl ScenePhysics {
         Self { world, held: vec![false; bodies.len()], bodies, colliders: handles, let_go, initial, hands: Vec::new(), returned, floor, reach }
     }
 
-    /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves; returns its
-    /// index there.
+    /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves (as their
+    /// [`ProxyCollider::simulated`](crate::collision::ProxyCollider::simulated) shapes, which
+    /// hold them with fewer vertices); returns its index there.
     pub fn add_hand(&mut self, proxies: &HandProxies) -> usize {
         let hand = proxies
             .colliders()
             .iter()
             .map(|p| {
                 let body = RigidBodyBuilder::kinematic_position_based().build();
-                let (body, collider) = self.world.insert(body, ColliderBuilder::new(p.shape.clone()).build());
+                let (body, collider) = self.world.insert(body, ColliderBuilder::new(p.simulated.clone()).build());
                 ProxyBody { body, collider, joint: p.joint, palm: p.part == HandPart::Palm }
             })
             .collect();

@@ -1,0 +1,122 @@
+//! The shape the physics simulates a hull proxy as: a few of its vertices' hull, rounded by
+//! how far the rest lie outside it, so it holds the whole proxy.
+//!
+//! A hull proxy is the hull of every skin vertex its joint carries (957 vertices on the built-in
+//! hand's wrist). rapier transforms every one of them for the collider's box twice a step, and
+//! its contacts try every one for each support point: a quarter of the manipulation loop's time
+//! on the teapot. The vertices that are extreme along [`DIRECTIONS`] spread directions keep the
+//! shape; the rounding (parry's round convex polyhedron, which rapier's contacts handle as
+//! they do a polyhedron, faces and all) makes it no smaller anywhere, so an object pushed by
+//! the simulated hand is never pushed into the hand the contact constraint sees.
+
+use glam::Vec3;
+use parry3d::query::PointQuery;
+use parry3d::shape::{SharedShape, Triangle};
+
+/// Directions whose extreme vertices start the simulated hull.
+const DIRECTIONS: usize = 32;
+
+/// Vertices are added to the simulated hull until none is farther than this outside its
+/// faces' planes (m).
+const OUTSIDE_M: f32 = 2.5e-4;
+
+/// How far parry's polyhedron of a hull may lie outside the hull's own faces (m): it merges
+/// nearly coplanar ones (4.7 µm measured on the built-in hand's wrist).
+const MERGED_M: f32 = 2e-5;
+
+/// How many vertices are added to the simulated hull at a time: one at a time keeps fewest
+/// (each the farthest out), but builds a hull for each (0.3 s for the wrist's).
+const BATCH: usize = 16;
+
+/// The most vertices the simulated hull keeps.
+pub const MAX_VERTICES: usize = 256;
+
+/// The simulated shape of the hull of `points` (a proxy's vertices, m): the hull of the
+/// vertices extreme along [`DIRECTIONS`] directions, grown by the vertex farthest outside it
+/// until none is [`OUTSIDE_M`] outside (or it has [`MAX_VERTICES`]), rounded by the largest
+/// distance of any of `points` from it. `None` where `points` span no volume.
+#[must_use]
+pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
+    let mut kept: Vec<Vec3> = fibonacci_sphere(DIRECTIONS)
+        .filter_map(|u| points.iter().copied().max_by(|a, b| a.dot(u).total_cmp(&b.dot(u))))
+        .collect();
+    kept.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).expect("finite points"));
+    kept.dedup();
+    loop {
+        let (vertices, faces) = parry3d::transformation::try_convex_hull(&kept).ok()?;
+        let triangles: Vec<Triangle> = faces.iter().map(|&[a, b, c]| Triangle::new(vertices[a as usize], vertices[b as usize], vertices[c as usize])).collect();
+        let planes: Vec<(Vec3, f32)> = triangles.iter().filter_map(|t| t.normal().map(|n| (n, n.dot(t.a)))).collect();
+        // Per face (the hull's faces turn outward), the point farthest above its plane, if
+        // more than [`OUTSIDE_M`]: quickhull's next points, the [`BATCH`] farthest at once.
+        let mut farthest: Vec<(f32, Vec3)> = vec![(OUTSIDE_M, Vec3::ZERO); planes.len()];
+        for &p in points {
+            let (face, by) = planes.iter().map(|&(n, d)| n.dot(p) - d).enumerate().max_by(|a, b| a.1.total_cmp(&b.1))?;
+            if by > farthest[face].0 {
+                farthest[face] = (by, p);
+            }
+        }
+        let mut due: Vec<(f32, Vec3)> = farthest.into_iter().filter(|&(by, _)| by > OUTSIDE_M).collect();
+        if !due.is_empty() && kept.len() < MAX_VERTICES {
+            due.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let room = (MAX_VERTICES - kept.len()).min(BATCH);
+            kept.extend(due.iter().take(room).map(|&(_, p)| p));
+            continue;
+        }
+        // Each point's distance: an outside point's nearest point of the hull is on a face
+        // whose plane it is above. parry's polyhedron of the hull merges nearly coplanar
+        // faces, which moves the surface by up to a few micrometres: [`MERGED_M`] more.
+        let distance = |p: Vec3| triangles.iter().filter(|t| t.normal().is_some_and(|n| n.dot(p - t.a) > 0.0)).map(|t| t.distance_to_local_point(p, true)).reduce(f32::min).unwrap_or(0.0);
+        let outside = points.iter().map(|&p| distance(p)).fold(0.0, f32::max);
+        return SharedShape::round_convex_mesh(vertices, &faces, outside + MERGED_M);
+    }
+}
+
+/// `n` directions spread evenly over the unit sphere (the golden-angle spiral).
+fn fibonacci_sphere(n: usize) -> impl Iterator<Item = Vec3> {
+    let turn = core::f32::consts::PI * (3.0 - 5.0f32.sqrt());
+    (0..n).map(move |i| {
+        let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let r = (1.0 - y * y).max(0.0).sqrt();
+        let a = turn * i as f32;
+        Vec3::new(r * a.cos(), y, r * a.sin())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::{fit_proxies, ProxyShape, PROXY_MARGIN};
+
+    #[test]
+    fn the_simulated_hull_holds_the_proxy_and_is_little_larger() {
+        let model = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
+        let mut hulls = 0;
+        for proxy in fit_proxies(&model, PROXY_MARGIN) {
+            let ProxyShape::ConvexHull { points, .. } = &proxy.shape else { continue };
+            hulls += 1;
+            let simulated = simulated_hull(points).expect("a hull spans a volume");
+            let simulated = &*simulated;
+            let round = simulated.as_round_convex_polyhedron().expect("a rounded hull");
+            let radius = round.border_radius;
+            // Every vertex of the proxy is in it: no farther from the inner hull than the
+            // rounding (inside every face's plane, or near enough to some face).
+            let (vertices, faces) = round.inner_shape.to_trimesh();
+            let faces: Vec<Triangle> = faces.iter().map(|f| Triangle::new(vertices[f[0] as usize], vertices[f[1] as usize], vertices[f[2] as usize])).collect();
+            let inside = |p: Vec3| faces.iter().all(|t| t.normal().is_some_and(|n| n.dot(p - t.a) <= 1e-7));
+            let gap = |p: Vec3| if inside(p) { 0.0 } else { faces.iter().map(|t| t.distance_to_local_point(p, true)).fold(f32::MAX, f32::min) };
+            let outside = points.iter().map(|&p| gap(p) - radius).fold(f32::MIN, f32::max);
+            // How much larger it is: its reach past the proxy's along many directions.
+            let larger = fibonacci_sphere(500)
+                .map(|u| {
+                    let reach = |q: &[Vec3]| q.iter().map(|p| p.dot(u)).fold(f32::MIN, f32::max);
+                    reach(round.inner_shape.points()) + radius - reach(points)
+                })
+                .fold(0.0, f32::max);
+            eprintln!("joint {}: {} -> {} vertices, rounded {:.3} mm, at most {:.3} mm larger", proxy.joint, points.len(), round.inner_shape.points().len(), radius * 1e3, larger * 1e3);
+            assert!(outside <= 1e-6, "joint {}: a vertex {outside} m outside", proxy.joint);
+            assert!(round.inner_shape.points().len() <= MAX_VERTICES);
+            assert!(larger <= 1e-3, "joint {}: {larger} m larger", proxy.joint);
+        }
+        assert!(hulls >= 5, "{hulls} hulls");
+    }
+}
