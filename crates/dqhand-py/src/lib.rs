@@ -285,6 +285,17 @@ impl Hand {
         array_of(py, ranges.into_iter())
     }
 
+    /// Each vertex's optimized centre of rotation (Le and Hodgins 2016), the rest-pose point its
+    /// skin turns about under `method="cor"`, (V, 3), m: computed once per hand, when first
+    /// asked for (by this or by a `cor` skin), or read from the glTF file that stored them.
+    #[getter]
+    fn centres_of_rotation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let mesh = &self.model.mesh;
+        // (The first one asked computes them all: without the interpreter's lock.)
+        py.detach(|| (mesh.vertex_count() > 0).then(|| mesh.centre_of_rotation(0)));
+        array_of(py, (0..mesh.vertex_count()).map(|v| mesh.centre_of_rotation(v).to_array()))
+    }
+
     /// The skin's influences: joint indices (into `joint_names`) and weights, each (V, K),
     /// heaviest first, unused slots (0, 0).
     #[getter]

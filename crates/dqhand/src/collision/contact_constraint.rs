@@ -244,9 +244,11 @@ impl ContactConstraint {
             let bounds = vec![UNMEASURED; proxies.len()];
             let root = dofs.first().map(|&(_, j)| j);
             let moved = |j: usize| root.is_some_and(|r| is_ancestor(r, j));
-            let joints = skeleton.order().iter().copied().filter(|&j| moved(j)).collect();
+            let subtree = skeleton.order().iter().copied().filter(|&j| moved(j)).collect();
             let turns = rig.dofs().iter().enumerate().filter(|(_, r)| moved(r.joint)).map(|(i, _)| i).collect();
-            FingerChain { dofs, others, joints, turns, proxies, reach, bounds }
+            // What a step of the closure turns is all below its first joint (see forward_trial_of).
+            debug_assert!(dofs.iter().all(|&(_, j)| moved(j)), "a finger's closing joints under its first");
+            FingerChain { dofs, others, joints: subtree, turns, proxies, reach, bounds }
         });
         let n = skeleton.len();
         let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
@@ -765,4 +767,39 @@ fn moves_off(motion: &NonlinearRigidMotion, shape: &dyn parry3d::shape::Shape, o
     let Ok(Some(c)) = query::contact(&motion.start, shape, &o.pose, &*o.surface, CONTACT_DISTANCE) else { return false };
     let deeper = |t: f32| query::contact(&motion.position_at_time(t), shape, &o.pose, &*o.surface, CONTACT_DISTANCE).is_ok_and(|e| e.is_some_and(|e| e.dist < c.dist.min(0.0) - TOLERANCE));
     (motion.linvel + motion.angvel.cross(c.point1 - pivot)).dot(c.normal1) <= 0.0 && !deeper(end / 2.0) && !deeper(end)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::{fit_proxies, PROXY_MARGIN};
+    use crate::kinematics::JointModel;
+
+    /// A step of a finger's closure poses its joints as the whole hand's forward kinematics
+    /// does, to the bit, and leaves the rest as they were.
+    #[test]
+    fn a_closing_finger_is_posed_alone_as_the_whole_hand_poses_it() {
+        let model = crate::hand::build(&crate::hand::HandParams { vertices: 2000, ..crate::hand::HandParams::default() }).expect("the built-in hand");
+        let kinematics = HandKinematics::new(&model.skeleton, model.mesh.inverse_bind(), JointModel::Full).expect("a rig");
+        let mut c = ContactConstraint::new(HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), &model.skeleton), kinematics);
+        let mut rng = crate::math::Rng::new(3);
+        for f in 0..5 {
+            let chain = std::mem::take(&mut c.fingers[f]);
+            assert!(!chain.dofs.is_empty() && chain.proxies.iter().all(|(p, ..)| chain.joints.contains(&c.proxies.colliders()[*p].joint)), "finger {f}");
+            for a in &mut c.rendered.angles {
+                *a = rng.uniform(-0.3, 1.2) as f32;
+            }
+            c.forward_trial();
+            for &(i, _) in &chain.dofs {
+                c.rendered.angles[i] = rng.uniform(0.0, 1.5) as f32;
+            }
+            let before = c.trial_world.clone();
+            c.forward_trial_of(&chain);
+            let alone = c.trial_world.clone();
+            c.forward_trial();
+            assert_eq!(alone, c.trial_world, "finger {f}: posed alone, not as the whole hand");
+            assert!(chain.joints.iter().all(|&j| alone[j] != before[j]), "finger {f}: a joint of the closure did not move");
+            c.fingers[f] = chain;
+        }
+    }
 }

@@ -8,7 +8,6 @@ use parry3d::math::Pose;
 use parry3d::shape::{SharedShape, SupportMap};
 
 use super::hull_support::HullSupport;
-use super::simulated_hull::simulated_hull;
 use super::{Proxy, ProxyShape};
 use crate::kinematics::Skeleton;
 
@@ -55,9 +54,6 @@ pub struct ProxyCollider {
     /// segment's less its radius, so it falls no faster than the segment's points move:
     /// the lever of a turn is this, not [`Self::extent`].
     pub lever: f32,
-    /// The shape the physics simulates (`simulated_hull`: a hull's few extreme vertices,
-    /// rounded to hold it; a capsule itself).
-    pub simulated: SharedShape,
     /// A hull's support function by hill climbing (parry's tries every vertex: 957 on the
     /// wrist's).
     hull: Option<HullSupport>,
@@ -114,22 +110,20 @@ impl HandProxies {
         let colliders = proxies
             .iter()
             .filter_map(|p| {
-                let (shape, simulated, lever, extent, hull) = match &p.shape {
+                let (shape, lever, extent, hull) = match &p.shape {
                     ProxyShape::Capsule { start, end, radius } => {
                         let lever = start.length().max(end.length());
-                        let shape = SharedShape::capsule(*start, *end, *radius);
-                        (shape.clone(), shape, lever, lever + radius, None)
+                        (SharedShape::capsule(*start, *end, *radius), lever, lever + radius, None)
                     }
                     ProxyShape::ConvexHull { points, triangles } => {
                         let extent = points.iter().map(|q| q.length()).fold(0.0, f32::max);
                         let shape = SharedShape::convex_mesh(points.clone(), triangles)?;
                         let hull = shape.as_convex_polyhedron().map(|h| HullSupport::new(h, 1.0));
-                        let simulated = simulated_hull(points).unwrap_or_else(|| shape.clone());
-                        (shape, simulated, extent, extent, hull)
+                        (shape, extent, extent, hull)
                     }
                 };
                 let local_aabb = shape.compute_local_aabb();
-                Some(ProxyCollider { joint: p.joint, shape, simulated, part: HandPart::of(&joints[p.joint].name), extent, lever, hull, local_aabb })
+                Some(ProxyCollider { joint: p.joint, shape, part: HandPart::of(&joints[p.joint].name), extent, lever, hull, local_aabb })
             })
             .collect();
         Self { colliders }

@@ -9,7 +9,7 @@
 //!   impact), its own rather than parry's, whose GJK in metres is centimetres off there;
 //!   a hull proxy's support points by hill climbing (`hull_support`), which parry's casts
 //!   between hulls take through a dispatcher of their own (`support_pair`).
-//! * `simulated_hull` — what the physics simulates a hull proxy as: fewer vertices, rounded
+//! * [`simulated_hull`] — what the physics simulates a hull proxy as: fewer vertices, rounded
 //!   to hold the whole proxy.
 //! * [`TriangleTree`] — a mesh object's triangles in a tree of its own, built once, which
 //!   those queries search.
@@ -29,4 +29,5 @@ pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
 pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};
 pub use proxy_mesh_query::{MeshNearest, ProxyMeshQuery};
+pub use simulated_hull::simulated_hull;
 pub use triangle_tree::{TreeNode, TreeTriangle, TriangleTree};

@@ -103,7 +103,8 @@ impl ObjectCollider {
     }
 
     /// The distance from `proxy` at `pose` to the surface, or a lower bound of it above
-    /// `enough` (m): the distance to the [`Self::hull`] when that is larger.
+    /// `enough` (m): the distance to the [`Self::hull`], or a box's face-plane gap, when that
+    /// is larger.
     #[must_use]
     pub fn distance_at_least(&self, pose: &Pose, proxy: &ProxyCollider, enough: f32) -> f32 {
         match self.hull_distance(pose, proxy).or_else(|| self.box_gap(pose, proxy)) {

@@ -6,8 +6,9 @@ use rapier3d::pipeline::PhysicsWorld;
 use parry3d::math::Pose;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::ShapeCastOptions;
+use parry3d::shape::SharedShape;
 
-use crate::collision::{pose_of, HandPart, HandProxies, ObjectColliders};
+use crate::collision::{pose_of, simulated_hull, HandPart, HandProxies, ObjectColliders};
 use crate::scene::Scene;
 
 /// Gravity, m/s² along −Y.
@@ -58,6 +59,11 @@ impl PhysicsHooks for LetGo {
         let pair = |a, b| self.pairs.iter().any(|p| (p.0, p.1) == (a, b));
         (!pair(c.collider1, c.collider2) && !pair(c.collider2, c.collider1)).then(SolverFlags::default)
     }
+}
+
+/// The shape rapier simulates for a hand proxy: a hull's [`simulated_hull`], a capsule itself.
+fn simulated(shape: &SharedShape) -> SharedShape {
+    shape.as_convex_polyhedron().and_then(|hull| simulated_hull(hull.points())).unwrap_or_else(|| shape.clone())
 }
 
 /// Whether hand proxy `proxy` is in the way of object `object` settling from the hand: within
@@ -177,16 +183,16 @@ impl ScenePhysics {
         Self { world, held: vec![false; bodies.len()], bodies, colliders: handles, let_go, initial, hands: Vec::new(), returned, floor, reach }
     }
 
-    /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves (as their
-    /// [`ProxyCollider::simulated`](crate::collision::ProxyCollider::simulated) shapes, which
-    /// hold them with fewer vertices); returns its index there.
+    /// Adds a hand: `proxies` as kinematic bodies that [`Self::move_hand`] moves, a hull as its
+    /// [`simulated_hull`] (which holds it with fewer vertices; the hull itself where that has
+    /// none); returns its index there.
     pub fn add_hand(&mut self, proxies: &HandProxies) -> usize {
         let hand = proxies
             .colliders()
             .iter()
             .map(|p| {
                 let body = RigidBodyBuilder::kinematic_position_based().build();
-                let (body, collider) = self.world.insert(body, ColliderBuilder::new(p.simulated.clone()).build());
+                let (body, collider) = self.world.insert(body, ColliderBuilder::new(simulated(&p.shape)).build());
                 ProxyBody { body, collider, joint: p.joint, palm: p.part == HandPart::Palm }
             })
             .collect();
