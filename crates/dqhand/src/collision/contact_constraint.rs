@@ -251,7 +251,7 @@ impl ContactConstraint {
             FingerChain { dofs, others, joints: subtree, turns, proxies, reach, bounds }
         });
         let n = skeleton.len();
-        let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.dofs.first().is_some_and(|&(_, root)| is_ancestor(root, j)))).collect();
+        let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.joints.contains(&j))).collect();
         Self {
             mesh_query: ProxyMeshQuery::new(&proxies),
             first_stop: 0,

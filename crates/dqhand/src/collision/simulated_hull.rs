@@ -4,10 +4,11 @@
 //! A hull proxy is the hull of every skin vertex its joint carries (957 vertices on the built-in
 //! hand's wrist). rapier transforms every one of them for the collider's box twice a step, and
 //! its contacts try every one for each support point: a fifth of the manipulation loop's time
-//! on the teapot, measured by `perf`. The vertices that are extreme along [`DIRECTIONS`] spread directions keep the
-//! shape; the rounding (parry's round convex polyhedron, which rapier's contacts handle as
-//! they do a polyhedron, faces and all) makes it no smaller anywhere, so an object pushed by
-//! the simulated hand is never pushed into the hand the contact constraint sees.
+//! on the teapot, measured by `perf`. A few hundred vertices at most keep the shape to a
+//! quarter of a millimetre; the rounding (parry's round convex polyhedron, which rapier's
+//! contacts handle as they do a polyhedron, faces and all) makes it no smaller anywhere, so an
+//! object pushed by the simulated hand is never pushed into the hand the contact constraint
+//! sees.
 
 use glam::Vec3;
 use parry3d::query::PointQuery;
@@ -20,10 +21,6 @@ const DIRECTIONS: usize = 32;
 /// faces' planes (m).
 const OUTSIDE_M: f32 = 2.5e-4;
 
-/// How far parry's polyhedron of a hull may lie outside the hull's own faces (m): it merges
-/// nearly coplanar ones (4.7 µm measured on the built-in hand's wrist).
-const MERGED_M: f32 = 2e-5;
-
 /// How many vertices are added to the simulated hull at a time: one at a time keeps fewest
 /// (each the farthest out), but builds a hull for each (0.3 s for the wrist's).
 const BATCH: usize = 16;
@@ -34,8 +31,8 @@ const MAX_VERTICES: usize = 256;
 /// The simulated shape of the hull of `points` (a proxy's vertices, m): the hull of the
 /// vertices extreme along [`DIRECTIONS`] directions, grown by each face's farthest vertex
 /// outside it ([`BATCH`] at a time, the farthest first) until none is [`OUTSIDE_M`] outside
-/// (or it has [`MAX_VERTICES`]), rounded by the largest distance of any of `points` from it
-/// and [`MERGED_M`]. `None` where `points` span no volume or are not all finite.
+/// (or it has [`MAX_VERTICES`]), rounded by the largest distance of any of `points` from it.
+/// `None` where `points` span no volume or are not all finite.
 #[must_use]
 pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
     if !points.iter().all(|p| p.is_finite()) {
@@ -48,13 +45,17 @@ pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
     kept.dedup();
     loop {
         let (vertices, faces) = parry3d::transformation::try_convex_hull(&kept).ok()?;
-        let triangles: Vec<Triangle> = faces.iter().map(|&[a, b, c]| Triangle::new(vertices[a as usize], vertices[b as usize], vertices[c as usize])).collect();
-        let planes: Vec<(Vec3, f32)> = triangles.iter().filter_map(|t| t.normal().map(|n| (n, n.dot(t.a)))).collect();
-        // Per face (the hull's faces turn outward), the point farthest above its plane, if
-        // more than [`OUTSIDE_M`]: quickhull's next points, the [`BATCH`] farthest at once.
+        // Each face (they turn outward) and its unit normal; a degenerate one has none, and its
+        // neighbours hold it.
+        let planes: Vec<(Triangle, Vec3)> = faces.iter().filter_map(|&[a, b, c]| {
+            let t = Triangle::new(vertices[a as usize], vertices[b as usize], vertices[c as usize]);
+            t.normal().map(|n| (t, n))
+        }).collect();
+        // Per face, the point farthest above its plane, if more than [`OUTSIDE_M`]: quickhull's
+        // next points, the [`BATCH`] farthest at once.
         let mut farthest: Vec<(f32, Vec3)> = vec![(OUTSIDE_M, Vec3::ZERO); planes.len()];
         for &p in points {
-            let (face, by) = planes.iter().map(|&(n, d)| n.dot(p) - d).enumerate().max_by(|a, b| a.1.total_cmp(&b.1))?;
+            let (face, by) = planes.iter().map(|(t, n)| n.dot(p - t.a)).enumerate().max_by(|a, b| a.1.total_cmp(&b.1))?;
             if by > farthest[face].0 {
                 farthest[face] = (by, p);
             }
@@ -67,11 +68,12 @@ pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
             continue;
         }
         // Each point's distance: an outside point's nearest point of the hull is on a face
-        // whose plane it is above. parry's polyhedron of the hull merges nearly coplanar
-        // faces, which moves the surface by up to a few micrometres: [`MERGED_M`] more.
-        let distance = |p: Vec3| triangles.iter().filter(|t| t.normal().is_some_and(|n| n.dot(p - t.a) > 0.0)).map(|t| t.distance_to_local_point(p, true)).reduce(f32::min).unwrap_or(0.0);
+        // whose plane it is above. (The shape is the hull of these vertices: parry's
+        // polyhedron of it merges nearly coplanar faces, and its support points, which GJK
+        // asks, are its vertices'.)
+        let distance = |p: Vec3| planes.iter().filter(|(t, n)| n.dot(p - t.a) > 0.0).map(|(t, _)| t.distance_to_local_point(p, true)).reduce(f32::min).unwrap_or(0.0);
         let outside = points.iter().map(|&p| distance(p)).fold(0.0, f32::max);
-        return SharedShape::round_convex_mesh(vertices, &faces, outside + MERGED_M);
+        return SharedShape::round_convex_mesh(vertices, &faces, outside);
     }
 }
 
@@ -91,20 +93,35 @@ mod tests {
     use super::*;
     use crate::collision::{fit_proxies, ProxyShape, PROXY_MARGIN};
 
+    /// On the built-in hand's proxies and on the WebXR generic hand's (a mesh the project did
+    /// not make: `DQHAND_WEBXR_HAND`, else the npm asset `make test` installs).
     #[test]
     fn the_simulated_hull_holds_the_proxy_and_is_little_larger() {
-        let model = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
+        let path = std::env::var_os("DQHAND_WEBXR_HAND").map_or_else(
+            || std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"),
+            std::path::PathBuf::from,
+        );
+        assert!(path.is_file(), "the WebXR generic hand {} is missing: run `make test`, or set DQHAND_WEBXR_HAND", path.display());
+        let generic = crate::io::load_gltf(&path).expect("the WebXR generic hand loads");
+        let builtin = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
+        for model in [builtin, generic] {
+            holds_the_proxy_and_is_little_larger(&model);
+        }
+    }
+
+    fn holds_the_proxy_and_is_little_larger(model: &crate::model::Model) {
         let mut hulls = 0;
-        for proxy in fit_proxies(&model, PROXY_MARGIN) {
+        for proxy in fit_proxies(model, PROXY_MARGIN) {
             let ProxyShape::ConvexHull { points, .. } = &proxy.shape else { continue };
             hulls += 1;
             let simulated = simulated_hull(points).expect("a hull spans a volume");
             let simulated = &*simulated;
             let round = simulated.as_round_convex_polyhedron().expect("a rounded hull");
             let radius = round.border_radius;
-            // Every vertex of the proxy is in it: no farther from the inner hull than the
-            // rounding (inside every face's plane, or near enough to some face).
-            let (vertices, faces) = round.inner_shape.to_trimesh();
+            // Every vertex of the proxy is in it: no farther from the inner hull (the hull of
+            // its vertices, built again here) than the rounding (inside every face's plane, or
+            // near enough to some face).
+            let (vertices, faces) = parry3d::transformation::try_convex_hull(round.inner_shape.points()).expect("a hull");
             let faces: Vec<Triangle> = faces.iter().map(|f| Triangle::new(vertices[f[0] as usize], vertices[f[1] as usize], vertices[f[2] as usize])).collect();
             let inside = |p: Vec3| faces.iter().all(|t| t.normal().is_some_and(|n| n.dot(p - t.a) <= 1e-7));
             let gap = |p: Vec3| if inside(p) { 0.0 } else { faces.iter().map(|t| t.distance_to_local_point(p, true)).fold(f32::MAX, f32::min) };
