@@ -3,6 +3,8 @@
 //! of joints with dense weight vectors, where the engine sums per pair over the triangles
 //! sharing it.
 
+mod support;
+
 use dqhand::glam::{Affine3A, DVec3, Vec3};
 use dqhand::skin::{centres_of_rotation, MeshData, SkinnedMesh, SIMILARITY_SIGMA};
 
@@ -115,20 +117,9 @@ fn centres_given_with_a_mesh_are_kept_and_bad_ones_are_refused() {
     assert!(bad.contains("vertex 7 has a non-finite centre of rotation"), "{bad}");
 }
 
-/// The WebXR generic right hand (a mesh the project did not make): `DQHAND_WEBXR_HAND`, else
-/// the npm asset under third_party/ (`make test` installs it).
-fn webxr_hand() -> dqhand::model::Model {
-    let path = std::env::var_os("DQHAND_WEBXR_HAND").map_or_else(
-        || std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"),
-        std::path::PathBuf::from,
-    );
-    assert!(path.is_file(), "the WebXR generic hand {} is missing: run `make test`, or set DQHAND_WEBXR_HAND", path.display());
-    dqhand::io::load_gltf(&path).expect("the WebXR generic hand loads")
-}
-
 #[test]
 fn on_the_webxr_generic_hand_the_centres_are_the_definitions() {
-    let model = webxr_hand();
+    let model = support::webxr_hand();
     let mesh = &model.mesh;
     // The same mesh as plain data for the reference: positions, triangles, weights.
     let n = mesh.vertex_count();

@@ -29,5 +29,5 @@ pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
 pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};
 pub use proxy_mesh_query::{MeshNearest, ProxyMeshQuery};
-pub use simulated_hull::simulated_hull;
+pub use simulated_hull::{simulated_hull, MAX_SIMULATED_VERTICES};
 pub use triangle_tree::{TreeNode, TreeTriangle, TriangleTree};

@@ -26,12 +26,12 @@ const OUTSIDE_M: f32 = 2.5e-4;
 const BATCH: usize = 16;
 
 /// The most vertices the simulated hull keeps.
-const MAX_VERTICES: usize = 256;
+pub const MAX_SIMULATED_VERTICES: usize = 256;
 
 /// The simulated shape of the hull of `points` (a proxy's vertices, m): the hull of the
 /// vertices extreme along [`DIRECTIONS`] directions, grown by each face's farthest vertex
 /// outside it ([`BATCH`] at a time, the farthest first) until none is [`OUTSIDE_M`] outside
-/// (or it has [`MAX_VERTICES`]), rounded by the largest distance of any of `points` from it.
+/// (or it has [`MAX_SIMULATED_VERTICES`]), rounded by the largest distance of any of `points` from it.
 /// `None` where `points` span no volume or are not all finite.
 #[must_use]
 pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
@@ -61,9 +61,9 @@ pub fn simulated_hull(points: &[Vec3]) -> Option<SharedShape> {
             }
         }
         let mut due: Vec<(f32, Vec3)> = farthest.into_iter().filter(|&(by, _)| by > OUTSIDE_M).collect();
-        if !due.is_empty() && kept.len() < MAX_VERTICES {
+        if !due.is_empty() && kept.len() < MAX_SIMULATED_VERTICES {
             due.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let room = (MAX_VERTICES - kept.len()).min(BATCH);
+            let room = (MAX_SIMULATED_VERTICES - kept.len()).min(BATCH);
             kept.extend(due.iter().take(room).map(|&(_, p)| p));
             continue;
         }
@@ -86,58 +86,4 @@ fn fibonacci_sphere(n: usize) -> impl Iterator<Item = Vec3> {
         let a = turn * i as f32;
         Vec3::new(r * a.cos(), y, r * a.sin())
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::collision::{fit_proxies, ProxyShape, PROXY_MARGIN};
-
-    /// On the built-in hand's proxies and on the WebXR generic hand's (a mesh the project did
-    /// not make: `DQHAND_WEBXR_HAND`, else the npm asset `make test` installs).
-    #[test]
-    fn the_simulated_hull_holds_the_proxy_and_is_little_larger() {
-        let path = std::env::var_os("DQHAND_WEBXR_HAND").map_or_else(
-            || std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"),
-            std::path::PathBuf::from,
-        );
-        assert!(path.is_file(), "the WebXR generic hand {} is missing: run `make test`, or set DQHAND_WEBXR_HAND", path.display());
-        let generic = crate::io::load_gltf(&path).expect("the WebXR generic hand loads");
-        let builtin = crate::hand::build(&crate::hand::HandParams::default()).expect("the built-in hand");
-        for model in [builtin, generic] {
-            holds_the_proxy_and_is_little_larger(&model);
-        }
-    }
-
-    fn holds_the_proxy_and_is_little_larger(model: &crate::model::Model) {
-        let mut hulls = 0;
-        for proxy in fit_proxies(model, PROXY_MARGIN) {
-            let ProxyShape::ConvexHull { points, .. } = &proxy.shape else { continue };
-            hulls += 1;
-            let simulated = simulated_hull(points).expect("a hull spans a volume");
-            let simulated = &*simulated;
-            let round = simulated.as_round_convex_polyhedron().expect("a rounded hull");
-            let radius = round.border_radius;
-            // Every vertex of the proxy is in it: no farther from the inner hull (the hull of
-            // its vertices, built again here) than the rounding (inside every face's plane, or
-            // near enough to some face).
-            let (vertices, faces) = parry3d::transformation::try_convex_hull(round.inner_shape.points()).expect("a hull");
-            let faces: Vec<Triangle> = faces.iter().map(|f| Triangle::new(vertices[f[0] as usize], vertices[f[1] as usize], vertices[f[2] as usize])).collect();
-            let inside = |p: Vec3| faces.iter().all(|t| t.normal().is_some_and(|n| n.dot(p - t.a) <= 1e-7));
-            let gap = |p: Vec3| if inside(p) { 0.0 } else { faces.iter().map(|t| t.distance_to_local_point(p, true)).fold(f32::MAX, f32::min) };
-            let outside = points.iter().map(|&p| gap(p) - radius).fold(f32::MIN, f32::max);
-            // How much larger it is: its reach past the proxy's along many directions.
-            let larger = fibonacci_sphere(500)
-                .map(|u| {
-                    let reach = |q: &[Vec3]| q.iter().map(|p| p.dot(u)).fold(f32::MIN, f32::max);
-                    reach(round.inner_shape.points()) + radius - reach(points)
-                })
-                .fold(0.0, f32::max);
-            eprintln!("joint {}: {} -> {} vertices, rounded {:.3} mm, at most {:.3} mm larger", proxy.joint, points.len(), round.inner_shape.points().len(), radius * 1e3, larger * 1e3);
-            assert!(outside <= 1e-6, "joint {}: a vertex {outside} m outside", proxy.joint);
-            assert!(round.inner_shape.points().len() <= MAX_VERTICES);
-            assert!(larger <= 3e-4, "joint {}: {larger} m larger", proxy.joint);
-        }
-        assert!(hulls >= 5, "{hulls} hulls");
-    }
 }

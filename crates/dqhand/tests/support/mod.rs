@@ -6,6 +6,17 @@ use proptest::prelude::*;
 
 pub mod kernels;
 
+/// The WebXR generic right hand (a mesh the project did not make): `DQHAND_WEBXR_HAND`, else
+/// the npm asset under third_party/ (`make test` installs it).
+pub fn webxr_hand() -> dqhand::model::Model {
+    let path = std::env::var_os("DQHAND_WEBXR_HAND").map_or_else(
+        || std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../third_party/node_modules/@webxr-input-profiles/assets/dist/profiles/generic-hand/right.glb"),
+        std::path::PathBuf::from,
+    );
+    assert!(path.is_file(), "the WebXR generic hand {} is missing: run `make test`, or set DQHAND_WEBXR_HAND", path.display());
+    dqhand::io::load_gltf(&path).expect("the WebXR generic hand loads")
+}
+
 /// Asserts `|a - b| <= tol` for anything with a distance, printing both values, the
 /// tolerance and the difference (and, after them, a message formatted from the rest).
 #[macro_export]
