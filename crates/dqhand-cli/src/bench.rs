@@ -66,6 +66,9 @@ enum Runner {
     Plain(Box<PlainSoaKernel>, Vec<[f32; 3]>, Vec<[f32; 3]>),
 }
 
+/// Frames per block of the back-to-back thread timing.
+const BACK_TO_BACK: usize = 50;
+
 /// The plain kernel's name in the report.
 const PLAIN: &str = "avx512-plain";
 
@@ -179,6 +182,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             std::hint::black_box(v.positions());
         }
     }
+    // The thread variants again, each frame right after the last (a tight loop, where a
+    // crew's helpers stay awake), in blocks that alternate between the variants; the
+    // interleaved loop above came to each one ~n variants apart, after its helpers parked.
+    let streamed: Vec<usize> = (0..n).filter(|&i| matches!(variants[i].runner, Runner::Engine(..)) && variants[i].method == Method::Dqb && variants[i].kernel == best.name() && variants[i].strategy.is_none()).collect();
+    let mut back_to_back: Vec<Vec<f64>> = vec![Vec::with_capacity(args.frames); streamed.len()];
+    for block in 0..args.frames.div_ceil(BACK_TO_BACK) {
+        for (samples, &i) in back_to_back.iter_mut().zip(&streamed) {
+            for f in block * BACK_TO_BACK..((block + 1) * BACK_TO_BACK).min(args.frames) {
+                animation.pose(f);
+                samples.push(variants[i].time(mesh, animation.skinning()));
+            }
+        }
+    }
+    let back_to_back: Vec<serde_json::Value> = streamed
+        .iter()
+        .zip(&mut back_to_back)
+        .map(|(&i, samples)| json!({ "threads": variants[i].threads, "normals": variants[i].normals, "us_per_frame": percentile(samples, 0.5), "p90_us": percentile(samples, 0.9) }))
+        .collect();
     let rows: Vec<serde_json::Value> = variants
         .iter_mut()
         .map(|v| {
@@ -227,6 +248,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "machine": { "l2_read_bytes_per_s": machine.l2_read_bytes_per_s, "l2_write_bytes_per_s": machine.l2_write_bytes_per_s, "peak_flops": machine.peak_flops, "vector_bits": machine.vector_bits },
         "roofline": roofline,
         "variants": rows,
+        "threads_back_to_back": back_to_back,
+        "crew_wake": crews.iter().map(|(t, c)| json!({ "threads": t, "join_us": c.wake_costs().map(|(j, _)| j.as_secs_f64() * 1e6), "wake_call_us": c.wake_costs().map(|(_, w)| w.as_secs_f64() * 1e6) })).collect::<Vec<_>>(),
     });
     if args.json {
         println!("{report}");
@@ -299,11 +322,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         print!(", {r:.2}× the straightforward kernel (≤ 0.75: {})", met(r <= 0.75));
     }
     println!(", LB/DQB {:.2} (≤ 1: {})", table3(Method::Lb) / table3(Method::Dqb), met(table3(Method::Lb) <= table3(Method::Dqb)));
-    println!("\nthreads: DQB, {} kernel ({cores} cores here)", best.name());
-    println!("{:<8} {:>18} {:>8} {:>18} {:>8}", "threads", "positions+normals", "speed-up", "positions only", "speed-up");
+    println!("\nthreads: DQB, {} kernel ({cores} cores here); interleaved as above (a crew's helpers park between frames), and back to back", best.name());
+    println!("{:<8} {:>18} {:>8} {:>18} {:>8} | {:>18} {:>8} {:>18} {:>8}", "threads", "positions+normals", "speed-up", "positions only", "speed-up", "positions+normals", "speed-up", "positions only", "speed-up");
+    let streamed_us = |t: usize, normals: bool| stat(back_to_back.iter().find(|r| r["threads"] == t && r["normals"] == normals).expect("a streamed variant"), "us_per_frame");
     for t in std::iter::once(1).chain(threads.iter().copied()) {
         let (a, b) = (us(Method::Dqb, best, t, true), us(Method::Dqb, best, t, false));
-        println!("{t:<8} {a:>18.1} {:>8.2} {b:>18.1} {:>8.2}", us(Method::Dqb, best, 1, true) / a, us(Method::Dqb, best, 1, false) / b);
+        let (c, d) = (streamed_us(t, true), streamed_us(t, false));
+        print!("{t:<8} {a:>18.1} {:>8.2} {b:>18.1} {:>8.2}", us(Method::Dqb, best, 1, true) / a, us(Method::Dqb, best, 1, false) / b);
+        println!(" | {c:>18.1} {:>8.2} {d:>18.1} {:>8.2}", streamed_us(1, true) / c, streamed_us(1, false) / d);
+    }
+    for (t, crew) in &crews {
+        match crew.wake_costs() {
+            Some((join, wake)) => println!("{t} threads: waking a parked helper took the caller {:.1} µs, and the helper ran {:.1} µs after it (medians): shorter jobs run without waking it", wake.as_secs_f64() * 1e6, join.as_secs_f64() * 1e6),
+            None => println!("{t} threads: no parked helper was woken often enough to measure"),
+        }
     }
     Ok(())
 }

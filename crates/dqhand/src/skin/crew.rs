@@ -8,9 +8,17 @@
 //! finds nothing left. Each thread has a home range of the pieces, which it claims first and
 //! the others only once theirs are done, so a thread deforms the same vertices frame after
 //! frame, from its own cache, when all are awake. Allocates nothing per job.
+//!
+//! Waking a parked helper is not free either: on the 2-core Intel Xeon VM of
+//! docs/performance.md the wake call alone took the caller 15 µs (an interrupt to a halted
+//! virtual CPU), and the helper joined later still, so a 16 µs frame woken into took 32.
+//! So the caller times the job's first piece and wakes parked helpers only where the work
+//! left outlasts what waking them costs, as measured on this crew's earlier wakes
+//! ([`worth_waking`]), or where jobs come in a stream (the last two each began within the
+//! spin of the one before), which a woken helper then stays awake for.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering::*};
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering::*};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -35,19 +43,75 @@ impl Job<'_> {
         r * self.pieces / n..(r + 1) * self.pieces / n
     }
 
-    /// Claims and runs pieces, from thread `home`'s range on, until none is left.
-    fn work(&self, home: usize) {
+    /// Claims and runs pieces, from thread `home`'s range on, until none is left or
+    /// `limit` have run; returns how many ran.
+    fn work(&self, home: usize, limit: usize) -> usize {
         let n = self.cursors.len();
+        let mut ran = 0;
         for r in (home..n).chain(0..home) {
             let range = self.range(r);
-            loop {
+            while ran < limit {
                 let i = range.start + self.cursors[r].0.fetch_add(1, Relaxed);
                 if i >= range.end {
                     break;
                 }
                 (self.f)(i);
+                ran += 1;
             }
         }
+        ran
+    }
+
+    /// Pieces no thread has claimed yet.
+    fn unclaimed(&self) -> usize {
+        (0..self.cursors.len()).map(|r| self.range(r).len().saturating_sub(self.cursors[r].0.load(Relaxed))).sum()
+    }
+}
+
+/// Whether waking `parked` helpers shortens a job that has `left` of one thread's work still
+/// unclaimed, which `awake` threads (the caller's included) are working on, when a woken
+/// helper joins `join` after the wake and the wake costs the caller `wake`.
+///
+/// Without waking the job ends after `left / awake`. Waking, by the time the helpers join
+/// the awake threads have done `awake · join − wake` of it, and all `awake + parked` share
+/// the rest.
+fn worth_waking(left: Duration, awake: usize, parked: usize, join: Duration, wake: Duration) -> bool {
+    let (r, a, h) = (left.as_secs_f64(), awake.max(1) as f64, parked as f64);
+    let (l, c) = (join.as_secs_f64(), wake.as_secs_f64());
+    l + (r - a * l + c).max(0.0) / (a + h) < r / a
+}
+
+/// The last [`WakeCosts::SAMPLES`] measurements of waking a parked helper: the caller's wake
+/// call and the time from it until a helper was running. Medians, since a wake that met a
+/// descheduled virtual CPU can take a thousand times the usual.
+#[derive(Default)]
+struct WakeCosts {
+    join: [Duration; Self::SAMPLES],
+    wake: [Duration; Self::SAMPLES],
+    /// Samples taken of each (the rings' next slot, modulo their length).
+    joins: usize,
+    wakes: usize,
+}
+
+impl WakeCosts {
+    const SAMPLES: usize = 8;
+    /// Wakes measured before their medians decide (until then the caller always wakes).
+    const TRUSTED: usize = 3;
+
+    fn median(ring: &[Duration], taken: usize) -> Option<Duration> {
+        if taken < Self::TRUSTED {
+            return None;
+        }
+        let mut v = [Duration::ZERO; Self::SAMPLES];
+        let v = &mut v[..taken.min(Self::SAMPLES)];
+        v.copy_from_slice(&ring[..v.len()]);
+        v.sort_unstable();
+        Some(v[v.len() / 2])
+    }
+
+    /// The median join and wake times, once both are measured.
+    fn medians(&self) -> Option<(Duration, Duration)> {
+        Some((Self::median(&self.join, self.joins)?, Self::median(&self.wake, self.wakes)?))
     }
 }
 
@@ -70,8 +134,22 @@ struct Shared {
     /// Set if a piece panicked on a helper.
     poisoned: AtomicBool,
     spin: Duration,
+    /// When the crew started: the origin of `woken_at`.
+    origin: Instant,
+    /// Nanoseconds from `origin` to the caller's last wake call.
+    woken_at: AtomicU64,
+    /// When the last two jobs were offered (nanoseconds from `origin`, the latest first).
+    offered_at: [AtomicU64; 2],
+    costs: Mutex<WakeCosts>,
     /// The job's cursors, one per thread (the caller's first), reset by each caller.
     cursors: Box<[Cursor]>,
+}
+
+impl Shared {
+    /// Nanoseconds since `origin`.
+    fn nanos(&self) -> u64 {
+        u64::try_from(self.origin.elapsed().as_nanos()).unwrap_or(u64::MAX)
+    }
 }
 
 /// A crew of `threads − 1` helper threads, started once; see the module docs.
@@ -108,6 +186,10 @@ impl Crew {
             stop: AtomicBool::new(false),
             poisoned: AtomicBool::new(false),
             spin,
+            origin: Instant::now(),
+            woken_at: AtomicU64::new(0),
+            offered_at: [AtomicU64::new(0), AtomicU64::new(0)],
+            costs: Mutex::new(WakeCosts::default()),
             cursors: (0..threads.max(1)).map(|_| Cursor(AtomicUsize::new(0))).collect(),
         });
         let helpers = (1..threads.max(1))
@@ -125,8 +207,17 @@ impl Crew {
         self.helpers.len() + 1
     }
 
+    /// What waking a parked helper has cost in this crew, as medians of its last wakes: the
+    /// time from the wake until the helper ran, and the wake call on the caller. `None` until
+    /// measured.
+    #[must_use]
+    pub fn wake_costs(&self) -> Option<(Duration, Duration)> {
+        self.shared.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).medians()
+    }
+
     /// Runs `f(0)` … `f(pieces − 1)`, each once, on the calling thread and any helpers that
-    /// are awake or wake in time; returns when all have run.
+    /// are awake or wake in time; returns when all have run. Parked helpers are woken only
+    /// where the job's first piece, timed, says the rest outlasts waking them.
     ///
     /// # Panics
     /// If a piece panicked on a helper (a piece that panics on the caller unwinds as usual,
@@ -160,13 +251,44 @@ impl Crew {
         // `Withdraw` waits for those to finish before `job` goes out of scope.
         s.epoch.fetch_add(1, SeqCst);
         s.job.store((&raw const job).cast_mut().cast(), SeqCst);
-        if s.parked.load(SeqCst) > 0 {
+        // Only one caller at a time gets here (`busy`), so these need no more than Relaxed.
+        let now = s.nanos();
+        let previous = s.offered_at.each_ref().map(|t| t.load(Relaxed));
+        s.offered_at[1].store(previous[0], Relaxed);
+        s.offered_at[0].store(now, Relaxed);
+        let spin = u64::try_from(s.spin.as_nanos()).unwrap_or(u64::MAX);
+        let stream = previous[1] > 0 && now - previous[0] < spin && previous[0] - previous[1] < spin;
+        let parked = s.parked.load(SeqCst);
+        if parked > 0 && stream {
+            self.wake();
+        } else if parked > 0 {
+            let start = Instant::now();
+            let ran = job.work(0, 1);
+            let left = start.elapsed() * u32::try_from(job.unclaimed()).unwrap_or(u32::MAX);
+            let costs = s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).medians();
+            let awake = self.threads() - parked;
+            if ran == 1 && costs.is_none_or(|(join, wake)| worth_waking(left, awake, parked, join, wake)) {
+                self.wake();
+            }
+        }
+        job.work(0, usize::MAX);
+        drop(withdraw);
+        assert!(!s.poisoned.load(Acquire), "a crew thread panicked");
+    }
+
+    /// Wakes the parked helpers, timing the call.
+    fn wake(&self) {
+        let s = &*self.shared;
+        let start = Instant::now();
+        s.woken_at.store(s.nanos(), SeqCst);
+        {
             let _guard = s.lock.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
             s.wake.notify_all();
         }
-        job.work(0);
-        drop(withdraw);
-        assert!(!s.poisoned.load(Acquire), "a crew thread panicked");
+        let took = start.elapsed();
+        let mut costs = s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let i = costs.wakes % WakeCosts::SAMPLES;
+        (costs.wake[i], costs.wakes) = (took, costs.wakes + 1);
     }
 }
 
@@ -199,10 +321,19 @@ fn helper(home: usize, s: &Shared) {
             // Counted before looking: a caller that has seen no helper parked has already
             // offered its job, so this look finds it.
             s.parked.fetch_add(1, SeqCst);
+            let mut waited = false;
             while !offered(seen) && !s.stop.load(SeqCst) {
                 guard = s.wake.wait(guard).unwrap_or_else(std::sync::PoisonError::into_inner);
+                waited = true;
             }
             s.parked.fetch_sub(1, SeqCst);
+            drop(guard);
+            if waited {
+                let woken = s.origin + Duration::from_nanos(s.woken_at.load(SeqCst));
+                let mut costs = s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                let i = costs.joins % WakeCosts::SAMPLES;
+                (costs.join[i], costs.joins) = (woken.elapsed(), costs.joins + 1);
+            }
             continue;
         }
         // Counted before the job is read again: a caller that has seen no helper active has
@@ -215,7 +346,7 @@ fn helper(home: usize, s: &Shared) {
             // still waiting in `Withdraw` and the job is alive.
             let job = unsafe { &*job };
             // A panicking piece is the caller's to report; the helper stays for the next job.
-            if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work(home))).is_err() {
+            if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work(home, usize::MAX))).is_err() {
                 s.poisoned.store(true, Release);
             }
         }
@@ -260,10 +391,58 @@ mod tests {
         let order = Mutex::new(Vec::new());
         let job = Job { f: &|i| order.lock().unwrap().push(i), pieces: 10, cursors: &cursors };
         assert_eq!([0, 1, 2].map(|r| job.range(r)), [0..3, 3..6, 6..10]);
-        job.work(1);
+        assert_eq!(job.work(1, 2), 2);
+        assert_eq!(job.unclaimed(), 8);
+        assert_eq!(job.work(1, usize::MAX), 8);
         assert_eq!(*order.lock().unwrap(), [3, 4, 5, 6, 7, 8, 9, 0, 1, 2]);
-        job.work(0);
+        assert_eq!(job.unclaimed(), 0);
+        job.work(0, usize::MAX);
         assert_eq!(order.lock().unwrap().len(), 10, "nothing left for a second thread");
+    }
+
+    #[test]
+    fn waking_pays_only_for_work_that_outlasts_it() {
+        let us = Duration::from_micros;
+        // One thread awake, one parked, joining 40 µs after a wake that costs 15 µs.
+        assert!(!worth_waking(us(16), 1, 1, us(40), us(15)));
+        assert!(!worth_waking(us(45), 1, 1, us(40), us(15)));
+        assert!(worth_waking(us(100), 1, 1, us(40), us(15)));
+        // Alone it would end at 60 µs; woken, at 40 + (60 − 40 + 15) / 2 = 57.5 µs.
+        assert!(worth_waking(us(60), 1, 1, us(40), us(15)));
+        assert!(!worth_waking(us(50), 1, 1, us(40), us(15)));
+        // Three awake already gain less from a fourth.
+        assert!(!worth_waking(us(150), 3, 1, us(40), us(15)));
+        // Free and instant wakes always pay.
+        assert!(worth_waking(us(1), 1, 3, Duration::ZERO, Duration::ZERO));
+    }
+
+    /// Helpers that park after every job are woken for long jobs, and, once the wakes are
+    /// measured, not for jobs far shorter than a wake.
+    #[test]
+    fn parked_helpers_are_woken_for_long_jobs_only() {
+        let crew = Crew::new(2, Duration::ZERO).unwrap();
+        let caller = std::thread::current().id();
+        let elsewhere = AtomicUsize::new(0);
+        for _ in 0..40 {
+            std::thread::sleep(Duration::from_millis(1));
+            crew.run(8, &|_| {
+                if std::thread::current().id() != caller {
+                    elsewhere.fetch_add(1, Relaxed);
+                }
+                std::thread::sleep(Duration::from_micros(300));
+            });
+        }
+        assert!(elsewhere.load(Relaxed) > 0, "no piece of a long job ran on the helper");
+        assert!(crew.wake_costs().is_some(), "wakes measured");
+        let wakes = |crew: &Crew| crew.shared.costs.lock().unwrap().wakes;
+        let before = wakes(&crew);
+        for _ in 0..100 {
+            std::thread::sleep(Duration::from_micros(500));
+            each_piece_once(&crew, 1, 8);
+        }
+        // A piece descheduled for a millisecond can still justify a wake; without the
+        // measurement every one of these jobs would wake the helper.
+        assert!(wakes(&crew) - before <= 10, "{} of 100 jobs of instant pieces woke the helper", wakes(&crew) - before);
     }
 
     #[test]
