@@ -242,6 +242,18 @@ fn bench_json_reports_every_method() {
     for key in ["l2_read_bytes_per_s", "l2_write_bytes_per_s", "peak_flops"] {
         positive_number(&report, &format!("/machine/{key}"));
     }
+    // The thread variants timed back to back besides interleaved: one thread and each count
+    // timed, with and without normals.
+    let streamed = report["threads_back_to_back"].as_array().expect("back-to-back thread rows");
+    let counts: Vec<u64> = report["variants"].as_array().expect("variants").iter().filter_map(|v| v["threads"].as_u64()).collect();
+    assert_eq!(streamed.len(), 2 * (1 + counts.iter().filter(|&&t| t > 1).count() / 2), "{streamed:?}");
+    for normals in [true, false] {
+        assert!(streamed.iter().any(|r| r["threads"] == 1 && r["normals"] == normals), "no one-thread row (normals {normals}) in {streamed:?}");
+    }
+    for i in 0..streamed.len() {
+        positive_number(&report, &format!("/threads_back_to_back/{i}/us_per_frame"));
+    }
+    assert!(report["crew_wake"].is_array());
     let rows = report["roofline"].as_array().expect("roofline rows");
     assert_eq!(rows.len(), 8, "a row per method, with and without normals");
     for i in 0..rows.len() {
