@@ -249,7 +249,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "roofline": roofline,
         "variants": rows,
         "threads_back_to_back": back_to_back,
-        "crew_wake": crews.iter().map(|(t, c)| json!({ "threads": t, "join_us": c.wake_costs().map(|(j, _)| j.as_secs_f64() * 1e6), "wake_call_us": c.wake_costs().map(|(_, w)| w.as_secs_f64() * 1e6) })).collect::<Vec<_>>(),
+        "crew_wake": crews.iter().map(|(t, c)| {
+            let costs = c.wake_costs();
+            json!({ "threads": t, "join_us": costs.map(|(j, _)| j.as_secs_f64() * 1e6), "wake_call_us": costs.map(|(_, w)| w.as_secs_f64() * 1e6) })
+        }).collect::<Vec<_>>(),
     });
     if args.json {
         println!("{report}");

@@ -81,38 +81,50 @@ fn worth_waking(left: Duration, awake: usize, parked: usize, join: Duration, wak
     l + (r - a * l + c).max(0.0) / (a + h) < r / a
 }
 
-/// The last [`WakeCosts::SAMPLES`] measurements of waking a parked helper: the caller's wake
-/// call and the time from it until the helper returned from its wait. Medians, since a wake that met a
+/// The last [`Samples::LEN`] measurements of one cost. Medians, since a wake that met a
 /// descheduled virtual CPU can take a thousand times the usual.
 #[derive(Default)]
-struct WakeCosts {
-    join: [Duration; Self::SAMPLES],
-    wake: [Duration; Self::SAMPLES],
-    /// Samples taken of each (the rings' next slot, modulo their length).
-    joins: usize,
-    wakes: usize,
+struct Samples {
+    ring: [Duration; Self::LEN],
+    /// Samples taken (the ring's next slot, modulo its length).
+    taken: usize,
 }
 
-impl WakeCosts {
-    const SAMPLES: usize = 8;
-    /// Wakes measured before their medians decide (until then the caller wakes for any job
-    /// of more than one piece).
+impl Samples {
+    const LEN: usize = 8;
+    /// Samples taken before the median decides (until then the caller wakes for any job of
+    /// more than one piece).
     const TRUSTED: usize = 3;
 
-    fn median(ring: &[Duration], taken: usize) -> Option<Duration> {
-        if taken < Self::TRUSTED {
+    fn push(&mut self, d: Duration) {
+        self.ring[self.taken % Self::LEN] = d;
+        self.taken += 1;
+    }
+
+    fn median(&self) -> Option<Duration> {
+        if self.taken < Self::TRUSTED {
             return None;
         }
-        let mut v = [Duration::ZERO; Self::SAMPLES];
-        let v = &mut v[..taken.min(Self::SAMPLES)];
-        v.copy_from_slice(&ring[..v.len()]);
+        let mut v = [Duration::ZERO; Self::LEN];
+        let v = &mut v[..self.taken.min(Self::LEN)];
+        v.copy_from_slice(&self.ring[..v.len()]);
         v.sort_unstable();
         Some(v[v.len() / 2])
     }
+}
 
+/// What waking a parked helper costs: the time from the caller's wake call until the
+/// helper returned from its wait, and the call itself.
+#[derive(Default)]
+struct WakeCosts {
+    join: Samples,
+    wake: Samples,
+}
+
+impl WakeCosts {
     /// The median join and wake times, once both are measured.
     fn medians(&self) -> Option<(Duration, Duration)> {
-        Some((Self::median(&self.join, self.joins)?, Self::median(&self.wake, self.wakes)?))
+        Some((self.join.median()?, self.wake.median()?))
     }
 }
 
@@ -278,12 +290,11 @@ impl Crew {
         } else if parked > 0 {
             let start = Instant::now();
             let ran = job.work(0, 1);
-            let left = start.elapsed().saturating_mul(u32::try_from(job.unclaimed()).unwrap_or(u32::MAX));
-            // A helper holding the lock (recording a join) may be descheduled: then no wake.
-            let costs = s.costs.try_lock().map(|c| c.medians());
-            let awake = self.threads() - parked;
             if ran == 1 {
-                match costs {
+                let left = start.elapsed().saturating_mul(u32::try_from(job.unclaimed()).unwrap_or(u32::MAX));
+                let awake = self.threads() - parked;
+                // A helper holding the lock (recording a join) may be descheduled: then no wake.
+                match s.costs.try_lock().map(|c| c.medians()) {
                     Ok(Some((join, wake))) if !worth_waking(left, awake, parked, join, wake) => {
                         if s.refused.fetch_add(1, Relaxed) % Self::REMEASURE == Self::REMEASURE - 1 {
                             self.wake();
@@ -310,9 +321,7 @@ impl Crew {
             s.wake.notify_all();
         }
         let took = start.elapsed();
-        let mut costs = s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let i = costs.wakes % WakeCosts::SAMPLES;
-        (costs.wake[i], costs.wakes) = (took, costs.wakes + 1);
+        s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).wake.push(took);
     }
 }
 
@@ -358,9 +367,7 @@ fn helper(home: usize, s: &Shared) {
             s.parked.fetch_sub(1, SeqCst);
             drop(guard);
             if let Some(joined) = joined {
-                let mut costs = s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-                let i = costs.joins % WakeCosts::SAMPLES;
-                (costs.join[i], costs.joins) = (joined, costs.joins + 1);
+                s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).join.push(joined);
             }
             continue;
         }
@@ -396,6 +403,20 @@ mod tests {
             });
             assert!(counts.iter().all(|c| c.load(Relaxed) == j), "job {j}: a piece ran other than once");
         }
+    }
+
+    /// Runs one job of `pieces` pieces that sleep `piece` each; returns how many ran on a
+    /// helper.
+    fn pieces_elsewhere(crew: &Crew, pieces: usize, piece: Duration) -> usize {
+        let caller = std::thread::current().id();
+        let elsewhere = AtomicUsize::new(0);
+        crew.run(pieces, &|_| {
+            if std::thread::current().id() != caller {
+                elsewhere.fetch_add(1, Relaxed);
+            }
+            std::thread::sleep(piece);
+        });
+        elsewhere.into_inner()
     }
 
     #[test]
@@ -449,8 +470,7 @@ mod tests {
     #[test]
     fn parked_helpers_are_woken_for_long_jobs_only() {
         let crew = Crew::new(2, Duration::ZERO).unwrap();
-        let caller = std::thread::current().id();
-        let elsewhere = AtomicUsize::new(0);
+        let mut elsewhere = 0;
         // Until the wakes are measured (on a loaded machine a helper may not have parked
         // before a job, and then it records no wake), at least 40 jobs.
         for j in 0..400 {
@@ -458,16 +478,11 @@ mod tests {
                 break;
             }
             std::thread::sleep(Duration::from_millis(1));
-            crew.run(8, &|_| {
-                if std::thread::current().id() != caller {
-                    elsewhere.fetch_add(1, Relaxed);
-                }
-                std::thread::sleep(Duration::from_micros(300));
-            });
+            elsewhere += pieces_elsewhere(&crew, 8, Duration::from_micros(300));
         }
-        assert!(elsewhere.load(Relaxed) > 0, "no piece of a long job ran on the helper");
+        assert!(elsewhere > 0, "no piece of a long job ran on the helper");
         assert!(crew.wake_costs().is_some(), "wakes measured");
-        let wakes = |crew: &Crew| crew.shared.costs.lock().unwrap().wakes;
+        let wakes = |crew: &Crew| crew.shared.costs.lock().unwrap().wake.taken;
         let before = wakes(&crew);
         for _ in 0..100 {
             std::thread::sleep(Duration::from_micros(500));
@@ -482,17 +497,8 @@ mod tests {
     #[test]
     fn helpers_take_part() {
         let crew = Crew::new(2, Crew::SPIN).unwrap();
-        let caller = std::thread::current().id();
-        let elsewhere = AtomicUsize::new(0);
-        for _ in 0..200 {
-            crew.run(4, &|_| {
-                if std::thread::current().id() != caller {
-                    elsewhere.fetch_add(1, Relaxed);
-                }
-                std::thread::sleep(Duration::from_micros(200));
-            });
-        }
-        assert!(elsewhere.load(Relaxed) > 0, "no piece ran on the helper");
+        let elsewhere: usize = (0..200).map(|_| pieces_elsewhere(&crew, 4, Duration::from_micros(200))).sum();
+        assert!(elsewhere > 0, "no piece ran on the helper");
     }
 
     #[test]
