@@ -596,8 +596,12 @@ impl ContactConstraint {
                         let (mut d, mut to) = (f32::INFINITY, usize::MAX);
                         for &o in &self.near {
                             let c = objects.collider(o);
+                            // (Against a mesh, exact only where it stops the finger: above, a
+                            // lower bound steps as far, and saves measuring the triangles within
+                            // millimetres of a palm's hull, which the search could not tell
+                            // apart, at every step.)
                             let (here, signed) = match c.triangles() {
-                                Some(mesh) => (self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, CONTACT_DISTANCE, MESH_LOOKOUT), true),
+                                Some(mesh) => (self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, STOP_DISTANCE, MESH_LOOKOUT), true),
                                 None => (c.distance_at_least(&pose, proxy, STOP_DISTANCE), false),
                             };
                             meshes_only &= signed || here > STOP_DISTANCE;

@@ -15,15 +15,21 @@
 //! millimetre inside its hull's box, which the box bound could not tell from the nearest and
 //! GJK or EPA measured one by one (2–9 µs each); that plane tells most of them at a glance.
 //!
-//! The time of impact is conservative advancement (Mirtich 1996) over the triangles the proxy's sweep meets, each
-//! with its own lower bound of the distance: measured exactly at some time, it falls no faster
-//! than the proxy closes on the plane through the nearest point (square to the gap), which
-//! holds the triangle on its far side: the motion's speed along that normal plus what its
-//! turning adds; where they overlap, it deepens no faster either, since they would have to part
-//! by no more than the depth along that normal. The search jumps to the earliest time a bound can reach [`TOLERANCE`] (or a
-//! triangle left, below, its floor) and
-//! measures only the triangles due then, so a proxy sliding along a surface or moving away
-//! from it takes a few steps, where a bound from the proxy's whole speed would creep.
+//! The time of impact is conservative advancement (Mirtich 1996) over the triangles the proxy's
+//! sweep can reach, each with its own lower bound of the distance: measured exactly at some
+//! time, it falls no faster than the proxy closes on the plane through the nearest point
+//! (square to the gap), which holds the triangle on its far side: the motion's speed along that
+//! normal n plus what its turning ω adds (radius · |n × ω|); where they overlap, it deepens no
+//! faster either, since they would have to part by no more than the depth along that normal.
+//! The search jumps to the earliest time a bound can reach [`TOLERANCE`] (or a triangle left,
+//! below, its floor) and measures only the triangles due then, so a proxy sliding along a
+//! surface or moving away from it takes a few steps, where a bound from the proxy's whole speed
+//! would creep. The triangles wait in a heap by when each is due, so a step costs its own
+//! measurements, not a pass over the thousands in a palm's sweep (frames of 1–2 ms on the
+//! teapot); a triangle due is first bounded again cheaply where the proxy now is, with the
+//! plane of the nearest measured there, and measured only if that bound is due too. Only the
+//! triangles within the proxy's reach over the motion are gathered, and none where the whole
+//! mesh is farther than that (one search).
 //!
 //! It replaces parry's nonlinear composite cast for meshes, which advances each triangle under
 //! the proxy on its own, with a stepping search for each one the proxy starts touching: 4–60 ms
@@ -45,6 +51,7 @@ use parry3d::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d::query::Contact;
 use parry3d::shape::{Shape, SupportMap, Triangle};
 use std::cell::Cell;
+use std::collections::BinaryHeap;
 use std::sync::Arc;
 
 use super::hull_support::HullSupport;
@@ -64,8 +71,12 @@ const REARM: f32 = 1e-4;
 /// trusted as the normal the advancement's bound falls along (m): their closest points are
 /// rounded by about 1e-8 m, which turns it by 1e-4 rad here.
 const PARTING: f32 = 1e-4;
-/// Steps of the advancement before it stops where it got (short of any hit: conservative).
+/// Steps of the advancement that measure a triangle before it stops where it got (short of
+/// any hit: conservative).
 const MAX_STEPS: usize = 128;
+/// How many more steps it may take that only bound triangles again: a palm's sweep may have
+/// hundreds far off, each due at its own time and put off by its bound there.
+const BOUNDING_STEPS: usize = 16;
 /// A triangle whose bound is within half a tolerance of the tolerance (of its floor, for one left)
 /// is measured again (the bound reaches it at the step's time, up to rounding).
 const DUE: f32 = 1.5;
@@ -74,7 +85,7 @@ const DUE: f32 = 1.5;
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
     triangle: u32,
-    /// A lower bound of the proxy's distance to it at time `at` (exact where computed).
+    /// A lower bound of the proxy's distance to it at time `at` (exact where measured).
     bound: f32,
     at: f32,
     /// How fast the bound falls after `at` (m per unit of time).
@@ -88,6 +99,27 @@ impl Candidate {
     /// started at less the tolerance (it may not go deeper than it started).
     fn stops_at(&self) -> f32 {
         self.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE)
+    }
+
+    /// The earliest time its bound can be down to `level` (earlier than `at` where it is
+    /// already; infinite where it does not fall and is not).
+    fn reaches(&self, level: f32) -> f32 {
+        match self.bound <= level {
+            _ if self.rate > 0.0 => self.at + (self.bound - level) / self.rate,
+            true => f32::NEG_INFINITY,
+            false => f32::INFINITY,
+        }
+    }
+
+    /// The earliest time it can stop the proxy.
+    fn stops_by(&self) -> f32 {
+        self.reaches(self.stops_at())
+    }
+
+    /// From when it is measured again: its bound within [`DUE`] tolerances of its stop (the
+    /// bound reaches the stop then, up to rounding); never where it does not fall that far.
+    fn measured_from(&self) -> Option<f32> {
+        Some(self.reaches(self.stops_at() + (DUE - 1.0) * TOLERANCE)).filter(|at| *at < f32::INFINITY)
     }
 }
 
@@ -118,7 +150,46 @@ pub struct ProxyMeshQuery {
     /// measured: a plane square to it bounds most triangles near that point at once.
     faced: Vec<Vec3>,
     epa: Scratch,
+    advancement: Advancement,
+}
+
+/// The advancement's buffers, kept between queries.
+#[derive(Clone, Default)]
+struct Advancement {
+    /// The triangles the sweep meets.
     candidates: Vec<Candidate>,
+    /// Each candidate not being measured, by the time it is due to be measured again.
+    due: BinaryHeap<Due>,
+    /// The candidates measured at the step's time.
+    batch: Vec<u32>,
+}
+
+/// A candidate (its index) due to be measured again at time `at`: ordered earliest first.
+#[derive(Clone, Copy, Debug)]
+struct Due {
+    at: f32,
+    candidate: u32,
+}
+
+impl PartialEq for Due {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Due {}
+
+impl PartialOrd for Due {
+    fn partial_cmp(&self, other: &Self) -> Option<core::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Due {
+    /// Reversed: std's heap pops its largest, the advancement wants the earliest.
+    fn cmp(&self, other: &Self) -> core::cmp::Ordering {
+        other.at.total_cmp(&self.at).then(other.candidate.cmp(&self.candidate))
+    }
 }
 
 /// parry's GJK, in f32 with tolerances fixed in absolute units, reports distances from a
@@ -394,7 +465,7 @@ impl ProxyMeshQuery {
     #[must_use]
     pub fn new(proxies: &HandProxies) -> Self {
         let shapes: Vec<QueryShape> = proxies.colliders().iter().map(|p| QueryShape::of(&*p.shape)).collect();
-        Self { faced: vec![Vec3::ZERO; shapes.len()], shapes, epa: Scratch::default(), candidates: Vec::new() }
+        Self { faced: vec![Vec3::ZERO; shapes.len()], shapes, epa: Scratch::default(), advancement: Advancement::default() }
     }
 
     /// The point of `mesh` (at `mesh_pose`) nearest proxy `proxy` (at `pose`), if it is nearer
@@ -417,10 +488,15 @@ impl ProxyMeshQuery {
     #[allow(clippy::too_many_arguments)]
     #[must_use]
     pub fn distance_at_least(&mut self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
-        let query = &self.shapes[proxy];
+        Self::at_least(&self.shapes[proxy], &mut self.faced[proxy], &mut self.epa.0, &mesh_pose.inv_mul(pose), mesh, exact_below, limit)
+    }
+
+    /// [`Self::distance_at_least`] of `query` at `pose` (the mesh's frame), through
+    /// [`Self::search`]'s `faced` and `epa`.
+    fn at_least(query: &QueryShape, faced: &mut Vec3, epa: &mut EPA, pose: &Pose, mesh: &TriangleTree, exact_below: f32, limit: f32) -> f32 {
         // Nothing found within the limit: what was passed over may be a little nearer.
         let passed_over = limit - SHORT_ABOVE * (limit - exact_below).max(0.0);
-        Self::search(query, &mut self.faced[proxy], &mut self.epa.0, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
+        Self::search(query, faced, epa, pose, mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
     }
 
     /// The best-first search of the mesh's tree for the triangle nearest `query` at `pose` (the
@@ -493,63 +569,112 @@ impl ProxyMeshQuery {
                 return Some(0.0);
             }
         }
+        // How fast the proxy closes on a plane of unit normal `n` (the mesh's frame, towards
+        // the proxy): its motion's speed against `n`, plus what turning adds (a point at most
+        // `radius` from the centre turning by ω moves along `n` by at most radius |n × ω|).
+        let closing = |n: Vec3| {
+            let n = mesh_pose.rotation * n;
+            (radius * n.cross(motion.angvel).length() - motion.linvel.dot(n)).clamp(0.0, speed)
+        };
+        // No point of the proxy gets farther than this from where it starts.
+        let reach = speed * end + DUE * TOLERANCE;
+        // The whole mesh farther than that from the start by the triangles' cheap bounds (one
+        // search that measures none, exact below −1 m, where the sweep's box may hold
+        // thousands): nothing is hit.
+        Self::search(cast, &mut faced, &mut self.epa.0, &start, mesh, reach, -1.0, 0.0)?;
+        // The triangles the sweep may reach: in its box, and no farther from the proxy at the
+        // start than that (by the bounds of the tree's nodes and their own, with the plane the
+        // search faced).
         let placed = cast.at(start);
-        self.candidates.clear();
-        let candidates = &mut self.candidates;
-        mesh.overlapping(&swept.transform_by(&mesh_pose.inverse()), |triangle| {
+        placed.face(start.rotation * faced);
+        let Advancement { candidates, due, batch } = &mut self.advancement;
+        candidates.clear();
+        mesh.overlapping(&swept.transform_by(&mesh_pose.inverse()), |node| placed.node_gap(node) <= reach, |triangle| {
             let bound = placed.bound(&mesh.triangles()[triangle as usize]);
-            candidates.push(Candidate { triangle, bound, at: 0.0, rate: speed, left: None });
+            if bound <= reach {
+                candidates.push(Candidate { triangle, bound, at: 0.0, rate: speed, left: None });
+            }
         });
-        // Nearest first: a contact at the start is then found after few exact distances.
-        self.candidates.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound));
+        // Nearest first (the earliest due): a contact at the start is then found after few
+        // exact distances.
+        due.clear();
+        due.extend(candidates.iter().enumerate().filter_map(|(k, c)| c.measured_from().map(|at| Due { at, candidate: k as u32 })));
         let mut t = 0.0;
-        for _ in 0..MAX_STEPS {
+        batch.clear();
+        while let Some(d) = due.peek().filter(|d| d.at <= 0.0) {
+            batch.push(d.candidate);
+            due.pop();
+        }
+        // Steps that measured a triangle (a step that only bounded some again costs little).
+        let mut measuring = 0;
+        for _ in 0..MAX_STEPS * BOUNDING_STEPS {
             let pose = if t == 0.0 { start } else { local_pose(t) };
-            // The earliest time another triangle's bound can come down to the tolerance.
-            let mut next = end;
-            for c in &mut self.candidates {
+            let placed = cast.at(pose);
+            let (mut nearest, mut measured) = (f32::INFINITY, false);
+            for &k in batch.iter() {
+                let c = &mut candidates[k as usize];
+                let tri = &mesh.triangles()[c.triangle as usize];
+                if t > 0.0 {
+                    // Its cheap bound here first, with the plane of the nearest measured in
+                    // this step: what that puts off is not measured (hundreds of triangles whose
+                    // bounds from the start ran out, most of them far, or behind that plane).
+                    let cheap = Candidate { bound: placed.bound(tri), at: t, rate: speed, ..*c };
+                    if let Some(at) = cheap.measured_from().filter(|&at| at > t) {
+                        *c = cheap;
+                        due.push(Due { at, candidate: k });
+                        continue;
+                    }
+                }
+                let (distance, normal, point) = cast.to_triangle(&pose, &tri.triangle, &mut self.epa.0);
+                measured = true;
+                if distance < nearest && normal != Vec3::ZERO {
+                    nearest = distance;
+                    placed.face(-normal);
+                }
+                (c.bound, c.at) = (distance, t);
+                let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
+                if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
+                    // Its touching point moves off it: a proxy may leave what it rests on.
+                    c.left = (along(x, n) >= 0.0).then_some(distance);
+                }
+                // The plane through its nearest point, square to `n`, holds the triangle on
+                // its far side; the proxy closes on that plane no faster than this. Where
+                // they overlap, by no more than they would have to part along `n`, which
+                // grows no faster (where a capsule's axis crosses the triangle, or the query
+                // gave no normal, there is no such direction: the whole speed).
+                c.rate = if n != Vec3::ZERO && cast.parts_along_normal(distance) { closing(normal) } else { speed };
                 // A triangle left may not stop the proxy unless it goes deeper than it started
                 // (a turn can lift the touching point and sink another end of the proxy): its
-                // floor is what matters then, not the tolerance.
-                if c.bound - c.rate * (t - c.at) <= c.stops_at() + (DUE - 1.0) * TOLERANCE {
-                    let (distance, normal, point) = cast.to_triangle(&pose, &mesh.triangles()[c.triangle as usize].triangle, &mut self.epa.0);
-                    (c.bound, c.at) = (distance, t);
-                    let (n, x) = (mesh_pose.rotation * normal, *mesh_pose * point);
-                    if t == 0.0 && distance <= TOLERANCE && n != Vec3::ZERO {
-                        // Its touching point moves off it: a proxy may leave what it rests on.
-                        c.left = (along(x, n) >= 0.0).then_some(distance);
-                    }
-                    // The plane through its nearest point, square to `n`, holds the triangle on
-                    // its far side; the proxy closes on that plane no faster than this. Where
-                    // they overlap, by no more than they would have to part along `n`, which
-                    // grows no faster (where a capsule's axis crosses the triangle, or the query
-                    // gave no normal, there is no such direction: the whole speed).
-                    c.rate = if n != Vec3::ZERO && cast.parts_along_normal(distance) { (turning - motion.linvel.dot(n)).clamp(0.0, speed) } else { speed };
-                    if c.left.is_some() {
-                        let floor = c.stops_at();
-                        if distance <= floor {
-                            return Some(t);
-                        }
-                        if distance <= REARM {
-                            if c.rate > 0.0 {
-                                next = next.min(t + (distance - floor) / c.rate);
-                            }
-                            continue;
-                        }
-                        c.left = None;
-                    }
-                    if distance <= TOLERANCE {
-                        return Some(t);
-                    }
+                // floor is what matters then, not the tolerance, until it is clear by REARM.
+                if c.left.is_some() && distance > REARM {
+                    c.left = None;
                 }
-                if c.rate > 0.0 {
-                    next = next.min(c.at + (c.bound - c.stops_at()) / c.rate);
+                if distance <= c.stops_at() {
+                    return Some(t);
                 }
+                if let Some(at) = c.measured_from() {
+                    due.push(Due { at, candidate: k });
+                }
+            }
+            // The next step: the earliest time a bound can come down to its stop, and every
+            // triangle due by then (taken off in the order they fall due: none later can be
+            // earlier).
+            let mut next = f32::INFINITY;
+            batch.clear();
+            while let Some(d) = due.peek().filter(|d| d.at <= next) {
+                let k = d.candidate;
+                due.pop();
+                next = next.min(candidates[k as usize].stops_by());
+                batch.push(k);
             }
             if next >= end {
                 return None;
             }
             t = next;
+            measuring += usize::from(measured);
+            if measuring == MAX_STEPS {
+                break;
+            }
         }
         Some(t)
     }
@@ -569,7 +694,7 @@ mod tests {
     }
 
     fn cast(shape: &SharedShape, from: Vec3, linvel: Vec3, angvel: Vec3) -> Option<f32> {
-        let mut cast = ProxyMeshQuery { shapes: vec![QueryShape::of(&**shape)], faced: vec![Vec3::ZERO], epa: Scratch::default(), candidates: Vec::new() };
+        let mut cast = ProxyMeshQuery { shapes: vec![QueryShape::of(&**shape)], faced: vec![Vec3::ZERO], epa: Scratch::default(), advancement: Advancement::default() };
         let start = Pose::from_translation(from);
         let motion = NonlinearRigidMotion::new(start, Vec3::ZERO, linvel, angvel);
         let extent = shape.compute_local_bounding_sphere().radius;
@@ -670,7 +795,7 @@ mod tests {
         let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
         let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
         let shapes = [SharedShape::capsule(a, b, radius), SharedShape::cuboid(0.04, 0.01, 0.03)];
-        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), candidates: Vec::new() };
+        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), advancement: Advancement::default() };
         let mesh_pose = Pose::from_parts(Vec3::new(0.3, 0.8, -0.2), glam::Quat::from_rotation_y(0.7));
         let corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -0.04 } else { 0.04 }, if i & 2 == 0 { -0.01 } else { 0.01 }, if i & 4 == 0 { -0.03 } else { 0.03 })).collect();
         let (box_points, box_triangles) = parry3d::transformation::try_convex_hull(&corners).expect("a box's hull");
@@ -737,6 +862,92 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 20 && touching > 3 && boxes > 10 && overlaps > 0, "{checked} poses, {touching} within 2 mm, {boxes} boxes clear, {overlaps} overlapping");
+    }
+
+    /// A capsule (a finger's) and a hull (a palm-sized box) swept past, into and away from the
+    /// Utah teapot (data from outside the project), turning as they go: the advancement must
+    /// stop no later than the first contact and at it (within the tolerance, the hull's
+    /// within parry's error), and find none only where there is none. The reference samples
+    /// each motion at 200 times and measures every triangle whose box the motion may reach
+    /// exactly (where its bounding sphere is near enough to matter) (the closest points of segment and triangle; the polyhedron's from its faces
+    /// and edges), no tree, no bound and no advancement.
+    #[test]
+    fn a_sweep_past_the_teapot_stops_at_its_first_contact() {
+        const SAMPLES: usize = 200;
+        let triangles = teapot_triangles();
+        let corners: Vec<Vec3> = triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect();
+        let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
+        let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
+        let half = Vec3::new(0.04, 0.01, 0.03);
+        let box_corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -half.x } else { half.x }, if i & 2 == 0 { -half.y } else { half.y }, if i & 4 == 0 { -half.z } else { half.z })).collect();
+        let (box_points, box_triangles) = parry3d::transformation::try_convex_hull(&box_corners).expect("a box's hull");
+        let shapes = [SharedShape::capsule(a, b, radius), SharedShape::convex_mesh(box_points.clone(), &box_triangles).expect("a hull")];
+        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), advancement: Advancement::default() };
+        let (mut hits, mut misses) = ([0; 2], [0; 2]);
+        for (case, (k, tri)) in triangles.iter().enumerate().step_by(151).enumerate() {
+            let proxy = case / 3 % 2;
+            let extent = shapes[proxy].compute_local_bounding_sphere().radius;
+            let centre = (tri.a + tri.b + tri.c) / 3.0;
+            let n = face_normal(tri);
+            let side = n.any_orthonormal_vector();
+            // 5–20 mm off its surface, moved 3 cm: into it, past it, or off it, and turned.
+            let off = 0.005 + 0.015 * (k % 7) as f32 / 6.0;
+            let linvel = [-n * 0.03, side * 0.03 - n * 0.006, n * 0.03 + side * 0.01][case % 3];
+            let angvel = Vec3::new(0.3, -0.2, 0.5) * ((k % 5) as f32 - 2.0) * 0.4;
+            // (The box lies along the surface, its thin side towards it.)
+            let turn = [glam::Quat::from_rotation_x(k as f32 * 0.37), glam::Quat::from_rotation_arc(Vec3::Y, n) * glam::Quat::from_rotation_y(k as f32 * 0.37)][proxy];
+            let start = Pose::from_parts(centre + n * (off + [extent, half.y][proxy]), turn);
+            let motion = NonlinearRigidMotion::new(start, Vec3::ZERO, linvel, angvel);
+            let swept = shapes[proxy].compute_swept_aabb(&start, &motion.position_at_time(1.0)).loosened(extent * angvel.length());
+            let found = query.time_of_impact(proxy, &motion, extent, &swept, &mesh, &Pose::identity(), 1.0);
+            // The reference: every triangle the motion's box may reach, measured exactly where
+            // its bounding sphere is within `below` of the proxy's (the least, or `below`).
+            let near: Vec<(&Triangle, Vec3, f32)> = triangles
+                .iter()
+                .filter(|t| t.local_aabb().intersects(&swept))
+                .map(|t| {
+                    let centroid = (t.a + t.b + t.c) / 3.0;
+                    (t, centroid, [t.a, t.b, t.c].iter().map(|v| v.distance(centroid)).fold(0.0, f32::max))
+                })
+                .collect();
+            let distance = |t: f32, below: f32| {
+                let pose = motion.position_at_time(t);
+                near.iter()
+                    .filter(|(_, centroid, spread)| match proxy {
+                        0 => crate::math::segment_distance(*centroid, pose * a, pose * b) - spread - radius < below,
+                        _ => centroid.distance(pose.translation) - spread - half.length() < below,
+                    })
+                    .map(|(tri, _, _)| match proxy {
+                        0 => {
+                            let (p, q) = segment_triangle_closest(pose * a, pose * b, [tri.a, tri.b, tri.c]);
+                            p.distance(q) - radius
+                        }
+                        _ => polyhedron_triangle(&box_points, &box_triangles, &pose, tri),
+                    })
+                    .fold(below, f32::min)
+            };
+            // (A start in the teapot's other parts, or its winding turned in, is no sweep.)
+            if distance(0.0, 0.002) < 0.002 {
+                continue;
+            }
+            let first = (0..=SAMPLES).map(|i| i as f32 / SAMPLES as f32).find(|&t| distance(t, 2.0 * TOLERANCE) <= TOLERANCE);
+            // (The box's distances are parry's in units, which may be short by its error.)
+            let slack = if proxy == 0 { 1e-6 } else { 2.0 * GJK_ERROR };
+            match found {
+                Some(t) => {
+                    let there = distance(t, f32::INFINITY);
+                    assert!(there >= -slack && there <= 2.0 * TOLERANCE + slack, "proxy {proxy} by triangle {k}: stopped at {t}, {there} m from the teapot");
+                    assert!(first.is_none_or(|f| t <= f + 1e-6), "proxy {proxy} by triangle {k}: stopped at {t}, past the contact at {first:?}");
+                    hits[proxy] += 1;
+                }
+                None => {
+                    let least = (0..=SAMPLES).map(|i| distance(i as f32 / SAMPLES as f32, TOLERANCE)).fold(f32::INFINITY, f32::min);
+                    assert!(least > 0.0, "proxy {proxy} by triangle {k}: no stop, but {least} m from the teapot on the way");
+                    misses[proxy] += 1;
+                }
+            }
+        }
+        assert!(hits.iter().all(|&h| h >= 3) && misses.iter().all(|&m| m >= 2), "hits {hits:?}, misses {misses:?}");
     }
 
     /// Why hull proxies are queried in [`UNIT`]s: against the Utah teapot's millimetre

@@ -102,15 +102,15 @@ impl TriangleTree {
     }
 
     /// Calls `each` with the index (in [`Self::triangles`]) of every triangle whose box meets
-    /// `aabb`.
-    pub fn overlapping(&self, aabb: &Aabb, mut each: impl FnMut(u32)) {
+    /// `aabb`, under nodes that `keep` keeps.
+    pub fn overlapping(&self, aabb: &Aabb, keep: impl Fn(&TreeNode) -> bool, mut each: impl FnMut(u32)) {
         let mut stack = [0u32; MAX_DEPTH + 1];
         let mut depth = usize::from(!self.nodes.is_empty());
         while depth > 0 {
             depth -= 1;
             let i = stack[depth] as usize;
             let node = &self.nodes[i];
-            if !node.aabb.intersects(aabb) {
+            if !node.aabb.intersects(aabb) || !keep(node) {
                 continue;
             }
             match node.leaf() {
@@ -269,7 +269,7 @@ mod tests {
             let c = Vec3::new((k as f32 * 0.37).fract(), (k as f32 * 0.11).sin() * 0.2, (k as f32 * 0.73).fract());
             let query = Aabb::from_half_extents(c, Vec3::splat(0.02 + 0.01 * (k % 5) as f32));
             let mut found = Vec::new();
-            tree.overlapping(&query, |t| found.push(t));
+            tree.overlapping(&query, |_| true, |t| found.push(t));
             let reference: Vec<u32> = (0..tree.triangles().len() as u32)
                 .filter(|&t| tree.triangles()[t as usize].triangle.local_aabb().intersects(&query))
                 .collect();
