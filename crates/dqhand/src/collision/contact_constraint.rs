@@ -597,7 +597,7 @@ impl ContactConstraint {
                         for &o in &self.near {
                             let c = objects.collider(o);
                             // (Against a mesh, exact only where it stops the finger: above, a
-                            // lower bound steps as far, and saves measuring the triangles within
+                            // lower bound steps nearly as far, and saves measuring the triangles within
                             // millimetres of a palm's hull, which the search could not tell
                             // apart, at every step.)
                             let (here, signed) = match c.triangles() {
