@@ -103,6 +103,14 @@ impl Candidate {
         self.left.map_or(TOLERANCE, |start| start.min(0.0) - TOLERANCE)
     }
 
+    /// Arms a triangle left again once its bound clears it by [`REARM`] (a bound under its
+    /// distance, measured or not): then it stops the proxy at the tolerance.
+    fn rearm(&mut self) {
+        if self.left.is_some() && self.bound > REARM {
+            self.left = None;
+        }
+    }
+
     /// The earliest time its bound can be down to `level` (earlier than `at` where it is
     /// already; infinite where it does not fall and is not).
     fn reaches(&self, level: f32) -> f32 {
@@ -490,15 +498,10 @@ impl ProxyMeshQuery {
     #[allow(clippy::too_many_arguments)]
     #[must_use]
     pub fn distance_at_least(&mut self, proxy: usize, pose: &Pose, mesh: &TriangleTree, mesh_pose: &Pose, exact_below: f32, limit: f32) -> f32 {
-        Self::at_least(&self.shapes[proxy], &mut self.faced[proxy], &mut self.epa.0, &mesh_pose.inv_mul(pose), mesh, exact_below, limit)
-    }
-
-    /// [`Self::distance_at_least`] of `query` at `pose` (the mesh's frame), through
-    /// [`Self::search`]'s `faced` and `epa`.
-    fn at_least(query: &QueryShape, faced: &mut Vec3, epa: &mut EPA, pose: &Pose, mesh: &TriangleTree, exact_below: f32, limit: f32) -> f32 {
+        let query = &self.shapes[proxy];
         // Nothing found within the limit: what was passed over may be a little nearer.
         let passed_over = limit - SHORT_ABOVE * (limit - exact_below).max(0.0);
-        Self::search(query, faced, epa, pose, mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
+        Self::search(query, &mut self.faced[proxy], &mut self.epa.0, &mesh_pose.inv_mul(pose), mesh, limit, exact_below, SHORT_ABOVE).map_or(passed_over, |n| n.distance)
     }
 
     /// The best-first search of the mesh's tree for the triangle nearest `query` at `pose` (the
@@ -622,11 +625,7 @@ impl ProxyMeshQuery {
                     // this step: what that puts off is not measured (hundreds of triangles whose
                     // bounds from the start ran out, most of them far, or behind that plane).
                     let mut cheap = Candidate { bound: placed.bound(tri), at: t, rate: speed, ..*c };
-                    // (One left and now clear by REARM, by a bound under its distance, stops
-                    // the proxy at the tolerance again, as if measured.)
-                    if cheap.left.is_some() && cheap.bound > REARM {
-                        cheap.left = None;
-                    }
+                    cheap.rearm();
                     if let Some(at) = cheap.measured_from().filter(|&at| at > t) {
                         *c = cheap;
                         due.push(Due { at, candidate: k });
@@ -654,9 +653,7 @@ impl ProxyMeshQuery {
                 // A triangle left may not stop the proxy unless it goes deeper than it started
                 // (a turn can lift the touching point and sink another end of the proxy): its
                 // floor is what matters then, not the tolerance, until it is clear by REARM.
-                if c.left.is_some() && distance > REARM {
-                    c.left = None;
-                }
+                c.rearm();
                 if distance <= c.stops_at() {
                     return Some(t);
                 }
@@ -702,7 +699,7 @@ mod tests {
     }
 
     fn cast(shape: &SharedShape, from: Vec3, linvel: Vec3, angvel: Vec3) -> Option<f32> {
-        let mut cast = ProxyMeshQuery { shapes: vec![QueryShape::of(&**shape)], faced: vec![Vec3::ZERO], epa: Scratch::default(), advancement: Advancement::default() };
+        let mut cast = query_of(std::slice::from_ref(shape));
         let start = Pose::from_translation(from);
         let motion = NonlinearRigidMotion::new(start, Vec3::ZERO, linvel, angvel);
         let extent = shape.compute_local_bounding_sphere().radius;
@@ -792,6 +789,23 @@ mod tests {
         mesh.triangles.iter().map(|t| Triangle::new(v(t[0]), v(t[1]), v(t[2]))).collect()
     }
 
+    /// The tree of `triangles`, each with corners of its own.
+    fn tree_of(triangles: &[Triangle]) -> TriangleTree {
+        let corners: Vec<Vec3> = triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect();
+        TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>())
+    }
+
+    /// The hull (points, triangles) of the box of half extents `half` about the origin.
+    fn box_hull(half: Vec3) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -half.x } else { half.x }, if i & 2 == 0 { -half.y } else { half.y }, if i & 4 == 0 { -half.z } else { half.z })).collect();
+        parry3d::transformation::try_convex_hull(&corners).expect("a box's hull")
+    }
+
+    /// The queries of `shapes`, in order, with nothing remembered.
+    fn query_of(shapes: &[SharedShape]) -> ProxyMeshQuery {
+        ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; shapes.len()], epa: Scratch::default(), advancement: Advancement::default() }
+    }
+
     #[test]
     fn the_nearest_triangle_is_the_nearest_of_all() {
         // A finger-sized capsule and a palm-sized box around the teapot, up to 3 cm off: the
@@ -799,14 +813,12 @@ mod tests {
         // points of the segment and each triangle, by brute force, no tree and no bound), and
         // the advancement's bound must never be above it and be it below `exact_below`.
         let triangles = teapot_triangles();
-        let corners: Vec<Vec3> = triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect();
-        let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
+        let mesh = tree_of(&triangles);
         let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
         let shapes = [SharedShape::capsule(a, b, radius), SharedShape::cuboid(0.04, 0.01, 0.03)];
-        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), advancement: Advancement::default() };
+        let mut query = query_of(&shapes);
         let mesh_pose = Pose::from_parts(Vec3::new(0.3, 0.8, -0.2), glam::Quat::from_rotation_y(0.7));
-        let corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -0.04 } else { 0.04 }, if i & 2 == 0 { -0.01 } else { 0.01 }, if i & 4 == 0 { -0.03 } else { 0.03 })).collect();
-        let (box_points, box_triangles) = parry3d::transformation::try_convex_hull(&corners).expect("a box's hull");
+        let (box_points, box_triangles) = box_hull(Vec3::new(0.04, 0.01, 0.03));
         let box_reach = Vec3::new(0.04, 0.01, 0.03).length();
         let (mut checked, mut touching, mut boxes, mut overlaps) = (0, 0, 0, 0);
         for (k, tri) in triangles.iter().enumerate().step_by(23) {
@@ -877,21 +889,20 @@ mod tests {
     /// 10 cm off, as the wrist stage turns its proxies): the advancement must
     /// stop no later than the first contact and at it (within the tolerance, the hull's
     /// within parry's error), and find none only where there is none. The reference samples
-    /// each motion at 200 times and measures every triangle whose box the motion may reach
-    /// exactly (where its bounding sphere is near enough to matter) (the closest points of segment and triangle; the polyhedron's from its faces
-    /// and edges), no tree, no bound and no advancement.
+    /// each motion at 200 times and measures exactly every triangle whose box the motion may
+    /// reach and whose bounding sphere is near enough to matter (the closest points of segment
+    /// and triangle; the polyhedron's from its faces and edges): no tree, no bound and no
+    /// advancement.
     #[test]
     fn a_sweep_past_the_teapot_stops_at_its_first_contact() {
         const SAMPLES: usize = 200;
         let triangles = teapot_triangles();
-        let corners: Vec<Vec3> = triangles.iter().flat_map(|t| [t.a, t.b, t.c]).collect();
-        let mesh = TriangleTree::new(&corners, &(0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect::<Vec<_>>());
+        let mesh = tree_of(&triangles);
         let (a, b, radius) = (Vec3::new(0.0, -0.02, 0.0), Vec3::new(0.0, 0.02, 0.0), 0.008);
         let half = Vec3::new(0.04, 0.01, 0.03);
-        let box_corners: Vec<Vec3> = (0..8).map(|i| Vec3::new(if i & 1 == 0 { -half.x } else { half.x }, if i & 2 == 0 { -half.y } else { half.y }, if i & 4 == 0 { -half.z } else { half.z })).collect();
-        let (box_points, box_triangles) = parry3d::transformation::try_convex_hull(&box_corners).expect("a box's hull");
+        let (box_points, box_triangles) = box_hull(half);
         let shapes = [SharedShape::capsule(a, b, radius), SharedShape::convex_mesh(box_points.clone(), &box_triangles).expect("a hull")];
-        let mut query = ProxyMeshQuery { shapes: shapes.iter().map(|s| QueryShape::of(&**s)).collect(), faced: vec![Vec3::ZERO; 2], epa: Scratch::default(), advancement: Advancement::default() };
+        let mut query = query_of(&shapes);
         let (mut hits, mut misses) = ([0; 2], [0; 2]);
         for (case, (k, tri)) in triangles.iter().enumerate().step_by(151).enumerate() {
             let proxy = case / 3 % 2;
