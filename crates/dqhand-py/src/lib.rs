@@ -316,7 +316,8 @@ impl Hand {
     /// The posed hands' skin: `angles` (B, D) radians, `wrist` (B, 4, 4) rigid transforms or
     /// None (the rest wrist), `method` "dqb", "qb", "lb" or "cor", `limits` whether angles are clamped
     /// to their anatomical ranges. Returns the positions (B, V, 3), m, or with `normals` the
-    /// positions and the unit normals.
+    /// positions and the unit normals. Each pose is skinned alone: a joint twisted past 180°
+    /// is blended the shortest way, as no previous frame says which way it turned.
     #[pyo3(signature = (angles, wrist = None, method = "dqb", *, normals = false, limits = true))]
     fn skin<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, method: &str, normals: bool, limits: bool) -> PyResult<Bound<'py, PyAny>> {
         let method: Method = method.parse().map_err(to_py)?;
@@ -327,6 +328,8 @@ impl Hand {
         let start = (self.kinematics(limits), Deformer::new(method, mesh));
         let mut skinned = batch::<numpy::Ix3, _>(py, &[poses.count, v, 3], if normals { 2 } else { 1 }, start, |((k, pose), d), b, positions, normals| {
             k.pose(source.read(b, pose));
+            // Each pose alone, whichever thread took the one before it.
+            d.forget_previous_frame();
             d.deform_into(mesh, k.layer(), VertexBuffers::Separate { positions, normals });
         })?;
         let positions = skinned.remove(0);

@@ -83,6 +83,7 @@ pub(crate) fn realism<'py>(hand: &Hand, py: Python<'py>, args: &RealismArgs<'_, 
                 |((k, pose), deformer, deformed): &mut (_, Deformer, Deformed), b| {
                     let pose: &Pose = source.read(b, pose);
                     k.pose(pose);
+                    deformer.forget_previous_frame();
                     deformer.deform(mesh, k.layer(), deformed);
                     let posed = deformed.positions();
                     let (min_distance, max_distance) = region.distance_ratios(mesh, &bind_world, k.world(), posed);

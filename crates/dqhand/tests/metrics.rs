@@ -105,17 +105,23 @@ fn dqb_keeps_volume_and_radius_where_lb_collapses() {
 }
 
 #[test]
-fn dqb_flips_past_180_degrees_of_twist_and_the_report_shows_it() {
+fn a_twist_past_180_degrees_flips_each_frame_alone_and_is_followed_frame_by_frame() {
     let report = measure(std::sync::Arc::new(build(&HandParams::default()).unwrap())).unwrap();
     let twist = report.sweep("index-pip-twist").unwrap();
-    let dqb = &twist.frames[2];
-    // At 180° the twisted bone's rotation leaves the hemisphere of its neighbour's, the sign
-    // alignment switches, and the skin jumps to the other side; elsewhere it moves smoothly.
     let flip = twist.values.iter().position(|&v| v == 180.0).unwrap();
-    let others: f32 = dqb[1..].iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, f)| f.jump).fold(0.0, f32::max);
-    assert!(dqb[flip].jump > 3.0 * others, "jump at 170→180°: {}, largest elsewhere: {others}", dqb[flip].jump);
-    // The radius itself is kept all the way.
-    assert!(dqb.iter().all(|f| f.section_radius > 0.9), "{dqb:?}");
+    let largest = |jumps: &mut dyn Iterator<Item = f32>| jumps.fold(0.0, f32::max);
+    for m in [1, 2, 3] {
+        let frames = &twist.frames[m];
+        // Alone, at 180° the twisted bone's rotation leaves the hemisphere of its neighbour's,
+        // the nearer sign switches, and the skin jumps to the other side.
+        let alone = largest(&mut frames[1..].iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, f)| f.jump_alone));
+        assert!(frames[flip].jump_alone > 3.0 * alone, "method {m}, alone: jump at 170→180°: {}, largest elsewhere: {alone}", frames[flip].jump_alone);
+        // Followed, the sign is kept and 180° is a step like the others.
+        let followed = largest(&mut frames[1..].iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, f)| f.jump));
+        assert!(frames[flip].jump < 1.5 * followed && frames[flip].jump < 0.2 * frames[flip].jump_alone, "method {m}, followed: jump at 170→180°: {}, largest elsewhere: {followed}", frames[flip].jump);
+    }
+    // DQB's radius itself is kept all the way.
+    assert!(twist.frames[2].iter().all(|f| f.section_radius > 0.9), "{:?}", twist.frames[2]);
 }
 
 #[test]

@@ -145,6 +145,12 @@ fn rotate(q: [f64; 4], v: DVec3) -> DVec3 {
 /// is 180° from the heaviest one's, their quaternions' dot product within rounding of 0,
 /// and either sign is as right (the blends differ completely).
 fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> {
+    reference_of(c, v, method, None)
+}
+
+/// As [`reference`], or with `turned` each joint's rotation as the quaternion of the way it
+/// turned, blended as given: no hemisphere is chosen, the skin follows the turn.
+fn reference_of(c: &Case, v: usize, method: Method, turned: Option<&[DQuat]>) -> Option<(DVec3, DVec3, f64)> {
     let total: f64 = c.influences[v].iter().map(|i| f64::from(i.1)).sum();
     let inf: Vec<(usize, f64)> = c.influences[v].iter().map(|&(j, w)| (j as usize, f64::from(w) / total)).collect();
     let p = Vec3::from(c.positions[v]).as_dvec3();
@@ -167,15 +173,16 @@ fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> 
                 .iter()
                 .map(|&(j, w)| {
                     let (q, t) = bone(&c.skinning[j], c.flips[j]);
+                    let q = turned.map_or(q, |turned| turned[j]);
                     (j, w, [q.x, q.y, q.z, q.w], t)
                 })
                 .collect();
             let heaviest = bones.iter().fold(&bones[0], |a, b| if b.1 > a.1 { b } else { a }).2;
             let dot = |q: [f64; 4]| q.iter().zip(&heaviest).map(|(a, b)| a * b).sum::<f64>();
-            if bones.iter().any(|b| dot(b.2).abs() < 1e-5) {
+            if turned.is_none() && bones.iter().any(|b| dot(b.2).abs() < 1e-5) {
                 return None;
             }
-            let sign = |q: [f64; 4]| if dot(q) < 0.0 { -1.0 } else { 1.0 };
+            let sign = |q: [f64; 4]| if turned.is_none() && dot(q) < 0.0 { -1.0 } else { 1.0 };
             if method != Method::Dqb {
                 // q = normalise(Σ wᵢ sᵢ qᵢ). QB: t = Σ wᵢ tᵢ, v' = q v q* + t. CoR, about
                 // the centre c: v' = q (v − c) q* + Σ wᵢ (qᵢ c qᵢ* + tᵢ).
@@ -220,14 +227,9 @@ fn reference(c: &Case, v: usize, method: Method) -> Option<(DVec3, DVec3, f64)> 
 fn check(c: &Case, stride: usize) -> Result<(), TestCaseError> {
     let mesh = mesh(c, stride);
     let kernels = support::kernels::kernels();
-    let paths = kernels.run.iter().flat_map(|&k| if k == Kernel::Avx512 { LookupStrategy::ALL.map(Some).to_vec() } else { vec![None] }.into_iter().map(move |s| (k, s)));
-    for (kernel, strategy) in paths {
+    for (kernel, strategy) in paths(&kernels) {
         for method in Method::ALL {
-            let deformer = Deformer::new(method, &mesh).with_kernel(kernel);
-            let mut deformer = match strategy {
-                Some(s) => deformer.with_strategy(s),
-                None => deformer,
-            };
+            let mut deformer = deformer(method, &mesh, kernel, strategy);
             let kernel = format!("{kernel:?}{}", strategy.map_or(String::new(), |s| format!(" ({})", s.name())));
             let (mut out, mut only) = (Deformed::new(&mesh), Deformed::positions_only(&mesh));
             deformer.deform(&mesh, &c.skinning, &mut out);
@@ -246,6 +248,19 @@ fn check(c: &Case, stride: usize) -> Result<(), TestCaseError> {
         }
     }
     Ok(())
+}
+
+/// Every kernel this CPU runs, and on the AVX-512 kernel each lookup strategy.
+fn paths(kernels: &support::kernels::Kernels) -> Vec<(Kernel, Option<LookupStrategy>)> {
+    kernels.run.iter().flat_map(|&k| if k == Kernel::Avx512 { LookupStrategy::ALL.map(Some).to_vec() } else { vec![None] }.into_iter().map(move |s| (k, s))).collect()
+}
+
+fn deformer(method: Method, mesh: &SkinnedMesh, kernel: Kernel, strategy: Option<LookupStrategy>) -> Deformer {
+    let deformer = Deformer::new(method, mesh).with_kernel(kernel);
+    match strategy {
+        Some(s) => deformer.with_strategy(s),
+        None => deformer,
+    }
 }
 
 proptest! {
@@ -297,3 +312,59 @@ fn qb_translation_is_not_flipped_with_the_rotation() {
     assert_close!(out.positions()[0], p.as_vec3().to_array(), 1e-5);
 }
 
+
+/// A forearm-like cylinder: joint 0 placed by a fixed rigid motion, joint 1 twisted by
+/// `degrees` about the cylinder's axis (X) on top of it, and the vertices' weights passing
+/// from one to the other along X. Returns the case and the quaternions of the way each joint
+/// turned (joint 1's continuous in the twist, never re-signed).
+fn twisted(degrees: f64) -> (Case, Vec<DQuat>) {
+    let placed = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+    let turned = [placed, placed * DQuat::from_axis_angle(DVec3::X, degrees.to_radians())];
+    let offset = Vec3::new(0.1, -0.2, 0.3);
+    // Joint 1 twists about the axis itself, so both translations are the placement's.
+    let skinning = turned.map(|q| Affine3A::from_rotation_translation(q.as_quat(), offset)).to_vec();
+    let mut c = Case { positions: vec![], normals: vec![], influences: vec![], centres: vec![], skinning, flips: vec![false; 2] };
+    for i in 0..24 {
+        let (x, around) = (0.2 + 0.6 * (i / 6) as f32 / 3.0, std::f32::consts::TAU * (i % 6) as f32 / 6.0);
+        let n = Vec3::new(0.0, around.cos(), around.sin());
+        c.positions.push((Vec3::new(x, 0.0, 0.0) + 0.1 * n).to_array());
+        c.normals.push(n.to_array());
+        c.influences.push(vec![(0, 1.0 - x), (1, x)]);
+        c.centres.push([x, 0.0, 0.0]);
+    }
+    (c, turned.to_vec())
+}
+
+#[test]
+fn a_twist_past_180_degrees_is_followed_the_way_it_turned_up_to_270() {
+    // Twisted frame by frame in 10° steps, every method on every kernel blends joint 1 the
+    // way it turned while the twist is under 270° and the shortest way past it. A jump
+    // (355° to 185°) takes the shortest way, −175°; the next step, to −185°, is followed on
+    // that way; after a forgotten frame, −195° is the shortest way's 165°.
+    let kernels = support::kernels::kernels();
+    let mesh = mesh(&twisted(0.0).0, 4);
+    // (twist, blended the way it turned, the previous frame forgotten)
+    let mut frames: Vec<(f64, bool, bool)> = (0..36).map(|step| 5.0 + 10.0 * f64::from(step)).map(|d| (d, d < 270.0, false)).collect();
+    frames.extend([(185.0, false, false), (-185.0, true, false), (-195.0, false, true)]);
+    for (kernel, strategy) in paths(&kernels) {
+        for method in Method::ALL {
+            let mut deformer = deformer(method, &mesh, kernel, strategy);
+            let mut out = Deformed::new(&mesh);
+            for (frame, &(degrees, followed, forgotten)) in frames.iter().enumerate() {
+                let (c, turned) = twisted(degrees);
+                if forgotten {
+                    deformer.forget_previous_frame();
+                }
+                deformer.deform(&mesh, &c.skinning, &mut out);
+                for v in 0..c.positions.len() {
+                    let (p, n, _) = reference_of(&c, v, method, followed.then_some(&turned[..])).expect("signs decided");
+                    let (gp, gn) = (Vec3::from(out.positions()[v]).as_dvec3(), Vec3::from(out.normals()[v]).as_dvec3());
+                    assert!(
+                        gp.distance(p) < 2e-4 && gn.distance(n) < 2e-4,
+                        "{method} on {kernel:?} {strategy:?}, frame {frame} (twist {degrees}°, followed {followed}), vertex {v}: {gp} {gn} but the reference gives {p} {n}; {kernels}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -75,8 +75,12 @@ pub struct FrameMetrics {
     pub distortion_mean: f32,
     /// Largest relative edge-length change in the joint region.
     pub distortion_max: f32,
-    /// Largest vertex displacement from the previous frame of the sweep (m).
+    /// Largest vertex displacement from the previous frame of the sweep (m), the deformer
+    /// following the sweep frame by frame (its hemisphere signs kept along a twist).
     pub jump: f32,
+    /// The same with each frame deformed alone (hemisphere signs by the shortest path, as a
+    /// deformer's first frame): the flip at 180° of twist that following avoids.
+    pub jump_alone: f32,
     /// Skin inside skin between the hand's parts, in the sweeps where they meet (the fist).
     pub self_contact: Option<SelfContact>,
 }
@@ -146,9 +150,15 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     // The sweeps turn joints by local transforms of the rig's chain, the gestures by angles.
     let mut layer = KinematicsLayer::new(hand.skeleton().clone(), model.mesh.inverse_bind());
     let mut deformers = Method::ALL.map(|m| Deformer::new(m, &model.mesh));
+    let mut alone = deformers.clone();
     let mut outputs = Method::ALL.map(|_| Deformed::new(&model.mesh));
-    let mut deform = |bones: &KinematicsLayer, outputs: &mut [Deformed; 4]| {
+    let mut outputs_alone = outputs.clone();
+    // `follow`: the frame follows the last one deformed (within a sweep), else it is alone.
+    let deform = |deformers: &mut [Deformer; 4], bones: &KinematicsLayer, follow: bool, outputs: &mut [Deformed; 4]| {
         for (d, o) in deformers.iter_mut().zip(outputs) {
+            if !follow {
+                d.forget_previous_frame();
+            }
             d.deform(&model.mesh, bones, o);
         }
     };
@@ -174,18 +184,23 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         let region_edges: Vec<[u32; 2]> = all_edges.iter().copied().filter(|e| e.iter().all(|&v| in_region[v as usize])).collect();
         let mut frames: [Vec<FrameMetrics>; 4] = Default::default();
         let mut previous: [Option<Vec<[f32; 3]>>; 4] = Default::default();
-        for &value in &spec.values {
+        let mut previous_alone: [Option<Vec<[f32; 3]>>; 4] = Default::default();
+        let largest_move = |from: &Option<Vec<[f32; 3]>>, to: &[[f32; 3]]| {
+            from.as_ref().map_or(0.0, |p| p.iter().zip(to).map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b))).fold(0.0, f32::max))
+        };
+        for (i, &value) in spec.values.iter().enumerate() {
             pose_sweep(&rig, &spec, value, &region, &rest_world, &mut locals)?;
             layer.pose_locals(&locals);
-            deform(&layer, &mut outputs);
+            deform(&mut deformers, &layer, i > 0, &mut outputs);
+            deform(&mut alone, &layer, false, &mut outputs_alone);
             for m in Method::ALL {
                 let posed = outputs[m.index()].positions();
                 let world = layer.world();
                 let (min_distance, max_distance) = region.distance_ratios(mesh, &bind_world, world, posed);
                 let (distortion_mean, distortion_max) = edge_distortion(&rest_positions, posed, &region_edges);
-                let jump = previous[m.index()].as_ref().map_or(0.0, |p| {
-                    p.iter().zip(posed).map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b))).fold(0.0, f32::max)
-                });
+                let jump = largest_move(&previous[m.index()], posed);
+                let posed_alone = outputs_alone[m.index()].positions();
+                let jump_alone = largest_move(&previous_alone[m.index()], posed_alone);
                 frames[m.index()].push(FrameMetrics {
                     volume: rest_volume.map(|v0| (enclosed_volume(posed, mesh.indices()) / v0) as f32),
                     min_distance,
@@ -194,9 +209,11 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
                     distortion_mean,
                     distortion_max,
                     jump,
+                    jump_alone,
                     self_contact: (spec.contact && closed.is_ok()).then(|| self_contact(posed, mesh.indices(), &parts)),
                 });
                 previous[m.index()] = Some(posed.to_vec());
+                previous_alone[m.index()] = Some(posed_alone.to_vec());
             }
         }
         sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
@@ -205,7 +222,7 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
     let mut contact = Vec::new();
     for g in &GESTURES {
         hand.pose(&g.pose(JointModel::Full));
-        deform(hand.layer(), &mut outputs);
+        deform(&mut deformers, hand.layer(), false, &mut outputs);
         let posed = |m: Method| outputs[m.index()].positions();
         if INTERSECTION_GESTURES.contains(&g.name) {
             intersections.push((g.name, Method::ALL.map(|m| count_self_intersections(posed(m), mesh.indices()))));
@@ -273,6 +290,7 @@ impl Report {
                         "distortion_mean": col(|f| json!(f.distortion_mean)),
                         "distortion_max": col(|f| json!(f.distortion_max)),
                         "jump": col(|f| json!(f.jump)),
+                        "jump_alone": col(|f| json!(f.jump_alone)),
                     });
                     if frames.iter().any(|f| f.self_contact.is_some()) {
                         o[m.as_str()]["self_contact"] = col(|f| f.self_contact.as_ref().map_or(Value::Null, contact_json));
@@ -305,15 +323,15 @@ impl Report {
     pub fn write_csv(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
         for s in &self.sweeps {
-            let mut text = format!("{},method,volume,min_distance,max_distance,section_radius,distortion_mean,distortion_max,jump_m,contact_depth_m,contact_volume_m3\n", s.parameter);
+            let mut text = format!("{},method,volume,min_distance,max_distance,section_radius,distortion_mean,distortion_max,jump_m,jump_alone_m,contact_depth_m,contact_volume_m3\n", s.parameter);
             for (m, frames) in Method::ALL.iter().zip(&s.frames) {
                 for (v, f) in s.values.iter().zip(frames) {
                     let volume = f.volume.map_or(String::new(), |x| x.to_string());
                     let (depth, shared) = f.self_contact.map_or((String::new(), String::new()), |c| (c.depth_m.to_string(), c.volume_m3.to_string()));
                     let _ = writeln!(
                         text,
-                        "{v},{m},{volume},{},{},{},{},{},{},{depth},{shared}",
-                        f.min_distance, f.max_distance, f.section_radius, f.distortion_mean, f.distortion_max, f.jump
+                        "{v},{m},{volume},{},{},{},{},{},{},{},{depth},{shared}",
+                        f.min_distance, f.max_distance, f.section_radius, f.distortion_mean, f.distortion_max, f.jump, f.jump_alone
                     );
                 }
             }
@@ -344,8 +362,12 @@ impl Report {
             ("section radius at 180° PIP twist (candy wrapper < 1)".into(), at("index-pip-twist", 180.0, |f| Some(f.section_radius))),
             ("volume at 180° wrist twist".into(), at("wrist-twist", 180.0, |f| f.volume)),
             ("section radius at 180° wrist twist".into(), at("wrist-twist", 180.0, |f| Some(f.section_radius))),
-            ("largest frame-to-frame jump, twist 0–200° in 10° steps (mm)".into(), {
+            ("largest frame-to-frame jump, PIP twist 0–200° in 10° steps, followed (mm)".into(), {
                 let j = worst("index-pip-twist", |f| f.jump);
+                j.map(|x| x.map(|m| m * 1000.0))
+            }),
+            ("the same, each frame alone (mm)".into(), {
+                let j = worst("index-pip-twist", |f| f.jump_alone);
                 j.map(|x| x.map(|m| m * 1000.0))
             }),
         ];

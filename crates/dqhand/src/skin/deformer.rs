@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::crew::Crew;
 use super::fastest_strategy::fastest_strategy;
 use super::kernel::{self, Frame, FrameTable, Kernel};
+use super::pair_signs::PairSigns;
 use super::skinned_mesh::{SkinnedMesh, BLOCK, LANES};
 use super::strategy::Strategy;
 use super::Method;
@@ -136,7 +137,7 @@ pub struct Deformer {
     wide: Vec<[f32; WIDE]>,
     /// Eight per joint: QB's rotation and translation, or DQB's dual quaternion.
     quat: Vec<[f32; dqb::W]>,
-    signs: Vec<f32>,
+    signs: PairSigns,
     wide_table: FrameTable<WIDE>,
     quat_table: FrameTable<{ dqb::W }>,
     kernel: Kernel,
@@ -163,17 +164,17 @@ impl Deformer {
         let forced = std::env::var(Strategy::ENV).ok().and_then(|name| Strategy::named(&name));
         let strategy = forced.unwrap_or_else(|| if Kernel::best() == Kernel::Avx512 { fastest_strategy(method, mesh) } else { Strategy::Permute });
         let joints = mesh.inverse_bind().len();
-        let signs = mesh.pairs.len() + 1;
-        let (wn, qn, sn) = match method {
+        let pairs = mesh.pairs.len();
+        let (wn, qn, pairs) = match method {
             Method::Lb => (joints, 0, 0),
-            Method::Cor => (joints, 0, signs),
-            Method::Qb | Method::Dqb => (0, joints, signs),
+            Method::Cor => (joints, 0, pairs),
+            Method::Qb | Method::Dqb => (0, joints, pairs),
         };
         Self {
             method,
             wide: vec![[0.0; WIDE]; wn],
             quat: vec![[0.0; dqb::W]; qn],
-            signs: vec![1.0; sn],
+            signs: PairSigns::new(pairs),
             wide_table: FrameTable::new(wn, strategy),
             quat_table: FrameTable::new(qn, strategy),
             kernel: Kernel::best(),
@@ -231,8 +232,10 @@ impl Deformer {
     /// Step 1 of paper 4.4: each joint's transform is converted once (matrix rows, quaternion
     /// and translation, dual quaternion: the kinematics layer's own, where `bones` carries
     /// them, or quaternion and rows), and for the quaternion methods one sign per pair of
-    /// joints that share a vertex,
-    /// aligning the other joint's rotation to the hemisphere of the heaviest one. Steps 2–6:
+    /// joints that share a vertex, aligning the other joint's rotation to the hemisphere of
+    /// the heaviest one: the nearer one, or, while their relative rotation moves less than
+    /// 60° a frame, the one it had in the previous frame, so a joint twisted past 180° keeps
+    /// the way it turned (up to 270°) instead of flipping. Steps 2–6:
     /// every vertex is blended, split across the crew's threads if there is one. Allocates
     /// nothing.
     ///
@@ -295,6 +298,12 @@ impl Deformer {
         }
     }
 
+    /// The next deformation does not follow the last one (a seek, another clip, an unrelated
+    /// pose): its hemisphere signs take the shortest path, as a new deformer's first frame.
+    pub fn forget_previous_frame(&mut self) {
+        self.signs.forget();
+    }
+
     /// Step 1 of paper 4.4 for this frame: bone parameters, pair signs, lookup tables.
     fn prepare(&mut self, mesh: &SkinnedMesh, bones: Bones<'_>) {
         let skinning = bones.skinning;
@@ -309,9 +318,9 @@ impl Deformer {
                     *d = convert(m);
                 }
                 let pairs: &[(u16, u16)] = if self.method == Method::Lb { &[] } else { &mesh.pairs };
-                pair_signs(&self.wide, pairs, &mut self.signs);
+                self.signs.update(&self.wide, pairs);
                 if avx512 {
-                    self.wide_table.update(&self.wide, pairs, &self.signs);
+                    self.wide_table.update(&self.wide, pairs, self.signs.as_slice());
                 }
             }
             Method::Qb | Method::Dqb => {
@@ -330,9 +339,9 @@ impl Deformer {
                         }
                     }
                 }
-                pair_signs(&self.quat, &mesh.pairs, &mut self.signs);
+                self.signs.update(&self.quat, &mesh.pairs);
                 if avx512 {
-                    self.quat_table.update(&self.quat, &mesh.pairs, &self.signs);
+                    self.quat_table.update(&self.quat, &mesh.pairs, self.signs.as_slice());
                 }
             }
         }
@@ -385,9 +394,9 @@ impl Deformer {
         let (kernel, strategy) = (self.kernel, self.strategy);
         match self.method {
             Method::Lb => kernel::deform::<WIDE, lb::Lb>(mesh, &Frame { params: &self.wide, signs: &[], centres: &[], table: &self.wide_table, kernel, strategy }, first, positions, normals),
-            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: &self.signs, centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
-            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: &self.signs, centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
-            Method::Cor => kernel::deform::<WIDE, cor::Cor>(mesh, &Frame { params: &self.wide, signs: &self.signs, centres: mesh.centres(), table: &self.wide_table, kernel, strategy }, first, positions, normals),
+            Method::Qb => kernel::deform::<{ qb::W }, qb::Qb>(mesh, &Frame { params: &self.quat, signs: self.signs.as_slice(), centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Dqb => kernel::deform::<{ dqb::W }, dqb::Dqb>(mesh, &Frame { params: &self.quat, signs: self.signs.as_slice(), centres: &[], table: &self.quat_table, kernel, strategy }, first, positions, normals),
+            Method::Cor => kernel::deform::<WIDE, cor::Cor>(mesh, &Frame { params: &self.wide, signs: self.signs.as_slice(), centres: mesh.centres(), table: &self.wide_table, kernel, strategy }, first, positions, normals),
         }
     }
 
@@ -395,7 +404,8 @@ impl Deformer {
     /// Deforms `mesh` once per pose, the poses split across `pool`'s threads (each pose on
     /// one thread): `skinning` holds the poses' transforms one after another (#joints each),
     /// `out` one buffer per pose. For data sets of posed hands. Each thread's scratch is made
-    /// once per call.
+    /// once per call; each pose is deformed as a first frame (no pose follows another), so
+    /// the result does not depend on which thread took which.
     ///
     /// # Panics
     /// As [`Self::deform`], or if `skinning` does not hold `out.len()` poses.
@@ -410,25 +420,11 @@ impl Deformer {
         }
         let single = Self { crew: None, ..self.clone() };
         pool.install(|| {
-            out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| d.deform(mesh, s, o));
+            out.par_iter_mut().zip(skinning.par_chunks(joints)).for_each_init(|| single.clone(), |d, (o, s)| {
+                d.forget_previous_frame();
+                d.deform(mesh, s, o);
+            });
         });
     }
 }
 
-/// One sign per pair of joints sharing a vertex (`signs[1 + i]` for `pairs[i]`, `signs[0]`
-/// the heaviest joint's own, +1): −1 where the other joint's rotation (the first four
-/// `params`) is in the other hemisphere than the heaviest's. Nothing for no pairs (LB).
-///
-/// # Panics
-/// If there are pairs and not one sign more than pairs.
-fn pair_signs<const W: usize>(params: &[[f32; W]], pairs: &[(u16, u16)], signs: &mut [f32]) {
-    if pairs.is_empty() {
-        return;
-    }
-    assert_eq!(signs.len(), pairs.len() + 1, "deformer made for another mesh");
-    for (sign, &(h, j)) in signs[1..].iter_mut().zip(pairs) {
-        let (a, b) = (&params[usize::from(h)], &params[usize::from(j)]);
-        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-        *sign = if dot < 0.0 { -1.0 } else { 1.0 };
-    }
-}

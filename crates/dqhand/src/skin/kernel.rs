@@ -265,7 +265,7 @@ fn chunks<const W: usize, const K: usize, B: Blend<W>, const ISA: u8, const NORM
             match (frame.strategy, frame.table.table.as_deref()) {
                 (Strategy::Permute, Some(table)) => blocks::<W, K, B, NORMALS>(table, mesh, frame.centres, first, positions, normals),
                 (Strategy::Broadcast, _) => blocks::<W, K, B, NORMALS>(&avx512::Runs { params: frame.params, signs: frame.signs }, mesh, frame.centres, first, positions, normals),
-                _ => blocks::<W, K, B, NORMALS>(&avx512::Gather(frame.params), mesh, frame.centres, first, positions, normals),
+                _ => blocks::<W, K, B, NORMALS>(&avx512::Gather { params: frame.params, signs: frame.signs }, mesh, frame.centres, first, positions, normals),
             }
         };
     }
@@ -640,10 +640,10 @@ mod avx512 {
         unsafe fn offsets(&self, joints: __m512i) -> __m512i;
         /// Component `c` of the parameters at `offsets`.
         unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512;
-        /// The lanes whose influence must be negated to share its heaviest influence's
-        /// hemisphere (a negative dot product of their rotations): `heaviest` and `joints`
-        /// are the two joints' indices, `h` and `v` their rotations.
-        unsafe fn opposite(&self, heaviest: __m512i, joints: __m512i, h: &[__m512; 4], v: &[__m512; 4]) -> __mmask16;
+        /// The lanes whose influence the frame's pair signs negate beside its heaviest
+        /// influence: `heaviest` and `joints` are the two joints' indices, `slot` the offset of
+        /// the block's slot in the mesh's block arrays.
+        unsafe fn opposite(&self, mesh: &SkinnedMesh, slot: usize, heaviest: __m512i, joints: __m512i) -> __mmask16;
     }
 
     /// The per-frame parameters component-major in two registers' worth per component,
@@ -700,7 +700,7 @@ mod avx512 {
         }
 
         #[inline(always)]
-        unsafe fn opposite(&self, heaviest: __m512i, joints: __m512i, _: &[__m512; 4], _: &[__m512; 4]) -> __mmask16 {
+        unsafe fn opposite(&self, _: &SkinnedMesh, _: usize, heaviest: __m512i, joints: __m512i) -> __mmask16 {
             let rows = self.opposite.as_ptr();
             let bits = _mm512_permutex2var_epi32(_mm512_loadu_si512(rows.cast()), heaviest, _mm512_loadu_si512(rows.add(16).cast()));
             // Joints are below 32 here; saying so spares the shift the compiler's checks
@@ -710,8 +710,12 @@ mod avx512 {
         }
     }
 
-    /// Any number of joints: each component gathered from the parameter rows.
-    pub(super) struct Gather<'a, const W: usize>(pub &'a [[f32; W]]);
+    /// Any number of joints: each component gathered from the parameter rows, each lane's
+    /// sign from the frame's pair signs.
+    pub(super) struct Gather<'a, const W: usize> {
+        pub params: &'a [[f32; W]],
+        pub signs: &'a [f32],
+    }
 
     impl<const W: usize> Lookup<W> for Gather<'_, W> {
         #[inline(always)]
@@ -721,20 +725,16 @@ mod avx512 {
 
         #[inline(always)]
         unsafe fn get(&self, offsets: __m512i, c: usize) -> __m512 {
-            _mm512_i32gather_ps::<4>(_mm512_add_epi32(offsets, _mm512_set1_epi32(c as i32)), self.0.as_ptr().cast())
+            _mm512_i32gather_ps::<4>(_mm512_add_epi32(offsets, _mm512_set1_epi32(c as i32)), self.params.as_ptr().cast())
         }
 
-        /// From the rotations themselves: the rule of the frame's pair signs, without a table,
-        /// in the same arithmetic (products summed left to right, unfused), so that a dot
-        /// product within rounding of 0 (a half-turn between two bones) takes the same sign
-        /// as in every other strategy and kernel.
+        /// One more gather, of the lanes' signs by their sign indices: the pair signs follow
+        /// a twist past 180° (module `pair_signs`), which the rotations alone cannot tell.
         #[inline(always)]
-        unsafe fn opposite(&self, _: __m512i, _: __m512i, h: &[__m512; 4], v: &[__m512; 4]) -> __mmask16 {
-            let mut dot = _mm512_mul_ps(h[0], v[0]);
-            for c in 1..4 {
-                dot = _mm512_add_ps(dot, _mm512_mul_ps(h[c], v[c]));
-            }
-            _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dot, _mm512_setzero_ps())
+        unsafe fn opposite(&self, mesh: &SkinnedMesh, slot: usize, _: __m512i, _: __m512i) -> __mmask16 {
+            let pairs = _mm512_loadu_si512(mesh.block_pairs.as_ptr().add(slot).cast());
+            let signs = _mm512_i32gather_ps::<4>(pairs, self.signs.as_ptr().cast());
+            _mm512_cmp_ps_mask::<_CMP_LT_OQ>(signs, _mm512_setzero_ps())
         }
     }
 
@@ -751,7 +751,7 @@ mod avx512 {
         let slot = |k: usize| (block * K + k) * BLOCK;
         let zero = _mm512_setzero_ps();
         let mut acc = [zero; W];
-        let (mut heaviest, mut heaviest_joints) = ([zero; 4], _mm512_setzero_si512());
+        let mut heaviest = _mm512_setzero_si512();
         for k in 0..kc.min(K) {
             let joints = _mm512_cvtepu16_epi32(_mm256_loadu_si256(mesh.block_joints.as_ptr().add(slot(k)).cast()));
             let w = _mm512_loadu_ps(mesh.block_weights.as_ptr().add(slot(k)));
@@ -766,10 +766,10 @@ mod avx512 {
                 w
             } else if k == 0 {
                 // Slot 0 is the heaviest joint itself, whose sign is always +1.
-                (heaviest, heaviest_joints) = ([v[0], v[1], v[2], v[3]], joints);
+                heaviest = joints;
                 w
             } else {
-                let opposite = lookup.opposite(heaviest_joints, joints, &heaviest, &[v[0], v[1], v[2], v[3]]);
+                let opposite = lookup.opposite(mesh, slot(k), heaviest, joints);
                 _mm512_mask_sub_ps(w, opposite, zero, w)
             };
             for c in 0..B::USED {

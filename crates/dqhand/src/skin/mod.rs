@@ -12,6 +12,7 @@ mod kernel;
 mod linear_blend;
 mod method;
 mod method_set;
+mod pair_signs;
 mod quaternion_blend;
 mod skin_layer;
 mod skinned_mesh;

@@ -149,6 +149,9 @@ pub struct SkinnedMesh {
     /// needs no transpose).
     pub(crate) block_joints: Vec<u16>,
     pub(crate) block_weights: Vec<f32>,
+    /// The slots' sign indices (`slot_pairs`) laid out as `block_joints`: the gather strategy
+    /// of the AVX-512 blend gathers each lane's sign with them.
+    pub(crate) block_pairs: Vec<u32>,
     /// Per block and slot, the lanes that share a joint and a pair sign, lanes of zero
     /// weight left out: `block_runs[block_run_start[s]..block_run_start[s + 1]]` for slot
     /// `s = block * k + slot` (the broadcast strategy of the AVX-512 blend, which blends each
@@ -289,11 +292,11 @@ impl SkinnedMesh {
             })
             .collect();
         let blocks = padded / BLOCK;
-        let (mut block_joints, mut block_weights) = (vec![0u16; blocks * k * BLOCK], vec![0f32; blocks * k * BLOCK]);
+        let (mut block_joints, mut block_weights, mut block_pairs) = (vec![0u16; blocks * k * BLOCK], vec![0f32; blocks * k * BLOCK], vec![0u32; blocks * k * BLOCK]);
         for v in 0..blocks * BLOCK {
             for s in 0..k {
-                let at = ((v / BLOCK) * k + s) * BLOCK + v % BLOCK;
-                (block_joints[at], block_weights[at]) = (joints[v * k + s], weights[v * k + s]);
+                let (at, i) = (((v / BLOCK) * k + s) * BLOCK + v % BLOCK, v * k + s);
+                (block_joints[at], block_weights[at], block_pairs[at]) = (joints[i], weights[i], slot_pairs[i]);
             }
         }
         let (block_runs, block_run_start) = runs(blocks, k, &joints, &weights, &slot_pairs);
@@ -340,6 +343,7 @@ impl SkinnedMesh {
             chunk_influences,
             block_joints,
             block_weights,
+            block_pairs,
             block_runs,
             block_run_start,
             centres: OnceLock::new(),
