@@ -10,7 +10,7 @@ use dqhand::math::DualQuat;
 use std::sync::Arc;
 use std::time::Duration;
 
-use dqhand::skin::{Crew, Deformed, Deformer, Kernel, MeshData, Method, SkinnedMesh, Strategy, MIN_VERTICES_PER_THREAD};
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, MeshData, Method, MethodSet, SkinLayer, SkinnedMesh, Strategy, MIN_VERTICES_PER_THREAD};
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 use proptest::prelude::*;
 use support::{rotation, vec3};
@@ -439,4 +439,25 @@ fn the_built_in_hand_is_grouped_by_influence_count() {
     let mesh = &model.mesh;
     let counts: Vec<usize> = (0..mesh.vertex_count()).map(|v| mesh.influences(v).count()).collect();
     assert!(counts.windows(2).all(|w| w[0] <= w[1]));
+}
+
+#[test]
+fn a_skin_layer_follows_a_twist_until_told_to_forget() {
+    // The cylinder twisted 0–190° in 10° steps through a skin layer, then the 190° frame
+    // again after forgetting: followed, it is the way it turned (the opposite side of the
+    // shortest way's 170°), forgotten it is what a new layer shows of 190°.
+    let mesh = Arc::new(cylinder(1.0));
+    let twist = |degrees: f32| [Affine3A::IDENTITY, Affine3A::from_rotation_y(degrees.to_radians())];
+    let mut followed = SkinLayer::new(Arc::clone(&mesh), MethodSet::new(&[Method::Dqb]).unwrap());
+    for step in 0..=19 {
+        followed.deform(&twist(10.0 * step as f32)[..]);
+    }
+    let mut fresh = SkinLayer::new(Arc::clone(&mesh), MethodSet::new(&[Method::Dqb]).unwrap());
+    fresh.deform(&twist(190.0)[..]);
+    let at = |layer: &SkinLayer| layer.deformed(Method::Dqb).unwrap().positions().to_vec();
+    let gap = |a: &[[f32; 3]], b: &[[f32; 3]]| a.iter().zip(b).map(|(p, q)| Vec3::from(*p).distance(Vec3::from(*q))).fold(0.0, f32::max);
+    assert!(gap(&at(&followed), &at(&fresh)) > 0.5, "followed 190° should differ from the shortest way");
+    followed.forget_previous_frame();
+    followed.deform(&twist(190.0)[..]);
+    assert_eq!(at(&followed), at(&fresh));
 }

@@ -54,7 +54,9 @@ impl SkinLayer {
         layer
     }
 
-    /// The methods [`Self::deform`] runs; a method new to the layer gets its buffers here.
+    /// The methods [`Self::deform`] runs; a method new to the layer gets its buffers here. A
+    /// method back in the set follows the frame it last deformed where that is near enough
+    /// ([`Deformer::deform`]).
     pub fn set_methods(&mut self, methods: MethodSet) {
         self.methods = methods;
         for &m in methods.as_slice() {
@@ -63,6 +65,12 @@ impl SkinLayer {
                 self.outputs[m.index()] = Some(Deformed::new(&self.mesh));
             }
         }
+    }
+
+    /// The next [`Self::deform`] does not follow the last one (a seek, another clip): see
+    /// [`Deformer::forget_previous_frame`].
+    pub fn forget_previous_frame(&mut self) {
+        self.deformers.iter_mut().flatten().for_each(Deformer::forget_previous_frame);
     }
 
     /// `method`'s deformer, made the first time (allocates then only).
