@@ -147,7 +147,7 @@ async function handFigures(compose) {
     await waitState(ui, 's.connected && s.framesReceived > 2');
     await ui.evaluate(() => window.dqhand.send({ type: 'gesture', name: 'point', seconds: 0 }));
     await ui.check('#split');
-    await waitState(ui, 's.visible.length === 3 && !s.frame.playing');
+    await waitState(ui, 's.visible.length === 4 && !s.frame.playing');
     await ui.waitForTimeout(500);
     await settle(ui, 4);
     writeFileSync(path.join(out, 'viewer-split.png'), await ui.screenshot());

@@ -5,7 +5,7 @@ import './style.css';
 import { Vector3 } from 'three';
 import { Connection, type ConnectionEvents } from './connection';
 import { heldText, InputPanel } from './input';
-import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, PAPER_METHODS, type LearningMessage, type RecordingMessage } from './protocol';
+import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
 import { LocalConnection, type RelaySetup } from './local';
 import { InputSender } from './sender';
@@ -207,7 +207,7 @@ function cameraAnchor(h: Hello): [number, number, number] {
 const selectedMethod = (): Method => (METHODS.find((m) => $<HTMLInputElement>(`method-${m}`).checked) ?? 'dqb');
 function sendView(): void {
   const split = $<HTMLInputElement>('split').checked;
-  connection.setting({ type: 'view', methods: split ? [...PAPER_METHODS] : [selectedMethod()] });
+  connection.setting({ type: 'view', methods: split ? [...METHODS] : [selectedMethod()] });
 }
 for (const m of METHODS) $(`method-${m}`).addEventListener('change', sendView);
 $('split').addEventListener('change', sendView);

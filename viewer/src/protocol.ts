@@ -1,8 +1,8 @@
-// The stream's wire format, version 1 (crates/dqhand-stream/src/frame.rs is the reference):
+// The stream's wire format, version 2 (crates/dqhand-stream/src/frame.rs is the reference):
 // a topology message once, then binary frames; JSON text for hello, input state, scene state, errors and commands.
 // Arrays are 4-byte aligned, so they are read as typed-array views without copying.
 
-export const VERSION = 1;
+export const VERSION = 2;
 export const FRAME_MAGIC = 0x46485144; // "DQHF" little-endian
 export const TOPOLOGY_MAGIC = 0x54485144; // "DQHT"
 export const FRAME_HEADER_BYTES = 76;
@@ -14,8 +14,6 @@ export const STATE_PLAYING = 1;
 export const STATE_LIMITS = 2;
 export const METHODS = ['lb', 'qb', 'dqb', 'cor'] as const;
 export type Method = (typeof METHODS)[number];
-/** The paper's three, which the split view shows side by side (a frame holds at most three meshes). */
-export const PAPER_METHODS: readonly Method[] = ['lb', 'qb', 'dqb'];
 
 export class ProtocolError extends Error {}
 
@@ -305,20 +303,21 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
   const view = new DataView(buffer);
   if (buffer.byteLength < FRAME_HEADER_BYTES) throw new ProtocolError(`frame of ${buffer.byteLength} bytes is truncated`);
   const flags = checkStart(view, FRAME_MAGIC, 'frame', FLAG_DISTORTION | FLAG_SECOND_HAND);
-  const meshCount = view.getUint8(24);
-  if (meshCount < 1 || meshCount > 3) throw new ProtocolError(`${meshCount} meshes (1 to 3)`);
+  // Bytes 24-27: one method code per mesh, 255 past the last.
+  const codes = METHODS.map((_, i) => view.getUint8(24 + i));
+  const meshCount = codes.includes(UNUSED_METHOD) ? codes.indexOf(UNUSED_METHOD) : codes.length;
+  if (meshCount === 0) throw new ProtocolError('no meshes (method code 255 in the first slot)');
   const methods: Method[] = [];
-  for (let i = 0; i < meshCount; i++) {
-    const code = view.getUint8(25 + i);
+  codes.forEach((code, i) => {
+    if (i >= meshCount) {
+      if (code !== UNUSED_METHOD) throw new ProtocolError(`mesh ${i}: method code ${code} after the last mesh (${meshCount})`);
+      return;
+    }
     const m = METHODS[code];
     if (m === undefined) throw new ProtocolError(`mesh ${i}: method code ${code}`);
     if (methods.includes(m)) throw new ProtocolError(`method "${m}" given twice`);
     methods.push(m);
-  }
-  for (let i = meshCount; i < 3; i++) {
-    const code = view.getUint8(25 + i);
-    if (code !== UNUSED_METHOD) throw new ProtocolError(`mesh ${i}: method code ${code} with ${meshCount} meshes`);
-  }
+  });
   const state = view.getUint32(44, true);
   const header: FrameHeader = {
     sequence: view.getUint32(8, true),

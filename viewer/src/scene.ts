@@ -1,4 +1,4 @@
-// The three.js scene: up to three hands side by side (one per skinning method), lit so that
+// The three.js scene: up to four hands side by side (one per skinning method), lit so that
 // creases and volume read, with optional heat map, wireframe and skeleton overlays; or, with a
 // manipulation scene, one hand (or a server's two) among the objects in their common world. Geometry comes from
 // the engine; this file only draws it.
@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { SceneObjects } from './objects';
-import type { Frame, HelloScene, Method, SceneMessage, Side, Topology } from './protocol';
+import { type Frame, type HelloScene, type Method, METHODS, type SceneMessage, type Side, type Topology } from './protocol';
 
 const SKIN = new THREE.Color(0xe0a98f);
 /** Distortion that maps to the top of the heat scale (30 % mean edge-length change). */
@@ -204,7 +204,7 @@ export class HandScene {
       this.scene.remove(v.group);
       v.dispose();
     }
-    this.views = [0, 1, 2].map(() => new HandView(topology));
+    this.views = METHODS.map(() => new HandView(topology));
     for (const v of this.views) {
       this.place(v);
       this.scene.add(v.group);
@@ -264,7 +264,7 @@ export class HandScene {
 
   /**
    * Shows a frame: one hand per mesh in it, side by side; with a scene or in the world one
-   * hand (DQB in a split view: three hands side by side would not be where the objects are).
+   * hand (DQB in a split view: four hands side by side would not be where the objects are).
    */
   showFrame(frame: Frame): void {
     if (frame.header.second) return this.showSecond(frame);

@@ -175,19 +175,19 @@ describe('the viewer page', () => {
     expect(thumbDifference(dqb, qb)).toBeGreaterThan(2 * thumbDifference(dqb, again) + 0.5);
   });
 
-  test('the split view shows three hands, LB, QB and DQB', async () => {
+  test('the split view shows four hands, LB, QB, DQB and CoR', async () => {
     await page.check('#split');
-    await waitState(page, 's.visible.join() === "lb,qb,dqb" && s.frame.methods.length === 3');
+    await waitState(page, 's.visible.join() === "lb,qb,dqb,cor" && s.frame.methods.length === 4');
     await settle(page);
-    const stats = await canvasStats(page, 3);
-    const strip = (stats.width / 3) * stats.height;
+    const stats = await canvasStats(page, 4);
+    const strip = (stats.width / 4) * stats.height;
     for (const covered of stats.strips) expect(covered / strip).toBeGreaterThan(0.01);
-    expect(await page.locator('#labels span').allTextContents()).toEqual(['LB', 'QB', 'DQB']);
+    expect(await page.locator('#labels span').allTextContents()).toEqual(['LB', 'QB', 'DQB', 'COR']);
   });
 
   test('the heat map colours the distortion', async () => {
     await page.check('#heatmap');
-    await waitState(page, 's.frame && s.frame.methods.length === 3');
+    await waitState(page, 's.frame && s.frame.methods.length === 4');
     await page.waitForFunction(() => (window as unknown as { dqhand: { state(): { frame: { distortion: boolean } } } }).dqhand.state().frame.distortion);
     await settle(page);
     const reds = await countColour(page, { r: [181, 255], g: [0, 109], b: [0, 89] });
@@ -211,7 +211,7 @@ describe('the viewer page', () => {
     expect(blue).toBeGreaterThan(100); // the bones, drawn over the skin
     await page.uncheck('#skeleton');
     await page.check('#split');
-    await waitState(page, 's.visible.length === 3');
+    await waitState(page, 's.visible.length === 4');
   });
 
   test('the skinning controls follow a change the engine makes itself (as on an input gesture)', async () => {

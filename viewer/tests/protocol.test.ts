@@ -16,7 +16,7 @@ const fixture = (name: string): ArrayBuffer => {
 
 describe('frame', () => {
   test('decodes every field of the golden frame', () => {
-    const buffer = fixture('frame-v1.bin');
+    const buffer = fixture('frame-v2.bin');
     expect(binaryKind(buffer)).toBe('frame');
     const f = decodeFrame(buffer);
     expect(f.header).toMatchObject({
@@ -34,7 +34,7 @@ describe('frame', () => {
   });
 
   test('refuses truncated, padded, foreign and future frames', () => {
-    const buffer = fixture('frame-v1.bin');
+    const buffer = fixture('frame-v2.bin');
     const bytes = new Uint8Array(buffer);
     const variant = (edit: (b: Uint8Array) => Uint8Array) => edit(bytes.slice()).buffer as ArrayBuffer;
     const cases: [ArrayBuffer, RegExp][] = [
@@ -43,18 +43,19 @@ describe('frame', () => {
       [buffer.slice(0, 20), /truncated/],
       [variant((b) => ((b[0] = 0x58), b)), /wrong magic/],
       [variant((b) => ((b[4] = 9), b)), /version 9/],
-      [variant((b) => ((b[26] = 7), b)), /method code 7/],
-      [variant((b) => ((b[24] = 0), b)), /0 meshes/],
-      [variant((b) => ((b[7] = 1), b)), /unknown to version 1/],
-      [variant((b) => ((b[26] = b[25]), b)), /given twice/],
-      [variant((b) => ((b[27] = 0), b)), /method code 0 with 2 meshes/],
+      [variant((b) => ((b[4] = 1), b)), /version 1, this page knows 2/],
+      [variant((b) => ((b[25] = 7), b)), /mesh 1: method code 7/],
+      [variant((b) => ((b[24] = 255), b)), /no meshes/],
+      [variant((b) => ((b[7] = 1), b)), /unknown to version 2/],
+      [variant((b) => ((b[25] = b[24]), b)), /given twice/],
+      [variant((b) => ((b[27] = 0), b)), /mesh 3: method code 0 after the last mesh \(2\)/],
     ];
     for (const [b, message] of cases) expect(() => decodeFrame(b)).toThrow(message);
     expect(() => decodeFrame(buffer.slice(0, 20))).toThrow(ProtocolError);
   });
 
   test('flag bit 1 marks the second hand\'s frame', () => {
-    const bytes = new Uint8Array(fixture('frame-v1.bin')).slice();
+    const bytes = new Uint8Array(fixture('frame-v2.bin')).slice();
     bytes[6] |= 2;
     expect(decodeFrame(bytes.buffer).header).toMatchObject({ second: true, distortion: true, sequence: 7 });
   });
@@ -62,7 +63,7 @@ describe('frame', () => {
 
 describe('topology', () => {
   test('decodes the golden topology', () => {
-    const buffer = fixture('topology-v1.bin');
+    const buffer = fixture('topology-v2.bin');
     expect(binaryKind(buffer)).toBe('topology');
     const t = decodeTopology(buffer);
     expect(t.vertexCount).toBe(4);
@@ -72,15 +73,15 @@ describe('topology', () => {
   });
 
   test('the second hand\'s topology says hand 1; any other hand is refused', () => {
-    const bytes = new Uint8Array(fixture('topology-v1.bin')).slice();
+    const bytes = new Uint8Array(fixture('topology-v2.bin')).slice();
     bytes[6] = 1;
     expect(decodeTopology(bytes.slice().buffer).hand).toBe(1);
     bytes[6] = 2;
-    expect(() => decodeTopology(bytes.buffer)).toThrow(/unknown to version 1/);
+    expect(() => decodeTopology(bytes.buffer)).toThrow(/unknown to version 2/);
   });
 
   test('refuses an index past the vertices and a joint that is its own parent', () => {
-    const bytes = new Uint8Array(fixture('topology-v1.bin'));
+    const bytes = new Uint8Array(fixture('topology-v2.bin'));
     const badIndex = bytes.slice();
     new DataView(badIndex.buffer).setUint32(20, 4, true);
     expect(() => decodeTopology(badIndex.buffer)).toThrow(/index 4 with 4 vertices/);

@@ -1,6 +1,6 @@
 // The page with no dqhand process at all: viewer/dist on a plain static file server (as any
 // web host), the engine running in the page in WebAssembly. What the page offers with a server
-// works here too: the split view LB / QB / DQB, the heat map, gestures and sliders, the
+// works here too: the split view LB / QB / DQB / CoR, the heat map, gestures and sliders, the
 // timeline, WebXR under IWER (a Meta Quest 3 tracking hands) driving the page's engine, a scene
 // of two hands, and Record, which saves a file the browser downloads and `dqhand replay` reads.
 
@@ -68,9 +68,9 @@ describe('the page on a static host, its engine in WebAssembly', () => {
     await waitState(page, `s.frame.playing && s.frame.time > ${s.frame!.time + 0.2}`);
   });
 
-  test('the split view draws LB, QB and DQB, and the heat map is on their frames', async () => {
+  test('the split view draws LB, QB, DQB and CoR, and the heat map is on their frames', async () => {
     await page.check('#split');
-    await waitState(page, 's.visible.length === 3 && s.frame.methods.length === 3');
+    await waitState(page, 's.visible.length === 4 && s.frame.methods.length === 4');
     await page.check('#heatmap');
     await waitState(page, 's.frame.distortion');
     await page.uncheck('#heatmap');

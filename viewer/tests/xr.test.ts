@@ -91,8 +91,8 @@ describe('the WebXR input, with an emulated headset tracking hands', () => {
     await settle(page);
     desktop = await canvasPlace();
     restView = await canvasStats(page);
-    await page.check('#split'); // three hands on the desktop; in the world, one
-    await waitState(page, 's.visible.length === 3');
+    await page.check('#split'); // four hands on the desktop; in the world, one
+    await waitState(page, 's.visible.length === 4');
     await page.click('#enter-vr');
     await waitState(page, 's.xr.active && s.xr.mode === "immersive-vr" && s.xr.side === "right" && s.visible.join() === "dqb"');
     await waitState(page, 's.input && s.input.tracking === "tracking" && s.input.accepted > 10');

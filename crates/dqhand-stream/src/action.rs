@@ -11,7 +11,7 @@ use crate::{Error, Result};
 pub enum Action {
     /// Show the next skinning method alone.
     NextMethod,
-    /// Show LB, QB and DQB side by side.
+    /// Show all four methods side by side.
     SplitView,
     /// Toggle the distortion heat map.
     ToggleHeatmap,

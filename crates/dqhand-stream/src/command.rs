@@ -17,7 +17,7 @@ pub enum Command {
     },
     /// Which methods to show: one (single view) or several side by side (split view).
     View {
-        /// `lb`, `qb`, `dqb`; 1 to 3, no repeats.
+        /// `lb`, `qb`, `dqb`, `cor`; 1 to 4, no repeats.
         methods: Vec<String>,
     },
     /// Switch the joint model (`paper` or `full`); the server answers with a new hello.

@@ -1,4 +1,4 @@
-//! The binary wire format of the viewer stream, version 1: the mesh topology once, then one
+//! The binary wire format of the viewer stream, version 2: the mesh topology once, then one
 //! frame per engine step. Little-endian; every array starts on a 4-byte boundary, so the page
 //! reads it through `Float32Array` / `Uint32Array` views without copying.
 //!
@@ -13,7 +13,7 @@
 //! 0  u32 magic "DQHF"   4 u16 version   6 u16 flags (bit 0: distortion arrays follow;
 //!                                                   bit 1: of the second hand)
 //! 8  u32 sequence number   12 u32 vertex count   16 u32 joint count   20 u32 DOF count
-//! 24 u8 mesh count (1–3)   25 u8 method per mesh (0 LB, 1 QB, 2 DQB, 3 CoR; 255 unused) ×3
+//! 24 u8 method per mesh ×4 (0 LB, 1 QB, 2 DQB, 3 CoR; 255 past the last): 1–4 meshes
 //! 28 f32 engine time of this frame (pose + skin + distortion), µs
 //! 32 f32 frames per second the engine is sending   36 f32 timeline time, s
 //! 40 f32 timeline duration, s (0: no timeline)     44 u32 state (bit 0: playing; bit 1: limits on)
@@ -22,6 +22,10 @@
 //!    then per mesh: f32 positions[3 · vertex count], f32 normals[3 · vertex count],
 //!                   (flag 0) f32 distortion[vertex count]
 //! ```
+//!
+//! Version 1 held a mesh count at byte 24 and three method codes after it; version 2 holds
+//! four codes there, so the split view can show all four methods, and the layout is otherwise
+//! the same (the topology's too, whose version goes with the frame's).
 //!
 //! A server driving two hands (`dqhand demo --hands 2`) sends the second hand's topology after
 //! the first's and, each step, the second hand's frame after the first's; its hello's
@@ -57,7 +61,7 @@ use dqhand::skin::{Method, MethodSet};
 use crate::{Error, Result};
 
 /// Version of the format written here; a reader refuses any other.
-pub const VERSION: u16 = 1;
+pub const VERSION: u16 = 2;
 /// `"DQHF"` read as a little-endian `u32`.
 pub const FRAME_MAGIC: u32 = u32::from_le_bytes(*b"DQHF");
 /// `"DQHT"` read as a little-endian `u32`.
@@ -70,8 +74,10 @@ pub const TOPOLOGY_HEADER_BYTES: usize = 20;
 pub const FLAG_DISTORTION: u16 = 1;
 /// Frame flag: the frame is of the second hand (the hello's `second_hand`).
 pub const FLAG_SECOND_HAND: u16 = 2;
-/// Method code of a mesh slot the frame does not use.
+/// Method code of a mesh slot past the frame's last mesh.
 const UNUSED_METHOD: u8 = 255;
+/// Mesh slots of a frame: one per method.
+const SLOTS: usize = Method::ALL.len();
 /// State bit: the timeline is playing.
 pub const STATE_PLAYING: u32 = 1;
 /// State bit: angles are clamped to the anatomical limits.
@@ -88,7 +94,7 @@ pub struct FrameHeader {
     pub joint_count: u32,
     /// Angles in the pose.
     pub dof_count: u32,
-    /// The method of each mesh, in order (1–3 of them, distinct).
+    /// The method of each mesh, in order (1–4 of them, distinct).
     pub methods: MethodSet,
     /// Whether each mesh carries a distortion array.
     pub distortion: bool,
@@ -154,8 +160,7 @@ impl<'a> FrameWriter<'a> {
         for v in [h.sequence, h.vertex_count, h.joint_count, h.dof_count] {
             out.extend_from_slice(&v.to_le_bytes());
         }
-        out.push(h.mesh_count() as u8);
-        let mut codes = [UNUSED_METHOD; 3];
+        let mut codes = [UNUSED_METHOD; SLOTS];
         for (c, m) in codes.iter_mut().zip(h.methods.as_slice()) {
             *c = m.index() as u8;
         }
@@ -257,17 +262,18 @@ impl FrameView {
         let mut r = Reader { bytes, at: 0 };
         let flags = r.start(FRAME_MAGIC, "frame", FLAG_DISTORTION | FLAG_SECOND_HAND)?;
         let (sequence, vertex_count, joint_count, dof_count) = (r.u32()?, r.u32()?, r.u32()?, r.u32()?);
-        let codes = r.take(4)?;
-        let mesh_count = usize::from(codes[0]);
-        if mesh_count == 0 || mesh_count > 3 {
-            return Err(bad(format!("{mesh_count} meshes (1 to 3)")));
+        let codes = r.take(SLOTS)?;
+        let mesh_count = codes.iter().position(|&c| c == UNUSED_METHOD).unwrap_or(SLOTS);
+        if mesh_count == 0 {
+            return Err(bad("no meshes (method code 255 in the first slot)"));
         }
-        let mut methods = [Method::Dqb; 3];
-        for (i, &c) in codes[1..].iter().enumerate() {
+        let mut methods = [Method::Dqb; SLOTS];
+        for (i, &c) in codes.iter().enumerate() {
             match (i < mesh_count, Method::ALL.get(usize::from(c))) {
                 (true, Some(&m)) => methods[i] = m,
                 (false, _) if c == UNUSED_METHOD => {}
-                _ => return Err(bad(format!("mesh {i}: method code {c} with {mesh_count} meshes"))),
+                (true, None) => return Err(bad(format!("mesh {i}: method code {c}"))),
+                (false, _) => return Err(bad(format!("mesh {i}: method code {c} after the last mesh ({mesh_count})"))),
             }
         }
         let methods = MethodSet::new(&methods[..mesh_count]).map_err(|e| bad(e.to_string()))?;

@@ -323,8 +323,8 @@ impl Session {
     }
 
     /// Applies a gesture command to the view: `next_method` shows the method after the first
-    /// one in view alone (of all four), `split_view` shows the paper's LB, QB and DQB side by
-    /// side (a frame holds three meshes), `toggle_heatmap` turns the distortion heat map on or
+    /// one in view alone (of all four), `split_view` shows all four side by side,
+    /// `toggle_heatmap` turns the distortion heat map on or
     /// off.
     pub fn act(&mut self, action: Action) {
         match action {
@@ -333,7 +333,7 @@ impl Session {
                 let next = Method::ALL[(first.index() + 1) % Method::ALL.len()];
                 self.set_methods(MethodSet::new(&[next]).expect("one method is a valid set"));
             }
-            Action::SplitView => self.set_methods(MethodSet::PAPER),
+            Action::SplitView => self.set_methods(MethodSet::ALL),
             Action::ToggleHeatmap => self.heatmap = !self.heatmap,
         }
     }

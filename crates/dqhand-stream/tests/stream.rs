@@ -36,7 +36,7 @@ fn golden(name: &str, bytes: &[u8]) {
     assert_eq!(bytes, expected.as_slice(), "{name} differs from the golden file (format changed?)");
 }
 
-/// The frame in viewer/tests/fixtures/frame-v1.bin: 2 vertices, 2 joints, 3 DOFs, LB and DQB
+/// The frame in viewer/tests/fixtures/frame-v2.bin: 2 vertices, 2 joints, 3 DOFs, LB and DQB
 /// with distortion; every value distinct so a misplaced field shows.
 fn sample_frame() -> (FrameHeader, Vec<u8>) {
     let header = FrameHeader {
@@ -69,7 +69,7 @@ fn sample_frame() -> (FrameHeader, Vec<u8>) {
 #[test]
 fn frame_format_matches_the_golden_vector_and_reads_back() {
     let (header, bytes) = sample_frame();
-    golden("frame-v1.bin", &bytes);
+    golden("frame-v2.bin", &bytes);
     assert_eq!(bytes.len(), header.byte_len());
     assert_eq!(&bytes[..4], b"DQHF");
     let view = FrameView::parse(&bytes).unwrap();
@@ -85,13 +85,13 @@ fn frame_format_matches_the_golden_vector_and_reads_back() {
 fn topology_format_matches_the_golden_vector_and_reads_back() {
     let topology = Topology { hand: 0, vertex_count: 4, indices: vec![0, 1, 2, 2, 1, 3], parents: vec![None, Some(0), Some(1)] };
     let bytes = topology.encode();
-    golden("topology-v1.bin", &bytes);
+    golden("topology-v2.bin", &bytes);
     assert_eq!(Topology::parse(&bytes).unwrap(), topology);
     // The second hand's says so; there is no third.
     let second = Topology { hand: 1, ..topology.clone() };
     assert_eq!(Topology::parse(&second.encode()).unwrap(), second);
     let third = Topology { hand: 2, ..topology }.encode();
-    assert!(Topology::parse(&third).unwrap_err().to_string().contains("unknown to version 1"));
+    assert!(Topology::parse(&third).unwrap_err().to_string().contains("unknown to version 2"));
 }
 
 #[test]
@@ -111,23 +111,27 @@ fn malformed_messages_are_refused_with_the_reason() {
     let mut version = frame.clone();
     version[4] = 9;
     refuse(&version, "version 9");
+    // Version 1's frame, a mesh count before three codes, is refused by its version.
+    let mut v1 = frame.clone();
+    v1[4] = 1;
+    refuse(&v1, "version 1, this reader knows 2");
     let mut method = frame.clone();
-    method[26] = 7;
-    refuse(&method, "method code 7");
-    let mut count = frame.clone();
-    count[24] = 0;
-    refuse(&count, "0 meshes (1 to 3)");
+    method[25] = 7;
+    refuse(&method, "mesh 1: method code 7");
+    let mut none = frame.clone();
+    none[24] = 255;
+    refuse(&none, "no meshes");
     // Issue 9 bug 4: a repeated method, or a gap in the list, is refused.
     let mut repeated = frame.clone();
-    repeated[26] = repeated[25];
+    repeated[25] = repeated[24];
     refuse(&repeated, "given twice");
-    // Found by fuzzing: flag bits a v1 reader does not know could change the layout.
+    // Found by fuzzing: flag bits a reader does not know could change the layout.
     let mut flags = frame.clone();
     flags[7] = 1;
-    refuse(&flags, "unknown to version 1");
+    refuse(&flags, "unknown to version 2");
     let mut gap = frame.clone();
-    gap[25] = 255;
-    refuse(&gap, "method code 255");
+    (gap[25], gap[26]) = (255, 1);
+    refuse(&gap, "mesh 2: method code 1 after the last mesh (1)");
 
     let topology = Topology { hand: 0, vertex_count: 2, indices: vec![0, 1, 2], parents: vec![None] }.encode();
     assert!(Topology::parse(&topology).unwrap_err().to_string().contains("index 2 with 2 vertices"));
@@ -139,7 +143,7 @@ fn malformed_messages_are_refused_with_the_reason() {
 proptest! {
     #[test]
     fn frames_round_trip(
-        vertices in 0u32..20, joints in 0u32..5, dofs in 0u32..6, meshes in 1usize..=3,
+        vertices in 0u32..20, joints in 0u32..5, dofs in 0u32..6, meshes in 1usize..=4,
         distortion: bool, second: bool, sequence: u32, time in 0f32..100.0, seed in 0u32..1000,
     ) {
         let order: Vec<Method> = (0..meshes).map(|i| Method::ALL[(i + seed as usize) % Method::ALL.len()]).collect();
@@ -409,8 +413,8 @@ fn following_an_input_of_another_joint_model_takes_the_shared_angles() {
     assert_eq!(frame(&mut s).header.state & STATE_PLAYING, 0);
 }
 
-/// Gesture commands change the view: the next method alone (cycling through all four), the
-/// paper's three side by side, the heat map.
+/// Gesture commands change the view: the next method alone (cycling through all four), all
+/// four side by side, the heat map.
 #[test]
 fn gesture_commands_change_the_view() {
     use dqhand_stream::Action;
@@ -422,7 +426,8 @@ fn gesture_commands_change_the_view() {
         assert_eq!(shown(&s), [expected]);
     }
     s.act(Action::SplitView);
-    assert_eq!(shown(&s), Method::PAPER);
+    assert_eq!(shown(&s), Method::ALL);
+    assert_eq!(frame(&mut s).meshes.len(), 4);
     s.act(Action::NextMethod);
     assert_eq!(shown(&s), [Method::Qb], "after the first of the split view");
     assert!(!s.heatmap());

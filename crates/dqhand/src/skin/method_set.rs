@@ -3,10 +3,10 @@
 use super::Method;
 use crate::{Error, Result};
 
-/// One to three distinct skinning methods (of the four) in display order.
+/// One to four distinct skinning methods in display order.
 ///
 /// A gap or a repeat cannot be represented, so whatever holds one (a viewer's view, a frame
-/// header) always describes 1–3 meshes.
+/// header) always describes 1–4 meshes.
 ///
 /// ```
 /// use dqhand::skin::{Method, MethodSet};
@@ -22,25 +22,27 @@ use crate::{Error, Result};
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct MethodSet {
-    methods: [Method; 3],
+    methods: [Method; 4],
     len: u8,
 }
 
 impl MethodSet {
     /// DQB alone: the paper's method.
-    pub const DQB: Self = Self { methods: [Method::Dqb; 3], len: 1 };
+    pub const DQB: Self = Self { methods: [Method::Dqb; 4], len: 1 };
     /// LB, QB and DQB, in the paper's order.
-    pub const PAPER: Self = Self { methods: Method::PAPER, len: 3 };
+    pub const PAPER: Self = Self { methods: [Method::Lb, Method::Qb, Method::Dqb, Method::Dqb], len: 3 };
+    /// All four, the paper's three and CoR: the split view.
+    pub const ALL: Self = Self { methods: Method::ALL, len: 4 };
 
     /// The methods given, in that order.
     ///
     /// # Errors
-    /// [`Error::Methods`] if there are none, more than three, or one is repeated.
+    /// [`Error::Methods`] if there are none, more than four, or one is repeated.
     pub fn new(methods: &[Method]) -> Result<Self> {
-        if methods.is_empty() || methods.len() > 3 {
-            return Err(Error::Methods(format!("{} methods (1 to 3)", methods.len())));
+        if methods.is_empty() || methods.len() > Method::ALL.len() {
+            return Err(Error::Methods(format!("{} methods (1 to 4)", methods.len())));
         }
-        let mut set = Self { methods: [methods[0]; 3], len: 0 };
+        let mut set = Self { methods: [methods[0]; 4], len: 0 };
         for &m in methods {
             if set.contains(m) {
                 return Err(Error::Methods(format!("method {:?} given twice", m.as_str())));
@@ -66,7 +68,7 @@ impl MethodSet {
         &self.methods[..usize::from(self.len)]
     }
 
-    /// How many methods (1 to 3).
+    /// How many methods (1 to 4).
     #[must_use]
     pub fn len(&self) -> usize {
         usize::from(self.len)
