@@ -15,7 +15,7 @@ HAND_FILES := viewer/public/hands/right.glb viewer/public/hands/left.glb
 # The engine's web builds as the npm package and the page load them (make package-wasm).
 PACKAGE_WASM := $(addprefix packages/dqhand/wasm/,dqhand_wasm.js dqhand_wasm.d.ts dqhand_wasm_bg.wasm dqhand_wasm_simd_bg.wasm)
 
-.PHONY: demo test build viewer assets chromium figures bench bench-web bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs python synth-figure
+.PHONY: demo test build viewer assets chromium figures bench bench-web bench-mediapipe bench-peers loadtest fuzz clean recordings features examples gestures wasm-check wasm package-wasm package dqs-package bench-dqs python synth-figure
 
 # The live viewer on the built-in hand: prints the URL (and opens a browser when there is a desktop).
 demo: build viewer
@@ -216,6 +216,12 @@ bench-dqs: build chromium dqs-package
 # (docs/performance.md, "The engine in the browser").
 bench-web: build viewer chromium recordings
 	cd viewer && CHROMIUM=$(CHROMIUM) node scripts/bench-web.mjs
+
+# MediaPipe Hands on 100 random views of the built-in hand in the library's gestures, in the
+# page (docs/realism.md, "Does MediaPipe see it?"); SEED=2 for the second set.
+SEED ?= 1
+bench-mediapipe: viewer chromium
+	cd viewer && CHROMIUM=$(CHROMIUM) node scripts/mediapipe-views.mjs --seed $(SEED) --json $(CURDIR)/target/mediapipe-views-$(SEED).json
 
 # The viewer server under load and abuse (1, 10, 64 viewers; malformed flood; slowloris; a
 # slow reader), measured; `make test` runs a short version that asserts behaviour only.

@@ -5,7 +5,7 @@ import './style.css';
 import { Vector3 } from 'three';
 import { Connection, type ConnectionEvents } from './connection';
 import { heldText, InputPanel } from './input';
-import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
+import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHOD_LABELS, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
 import { LocalConnection, type RelaySetup } from './local';
 import { InputSender } from './sender';
@@ -361,7 +361,7 @@ function loop(now: number, xrFrame?: XRFrame): void {
     const h = frame.header;
     $('stats').textContent =
       `page ${pageFps.toFixed(0)} fps   engine ${h.engineFps.toFixed(0)} fps\n` +
-      `engine ${(engineUs / 1000).toFixed(2)} ms/frame (${h.methods.join(' + ').toUpperCase()})\n` +
+      `engine ${(engineUs / 1000).toFixed(2)} ms/frame (${h.methods.map((m) => METHOD_LABELS[m]).join(' + ')})\n` +
       `${(frame.byteLength / 1024).toFixed(0)} KiB/frame, ${h.vertexCount.toLocaleString()} vertices`;
     const labels = h.methods.length > 1 || figure ? scene.labelPositions() : [];
     const spans = $('labels');
@@ -369,7 +369,7 @@ function loop(now: number, xrFrame?: XRFrame): void {
     while (spans.childElementCount > labels.length) spans.lastElementChild!.remove();
     labels.forEach(({ method, x, y }, i) => {
       const span = spans.children[i] as HTMLElement;
-      span.textContent = (method ?? '').toUpperCase();
+      span.textContent = method ? METHOD_LABELS[method] : '';
       span.style.left = `${x}px`;
       span.style.top = `${y}px`;
     });
@@ -398,6 +398,7 @@ window.dqhand = {
     errors: [...errors],
     jointModel: hello?.joint_model ?? null,
     dofs: hello?.dofs.map((d) => d.name) ?? [],
+    gestures: hello ? [...hello.gestures] : [],
     joints: hello ? [...hello.joints] : [],
     pageFps,
     visible: scene.visibleMethods(),
@@ -436,6 +437,8 @@ window.dqhand = {
     },
   }),
   send: (command: Command) => connection.send(command),
+  /** Where each joint (`state().joints` order) of the first visible hand is drawn: fractions of the canvas from its top left. */
+  jointsOnScreen: () => scene.jointsOnScreen(),
   /** Draws the second hand or leaves it out, to see what it draws. */
   showSecondHand: (on: boolean) => scene.showSecondHand(on),
   setting: (command: Command) => connection.setting(command),

@@ -14,6 +14,10 @@ export const STATE_PLAYING = 1;
 export const STATE_LIMITS = 2;
 export const METHODS = ['lb', 'qb', 'dqb', 'cor'] as const;
 export type Method = (typeof METHODS)[number];
+/** How the page names each method. */
+export const METHOD_LABELS: Record<Method, string> = { lb: 'LB', qb: 'QB', dqb: 'DQB', cor: 'CoR' };
+/** Mesh slots of a frame (bytes 24-27), fixed by the format's version: a fifth method fails this type check rather than change the layout. */
+const MESH_SLOTS = METHODS.length satisfies 4;
 
 export class ProtocolError extends Error {}
 
@@ -304,9 +308,10 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
   if (buffer.byteLength < FRAME_HEADER_BYTES) throw new ProtocolError(`frame of ${buffer.byteLength} bytes is truncated`);
   const flags = checkStart(view, FRAME_MAGIC, 'frame', FLAG_DISTORTION | FLAG_SECOND_HAND);
   // Bytes 24-27: one method code per mesh, 255 past the last.
-  const codes = METHODS.map((_, i) => view.getUint8(24 + i));
+  const codes = Array.from({ length: MESH_SLOTS }, (_, i) => view.getUint8(24 + i));
   const meshCount = codes.includes(UNUSED_METHOD) ? codes.indexOf(UNUSED_METHOD) : codes.length;
   if (meshCount === 0) throw new ProtocolError('no meshes (method code 255 in the first slot)');
+  // In the reference's order: each code, then repeats.
   const methods: Method[] = [];
   codes.forEach((code, i) => {
     if (i >= meshCount) {
@@ -315,9 +320,10 @@ export function decodeFrame(buffer: ArrayBuffer): Frame {
     }
     const m = METHODS[code];
     if (m === undefined) throw new ProtocolError(`mesh ${i}: method code ${code}`);
-    if (methods.includes(m)) throw new ProtocolError(`method "${m}" given twice`);
     methods.push(m);
   });
+  const repeated = methods.find((m, i) => methods.indexOf(m) !== i);
+  if (repeated !== undefined) throw new ProtocolError(`method "${repeated}" given twice`);
   const state = view.getUint32(44, true);
   const header: FrameHeader = {
     sequence: view.getUint32(8, true),

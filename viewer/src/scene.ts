@@ -355,6 +355,15 @@ export class HandScene {
     return first.oriented.localToWorld(new THREE.Vector3(f.joints[3 * index], f.joints[3 * index + 1], f.joints[3 * index + 2]));
   }
 
+  /** Where each joint of the first visible hand is drawn, as fractions of the canvas from its top left (to grade a tracker run on the canvas). */
+  jointsOnScreen(): [number, number][] {
+    const joints = (this.lastFrame?.joints.length ?? 0) / 3;
+    return Array.from({ length: joints }, (_, i) => {
+      const p = this.jointPosition(i)!.project(this.camera);
+      return [(p.x + 1) / 2, (1 - p.y) / 2] as [number, number];
+    });
+  }
+
   /** Screen position (CSS pixels) of each visible hand's centre, for the method labels. */
   labelPositions(): { method: Method | null; x: number; y: number }[] {
     const rect = this.canvas.getBoundingClientRect();

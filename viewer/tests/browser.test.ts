@@ -182,7 +182,7 @@ describe('the viewer page', () => {
     const stats = await canvasStats(page, 4);
     const strip = (stats.width / 4) * stats.height;
     for (const covered of stats.strips) expect(covered / strip).toBeGreaterThan(0.01);
-    expect(await page.locator('#labels span').allTextContents()).toEqual(['LB', 'QB', 'DQB', 'COR']);
+    expect(await page.locator('#labels span').allTextContents()).toEqual(['LB', 'QB', 'DQB', 'CoR']);
   });
 
   test('the heat map colours the distortion', async () => {

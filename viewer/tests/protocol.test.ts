@@ -49,6 +49,8 @@ describe('frame', () => {
       [variant((b) => ((b[7] = 1), b)), /unknown to version 2/],
       [variant((b) => ((b[25] = b[24]), b)), /given twice/],
       [variant((b) => ((b[27] = 0), b)), /mesh 3: method code 0 after the last mesh \(2\)/],
+      // Codes before repeats, as the reference (crates/dqhand-stream/tests/stream.rs).
+      [variant((b) => (b.set([0, 0, 255, 1], 24), b)), /mesh 3: method code 1 after the last mesh \(2\)/],
     ];
     for (const [b, message] of cases) expect(() => decodeFrame(b)).toThrow(message);
     expect(() => decodeFrame(buffer.slice(0, 20))).toThrow(ProtocolError);

@@ -1,6 +1,7 @@
 //! `dqhand bench --stream`: the viewer stream end to end. A server thread runs the real
-//! WebSocket endpoint on a loopback port; a client in this process asks for the split view
-//! (LB, QB and DQB of every frame), acknowledges each frame as the page does, and counts what
+//! WebSocket endpoint on a loopback port; a client in this process asks for the paper's three
+//! methods side by side (LB, QB and DQB of every frame, as the figures in performance.md were
+//! measured; the viewer's split view adds CoR), acknowledges each frame as the page does, and counts what
 //! arrives. Reported: frames per second achieved against the target rate, the engine's own
 //! time per frame (pose, three deformations, optional heat map) as median and 90th percentile,
 //! and the bytes streamed.
@@ -77,7 +78,7 @@ pub fn run(model: Model, seconds: f64, json_out: bool) -> anyhow::Result<()> {
         println!("{}", json!({ "vertices": vertices, "methods": ["lb", "qb", "dqb"], "seconds": seconds, "runs": runs }));
         return Ok(());
     }
-    println!("viewer stream, split view (LB + QB + DQB per frame), {vertices} vertices, loopback WebSocket, {seconds} s per run");
+    println!("viewer stream, the paper's three side by side (LB + QB + DQB per frame), {vertices} vertices, loopback WebSocket, {seconds} s per run");
     println!("{:<12} {:<8} {:>10} {:>16} {:>10} {:>8}", "target fps", "heat map", "fps", "engine median µs", "p90 µs", "MiB/s");
     for (r, fps, med, p90, mib) in &rows {
         let target = if r.target_fps >= 1000.0 { "as fast".to_string() } else { format!("{}", r.target_fps) };

@@ -437,7 +437,7 @@ fn the_input_socket_drives_the_viewers_and_gestures_act_as_commands() {
     for a in &expected_actions {
         match *a {
             "next_method" => methods = vec![["qb", "dqb", "cor", "lb"][["lb", "qb", "dqb", "cor"].iter().position(|m| *m == methods[0]).unwrap()]],
-            "split_view" => methods = vec!["lb", "qb", "dqb"],
+            "split_view" => methods = vec!["lb", "qb", "dqb", "cor"],
             _ => {}
         }
     }

@@ -76,8 +76,10 @@ pub const FLAG_DISTORTION: u16 = 1;
 pub const FLAG_SECOND_HAND: u16 = 2;
 /// Method code of a mesh slot past the frame's last mesh.
 const UNUSED_METHOD: u8 = 255;
-/// Mesh slots of a frame: one per method.
-const SLOTS: usize = Method::ALL.len();
+/// Mesh slots of a frame (bytes 24–27): fixed by the version, one per method today; a fifth
+/// method would need a new version, so this stops the build rather than change the layout.
+const SLOTS: usize = 4;
+const _: () = assert!(SLOTS == Method::ALL.len());
 /// State bit: the timeline is playing.
 pub const STATE_PLAYING: u32 = 1;
 /// State bit: angles are clamped to the anatomical limits.

@@ -284,8 +284,6 @@ impl Session {
                 finite("seek", &[*time])?;
                 self.transition = None;
                 self.time = time.clamp(0.0, self.timeline.duration());
-                // The pose seeked to is shown as it is, whatever was shown before.
-                self.engines().for_each(|e| e.skin_mut().forget_previous_frame());
                 self.sample_timeline();
             }
             Command::Heatmap { on } => self.heatmap = *on,

@@ -132,6 +132,10 @@ fn malformed_messages_are_refused_with_the_reason() {
     let mut gap = frame.clone();
     (gap[25], gap[26]) = (255, 1);
     refuse(&gap, "mesh 2: method code 1 after the last mesh (1)");
+    // Codes are checked before repeats, as the page's reader does (viewer/tests/protocol.test.ts).
+    let mut order = frame.clone();
+    order[24..28].copy_from_slice(&[0, 0, 255, 1]);
+    refuse(&order, "mesh 3: method code 1 after the last mesh (2)");
 
     let topology = Topology { hand: 0, vertex_count: 2, indices: vec![0, 1, 2], parents: vec![None] }.encode();
     assert!(Topology::parse(&topology).unwrap_err().to_string().contains("index 2 with 2 vertices"));

@@ -273,8 +273,18 @@ impl Skinner {
         self.out = if on { Deformed::new(&self.mesh) } else { Deformed::positions_only(&self.mesh) };
     }
 
+    /// The next [`Self::deform`] does not follow the last one: its quaternion signs take the
+    /// shortest path, as after [`Self::set_method`] (`Deformer::forget_previous_frame`).
+    #[wasm_bindgen(js_name = forgetPreviousFrame)]
+    pub fn forget_previous_frame(&mut self) {
+        self.deformer.forget_previous_frame();
+    }
+
     /// Deforms the skin by `transforms`: per joint the skinning transform (world × inverse
-    /// bind) as the 3 × 4 matrix `[R | t]`, row by row (12 floats). Allocates nothing.
+    /// bind) as the 3 × 4 matrix `[R | t]`, row by row (12 floats). Allocates nothing. Each
+    /// call follows the one before it, as frames of one motion do: a joint twisted past 180°
+    /// in steps of under 60° is blended the way it turned (up to 270°); a pose unrelated to the
+    /// last wants [`Self::forget_previous_frame`] first.
     ///
     /// # Errors
     /// Another length than 12 × `jointCount`, or a number that is not finite; the skin keeps

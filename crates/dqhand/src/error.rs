@@ -66,7 +66,7 @@ pub enum Error {
     /// No skin lies around a joint whose region is measured.
     #[error("joint {0:?}: no skin around it to measure")]
     NoSkin(String),
-    /// A list of skinning methods is empty, longer than three, or repeats one.
+    /// A list of skinning methods is empty, longer than four, or repeats one.
     #[error("{0}")]
     Methods(String),
     /// An input configuration (filters, dropouts, tracker mount, gesture commands) is invalid.

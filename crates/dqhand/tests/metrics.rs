@@ -4,6 +4,7 @@
 use dqhand::hand::{build, HandParams};
 use dqhand::geometry::{check_closed, edges, enclosed_volume, winding_number};
 use dqhand::metrics::{edge_distortion, measure};
+use dqhand::skin::Method;
 
 /// A unit cube, outward-facing triangles.
 fn cube() -> (Vec<[f32; 3]>, Vec<u32>) {
@@ -110,18 +111,18 @@ fn a_twist_past_180_degrees_flips_each_frame_alone_and_is_followed_frame_by_fram
     let twist = report.sweep("index-pip-twist").unwrap();
     let flip = twist.values.iter().position(|&v| v == 180.0).unwrap();
     let largest = |jumps: &mut dyn Iterator<Item = f32>| jumps.fold(0.0, f32::max);
-    for m in [1, 2, 3] {
-        let frames = &twist.frames[m];
+    for m in [Method::Qb, Method::Dqb, Method::Cor] {
+        let frames = &twist.frames[m.index()];
         // Alone, at 180° the twisted bone's rotation leaves the hemisphere of its neighbour's,
         // the nearer sign switches, and the skin jumps to the other side.
         let alone = largest(&mut frames[1..].iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, f)| f.jump_alone));
-        assert!(frames[flip].jump_alone > 3.0 * alone, "method {m}, alone: jump at 170→180°: {}, largest elsewhere: {alone}", frames[flip].jump_alone);
+        assert!(frames[flip].jump_alone > 3.0 * alone, "{m}, alone: jump at 170→180°: {}, largest elsewhere: {alone}", frames[flip].jump_alone);
         // Followed, the sign is kept and 180° is a step like the others.
         let followed = largest(&mut frames[1..].iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, f)| f.jump));
-        assert!(frames[flip].jump < 1.5 * followed && frames[flip].jump < 0.2 * frames[flip].jump_alone, "method {m}, followed: jump at 170→180°: {}, largest elsewhere: {followed}", frames[flip].jump);
+        assert!(frames[flip].jump < 1.5 * followed && frames[flip].jump < 0.2 * frames[flip].jump_alone, "{m}, followed: jump at 170→180°: {}, largest elsewhere: {followed}", frames[flip].jump);
     }
     // DQB's radius itself is kept all the way.
-    assert!(twist.frames[2].iter().all(|f| f.section_radius > 0.9), "{:?}", twist.frames[2]);
+    assert!(twist.frames[Method::Dqb.index()].iter().all(|f| f.section_radius > 0.9), "{:?}", twist.frames[Method::Dqb.index()]);
 }
 
 #[test]

@@ -442,7 +442,7 @@ fn the_built_in_hand_is_grouped_by_influence_count() {
 }
 
 #[test]
-fn a_skin_layer_follows_a_twist_until_told_to_forget() {
+fn a_skin_layer_follows_a_twist_until_told_to_forget_and_a_method_joining_follows_it_too() {
     // The cylinder twisted 0–190° in 10° steps through a skin layer, then the 190° frame
     // again after forgetting: followed, it is the way it turned (the opposite side of the
     // shortest way's 170°), forgotten it is what a new layer shows of 190°.
@@ -460,4 +460,20 @@ fn a_skin_layer_follows_a_twist_until_told_to_forget() {
     followed.forget_previous_frame();
     followed.deform(&twist(190.0)[..]);
     assert_eq!(at(&followed), at(&fresh));
+
+    // A method joining the set follows the frames the set deformed: QB shown beside DQB from
+    // 190° on is the QB that followed the whole twist itself, not the shortest way's.
+    let layer = |methods: &[Method]| SkinLayer::new(Arc::clone(&mesh), MethodSet::new(methods).unwrap());
+    let (mut joined, mut alone, mut fresh_qb) = (layer(&[Method::Dqb]), layer(&[Method::Qb]), layer(&[Method::Qb]));
+    for step in 0..=18 {
+        joined.deform(&twist(10.0 * step as f32)[..]);
+        alone.deform(&twist(10.0 * step as f32)[..]);
+    }
+    joined.set_methods(MethodSet::new(&[Method::Dqb, Method::Qb]).unwrap());
+    joined.deform(&twist(190.0)[..]);
+    alone.deform(&twist(190.0)[..]);
+    fresh_qb.deform(&twist(190.0)[..]);
+    let qb = |layer: &SkinLayer| layer.deformed(Method::Qb).unwrap().positions().to_vec();
+    assert_eq!(qb(&joined), qb(&alone));
+    assert!(gap(&qb(&joined), &qb(&fresh_qb)) > 0.5, "QB joining at 190° should follow the twist");
 }

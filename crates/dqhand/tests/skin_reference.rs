@@ -340,12 +340,13 @@ fn a_twist_past_180_degrees_is_followed_the_way_it_turned_up_to_270() {
     // Twisted frame by frame in 10° steps, every method on every kernel blends joint 1 the
     // way it turned while the twist is under 270° and the shortest way past it. A jump
     // (355° to 185°) takes the shortest way, −175°; the next step, to −185°, is followed on
-    // that way; after a forgotten frame, −195° is the shortest way's 165°.
+    // that way; after a forgotten frame, −195° is the shortest way's 165°. From there a jump of
+    // 75° to 240° takes the shortest way, −120°, and steps of 40° and 55° are followed to −215°.
     let kernels = support::kernels::kernels();
     let mesh = mesh(&twisted(0.0).0, 4);
     // (twist, blended the way it turned, the previous frame forgotten)
     let mut frames: Vec<(f64, bool, bool)> = (0..36).map(|step| 5.0 + 10.0 * f64::from(step)).map(|d| (d, d < 270.0, false)).collect();
-    frames.extend([(185.0, false, false), (-185.0, true, false), (-195.0, false, true)]);
+    frames.extend([(185.0, false, false), (-185.0, true, false), (-195.0, false, true), (240.0, false, false), (-160.0, true, false), (-215.0, true, false)]);
     for (kernel, strategy) in paths(&kernels) {
         for method in Method::ALL {
             let mut deformer = deformer(method, &mesh, kernel, strategy);

@@ -3,7 +3,7 @@
 //! Volume against rest, collapse and bulge near a bent joint, the candy wrapper of a twisted
 //! joint, edge-length distortion, the continuity of sweeps, and self-intersections and
 //! self-contact (how deep skin goes into skin, and the space it shares) in gesture poses, each
-//! for the three methods.
+//! for the four methods.
 
 mod distortion;
 mod joint_region;

@@ -85,7 +85,7 @@ pub struct FrameMetrics {
     pub self_contact: Option<SelfContact>,
 }
 
-/// One sweep measured under the three methods.
+/// One sweep measured under the four methods.
 #[derive(Clone, Debug)]
 pub struct Sweep {
     /// Sweep name (`index-pip`, …).

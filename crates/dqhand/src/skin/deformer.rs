@@ -304,6 +304,15 @@ impl Deformer {
         self.signs.forget();
     }
 
+    /// The next deformation follows the frames `other` deformed, as if this deformer had
+    /// deformed them: QB, DQB and CoR of one mesh choose their signs from the same rotations.
+    /// Nothing where either is LB (no signs).
+    pub(crate) fn follow(&mut self, other: &Deformer) {
+        if self.method != Method::Lb && other.method != Method::Lb {
+            self.signs.follow(&other.signs);
+        }
+    }
+
     /// Step 1 of paper 4.4 for this frame: bone parameters, pair signs, lookup tables.
     fn prepare(&mut self, mesh: &SkinnedMesh, bones: Bones<'_>) {
         let skinning = bones.skinning;

@@ -11,8 +11,6 @@
 //! since, so a joint twisted 190° is blended the way it turned; a pose far from the last one
 //! (a seek, a new clip, the first frame) takes the shortest path.
 
-use glam::Quat;
-
 /// Largest change of a pair's relative rotation between two frames that is still followed,
 /// as the cosine of half that angle (60°): far past any hand's motion at 60 frames a second,
 /// and far below the 180° at which the previous frame says nothing.
@@ -28,14 +26,15 @@ const LONGEST: f32 = -0.707_106_8;
 pub(crate) struct PairSigns {
     /// `signs[0]` the heaviest joint's own (+1), `signs[1 + i]` for pair `i`.
     signs: Vec<f32>,
-    /// Per pair, `conj(q_heaviest) · s q_other` of the last frame (identity when none).
-    last: Vec<Quat>,
+    /// Per pair, `conj(q_heaviest) · s q_other` of the last frame, `[x, y, z, w]` (the
+    /// identity when none).
+    last: Vec<[f32; 4]>,
 }
 
 impl PairSigns {
     /// Signs for `pairs` pairs, with no previous frame.
     pub(crate) fn new(pairs: usize) -> Self {
-        Self { signs: vec![1.0; pairs + 1], last: vec![Quat::IDENTITY; pairs] }
+        Self { signs: vec![1.0; pairs + 1], last: vec![IDENTITY; pairs] }
     }
 
     /// The signs of the last [`Self::update`], heaviest joint's first.
@@ -45,22 +44,23 @@ impl PairSigns {
 
     /// The next frame does not follow the last: it takes the shortest path.
     pub(crate) fn forget(&mut self) {
-        self.last.fill(Quat::IDENTITY);
+        self.last.fill(IDENTITY);
     }
 
     /// This frame's signs from the joints' parameters (a rotation `[x, y, z, w]` first) and
-    /// the pairs `(heaviest, other)`. Allocates nothing.
+    /// the pairs `(heaviest, other)`. Allocates nothing; the product is written out in plain
+    /// `f32` (no library's SIMD), so that every target decides a threshold alike.
     ///
     /// # Panics
     /// If made for another number of pairs.
     pub(crate) fn update<const W: usize>(&mut self, params: &[[f32; W]], pairs: &[(u16, u16)]) {
         assert_eq!(self.last.len(), pairs.len(), "deformer made for another mesh");
         for ((sign, last), &(h, j)) in self.signs[1..].iter_mut().zip(&mut self.last).zip(pairs) {
-            let (a, b) = (&params[usize::from(h)], &params[usize::from(j)]);
-            // The relative rotation's w: the hemisphere test of the shortest path.
-            let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-            let relative = Quat::from_xyzw(a[0], a[1], a[2], a[3]).conjugate() * Quat::from_xyzw(b[0], b[1], b[2], b[3]);
-            let along = relative.dot(*last);
+            let ([ax, ay, az, aw], [bx, by, bz, bw]) = (first4(&params[usize::from(h)]), first4(&params[usize::from(j)]));
+            // conj(a) · b; its w is the hemisphere test of the shortest path.
+            let dot = ax * bx + ay * by + az * bz + aw * bw;
+            let relative = [aw * bx - ax * bw - ay * bz + az * by, aw * by + ax * bz - ay * bw - az * bx, aw * bz - ax * by + ay * bx - az * bw, dot];
+            let along = relative[0] * last[0] + relative[1] * last[1] + relative[2] * last[2] + relative[3] * last[3];
             let followed = if along < 0.0 { -1.0 } else { 1.0 };
             *sign = if along.abs() >= FOLLOW && followed * dot >= LONGEST {
                 followed
@@ -69,15 +69,30 @@ impl PairSigns {
             } else {
                 1.0
             };
-            *last = relative * *sign;
+            *last = relative.map(|c| c * *sign);
         }
     }
+
+    /// Takes `other`'s state, as if this one had deformed the frames `other` did (QB, DQB and
+    /// CoR of one mesh share the rotations the signs are chosen from). Allocates nothing when
+    /// made for the same mesh.
+    pub(crate) fn follow(&mut self, other: &Self) {
+        self.signs.clone_from(&other.signs);
+        self.last.clone_from(&other.last);
+    }
+}
+
+/// The identity rotation, `[x, y, z, w]`.
+const IDENTITY: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
+
+fn first4<const W: usize>(p: &[f32; W]) -> [f32; 4] {
+    [p[0], p[1], p[2], p[3]]
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
+    use glam::{Quat, Vec3};
 
     /// Joint 0 still, joint 1 twisted by `degrees` about X, each as `[x, y, z, w]` with w ≥ 0
     /// (the sign a matrix conversion gives, whatever the way it turned).
@@ -110,6 +125,16 @@ mod tests {
         assert_eq!(s.as_slice()[1], -1.0, "followed to 185°");
         s.update(&params(60.0), &[(0, 1)]);
         assert_eq!(s.as_slice()[1], 1.0, "a jump back to 60° takes the shortest path");
+        // A step of 70° past 180°: following would keep −1 (255° the way it turned); the
+        // jump takes the shortest path, −105°. A step of 55° is followed.
+        for degrees in [175.0, 185.0, 255.0] {
+            s.update(&params(degrees), &[(0, 1)]);
+        }
+        assert_eq!(s.as_slice()[1], 1.0, "a jump of 70° from 185° to 255° takes the shortest path");
+        for degrees in [175.0, 185.0, 240.0] {
+            s.update(&params(degrees), &[(0, 1)]);
+        }
+        assert_eq!(s.as_slice()[1], -1.0, "a step of 55° from 185° to 240° is followed");
         for degrees in [175.0, 185.0] {
             s.update(&params(degrees), &[(0, 1)]);
         }

@@ -55,12 +55,15 @@ impl SkinLayer {
     }
 
     /// The methods [`Self::deform`] runs; a method new to the layer gets its buffers here. A
-    /// method back in the set follows the frame it last deformed where that is near enough
-    /// ([`Deformer::deform`]).
+    /// method joining the set follows the frames the set deformed (a joint twisted past 180°
+    /// stays the way it turned in every view: [`Deformer::deform`]).
     pub fn set_methods(&mut self, methods: MethodSet) {
-        self.methods = methods;
+        let before = std::mem::replace(&mut self.methods, methods);
         for &m in methods.as_slice() {
             self.deformer(m);
+            if !before.contains(m) {
+                self.follow_the_set(m, before);
+            }
             if self.outputs[m.index()].is_none() {
                 self.outputs[m.index()] = Some(Deformed::new(&self.mesh));
             }
@@ -71,6 +74,15 @@ impl SkinLayer {
     /// [`Deformer::forget_previous_frame`].
     pub fn forget_previous_frame(&mut self) {
         self.deformers.iter_mut().flatten().for_each(Deformer::forget_previous_frame);
+    }
+
+    /// `method`'s deformer takes the hemisphere signs of the first method of `set` that has
+    /// them (not LB, not `method` itself). Allocates nothing.
+    fn follow_the_set(&mut self, method: Method, set: MethodSet) {
+        let Some(&source) = set.as_slice().iter().find(|&&m| m != Method::Lb && m != method) else { return };
+        if let Ok([Some(to), Some(from)]) = self.deformers.get_disjoint_mut([method.index(), source.index()]) {
+            to.follow(from);
+        }
     }
 
     /// `method`'s deformer, made the first time (allocates then only).

@@ -15,7 +15,8 @@ pub enum Strategy {
     /// One two-source permute per parameter from a component-major table of the frame's
     /// parameters, two registers per component: skins of at most 32 joints.
     Permute,
-    /// One gather per parameter from the parameter rows: any number of joints.
+    /// One gather per parameter from the parameter rows, and one of the lanes' pair signs:
+    /// any number of joints.
     Gather,
     /// Per slot, the mesh's pre-arranged runs of lanes that share a joint (and hemisphere
     /// sign): one broadcast from memory and one masked fused multiply-add per parameter and
