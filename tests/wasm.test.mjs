@@ -67,6 +67,9 @@ for (const method of ['lb', 'qb', 'dqb', 'cor']) {
     hand.setMethod(method);
     for (const seed of [1, 2, 3]) {
       const a = angles(hand.dofCount, seed * 7919 + method.length);
+      // Unrelated poses, as `dqhand skin` deforms each (else a pair of bones that moved less
+      // than 60° since the last pose keeps its sign, as frames of one motion do).
+      hand.forgetPreviousFrame();
       hand.step(a);
       // Views into the module's memory, no copy (taken after the step, which never grows it).
       const n = 3 * hand.vertexCount;

@@ -145,6 +145,14 @@ impl Hand {
         Ok(())
     }
 
+    /// The next [`Self::step`] does not follow the last one: a joint twisted past 180° is
+    /// skinned the shortest way, as if the pose were the first (`SkinLayer::forget_previous_frame`).
+    /// Each step otherwise follows the one before it, as frames of one motion.
+    #[wasm_bindgen(js_name = forgetPreviousFrame)]
+    pub fn forget_previous_frame(&mut self) {
+        self.engine.skin_mut().forget_previous_frame();
+    }
+
     /// Where the skinned positions start in [`wasm_memory`]: `3 * vertexCount` floats, x y z per
     /// vertex, metres, rewritten in place by each [`Self::step`]. Take the view again after any
     /// other call (a first `setMethod` to a method allocates its buffer, and any allocation may

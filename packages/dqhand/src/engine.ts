@@ -413,6 +413,11 @@ export class PosedHand implements SkinSource {
     this.inner.step(angles);
   }
 
+  /** The next `setAngles` does not follow the last one (each call otherwise does, as frames of one motion: a joint twisted past 180° stays the way it turned): for a pose unrelated to the last. */
+  forgetPreviousFrame(): void {
+    this.inner.forgetPreviousFrame();
+  }
+
   setMethod(method: Method): void {
     this.inner.setMethod(method);
   }
