@@ -6,7 +6,11 @@
 // before each view; and each hand it reports is graded against where our joints are drawn
 // (`window.dqhand.jointsOnScreen`), so a detection elsewhere in the image is not counted.
 //
-//   node scripts/mediapipe-views.mjs [--views N] [--seed S] [--json FILE] [--save DIR]
+//   node scripts/mediapipe-views.mjs [--views N] [--seed S] [--json FILE] [--save DIR] [--model GLB]
+//
+// `--model GLB` draws another skinned hand with WebXR joint names instead (through `dqhand demo
+// --model`, the engine in that process), in the same material: the WebXR generic hand, say,
+// to see whether MediaPipe does better on a hand someone else modelled.
 //
 // A view counts as found when a reported hand's 21 landmarks lie, at the median, within
 // LOCATED of the hand's drawn size (the diagonal of its joints' bounding box on screen) from our
@@ -18,7 +22,7 @@
 
 import { mkdirSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { launchBrowser, newPage, root, serveStatic, settle, waitState } from './harness.mjs';
+import { launchBrowser, newPage, root, serveStatic, settle, startServer, waitState } from './harness.mjs';
 
 const arg = (name, fallback) => {
   const i = process.argv.indexOf(name);
@@ -28,6 +32,7 @@ const VIEWS = Number(arg('--views', 100));
 const SEED = Number(arg('--seed', 1));
 const JSON_OUT = arg('--json', null);
 const SAVE = arg('--save', null);
+const MODEL = arg('--model', null);
 const SIZE = { width: 640, height: 480 };
 const ELEVATION_DEG = [-40, 70];
 const DISTANCE_M = [0.35, 0.6];
@@ -57,7 +62,7 @@ const median = (xs) => {
   return s.length % 2 ? s[(s.length - 1) / 2] : (s[s.length / 2 - 1] + s[s.length / 2]) / 2;
 };
 
-const host = await serveStatic(path.join(root, 'viewer/dist'));
+const host = MODEL ? await startServer({ args: ['--model', path.resolve(MODEL)] }) : await serveStatic(path.join(root, 'viewer/dist'));
 const browser = await launchBrowser();
 try {
   const page = await newPage(browser, SIZE);
@@ -144,6 +149,7 @@ try {
   const share = (rs) => (rs.length ? rs.filter((r) => r.found).length / rs.length : null);
   const byGesture = Object.fromEntries(gestures.map((g) => [g, rows.filter((r) => r.gesture === g)]).filter(([, rs]) => rs.length).map(([g, rs]) => [g, { views: rs.length, found: rs.filter((r) => r.found).length }]));
   const report = {
+    model: MODEL ?? 'builtin',
     views: VIEWS,
     seed: SEED,
     size: SIZE,
@@ -161,7 +167,7 @@ try {
   };
   if (JSON_OUT) writeFileSync(JSON_OUT, JSON.stringify(report, null, 1));
   const pct = (x) => (x === null ? '—' : `${(100 * x).toFixed(1)} %`);
-  console.log(`MediaPipe Hands on the built-in hand (DQB), ${VIEWS} random views (seed ${SEED}), ${SIZE.width}×${SIZE.height}, software WebGL, CPU inference:`);
+  console.log(`MediaPipe Hands on ${MODEL ? path.basename(MODEL) : 'the built-in hand'} (DQB), ${VIEWS} random views (seed ${SEED}), ${SIZE.width}×${SIZE.height}, software WebGL, CPU inference:`);
   console.log(`  found (median landmark error ≤ ${LOCATED * 100} % of the hand's drawn size): ${report.found} of ${VIEWS} (${pct(report.found / VIEWS)}); a hand reported at all: ${report.detected}`);
   console.log(`  palm side ${pct(report.found_palm_side)}, back side ${pct(report.found_back_side)}; of those found, labelled a right hand ${pct(report.side_right_of_found)}; median error of those found ${report.median_error_of_found === null ? '—' : pct(report.median_error_of_found)}`);
   console.log(`  by gesture: ${Object.entries(byGesture).map(([g, c]) => `${g} ${c.found}/${c.views}`).join(', ')}`);
