@@ -73,11 +73,11 @@ impl PairSigns {
         }
     }
 
-    /// Takes `other`'s state, as if this one had deformed the frames `other` did (QB, DQB and
-    /// CoR of one mesh share the rotations the signs are chosen from). Allocates nothing when
-    /// made for the same mesh.
+    /// Takes `other`'s last frame, as if this one had deformed the frames `other` did (QB, DQB
+    /// and CoR of one mesh share the rotations the signs are chosen from); the signs
+    /// themselves are the next [`Self::update`]'s. Allocates nothing when made for the same
+    /// mesh.
     pub(crate) fn follow(&mut self, other: &Self) {
-        self.signs.clone_from(&other.signs);
         self.last.clone_from(&other.last);
     }
 }
