@@ -477,3 +477,52 @@ fn a_skin_layer_follows_a_twist_until_told_to_forget_and_a_method_joining_follow
     assert_eq!(qb(&joined), qb(&alone));
     assert!(gap(&qb(&joined), &qb(&fresh_qb)) > 0.5, "QB joining at 190° should follow the twist");
 }
+
+#[test]
+fn on_the_webxr_generic_hand_a_twist_past_180_degrees_flips_alone_and_is_followed() {
+    // A mesh the project did not make: its index intermediate phalanx, and the bones below it,
+    // twisted 5–195° about the phalanx's axis in 10° steps, every other bone at bind.
+    let model = support::webxr_hand();
+    let (mesh, bind, skeleton) = (&model.mesh, model.bind_world(), &model.skeleton);
+    let joint = skeleton.index_of("index-finger-phalanx-intermediate").unwrap();
+    let child = skeleton.index_of("index-finger-phalanx-distal").unwrap();
+    let (at, axis) = (Vec3::from(bind[joint].translation), Vec3::from(bind[child].translation - bind[joint].translation).normalize());
+    let below = |mut i: usize| loop {
+        if i == joint {
+            return true;
+        }
+        match skeleton.joints()[i].parent {
+            Some(p) => i = p,
+            None => return false,
+        }
+    };
+    let twist = |degrees: f32| {
+        let m = Affine3A::from_translation(at) * Affine3A::from_axis_angle(axis, degrees.to_radians()) * Affine3A::from_translation(-at);
+        (0..skeleton.len()).map(|i| if below(i) { m } else { Affine3A::IDENTITY }).collect::<Vec<_>>()
+    };
+    let largest_move = |a: &[[f32; 3]], b: &[[f32; 3]]| a.iter().zip(b).map(|(p, q)| Vec3::from(*p).distance(Vec3::from(*q))).fold(0.0, f32::max);
+    // 175° to 185°: the step where the nearer hemisphere switches.
+    let flip = 18;
+    for method in [Method::Qb, Method::Dqb, Method::Cor] {
+        let (mut followed, mut alone) = (Deformer::new(method, mesh), Deformer::new(method, mesh));
+        let (mut steps_followed, mut steps_alone) = (Vec::new(), Vec::new());
+        let (mut last_followed, mut last_alone): (Option<Vec<[f32; 3]>>, Option<Vec<[f32; 3]>>) = (None, None);
+        for step in 0..20 {
+            let skinning = twist(5.0 + 10.0 * step as f32);
+            let (mut f, mut a) = (Deformed::positions_only(mesh), Deformed::positions_only(mesh));
+            followed.deform(mesh, &skinning, &mut f);
+            alone.forget_previous_frame();
+            alone.deform(mesh, &skinning, &mut a);
+            if let (Some(lf), Some(la)) = (&last_followed, &last_alone) {
+                steps_followed.push(largest_move(lf, f.positions()));
+                steps_alone.push(largest_move(la, a.positions()));
+            }
+            (last_followed, last_alone) = (Some(f.positions().to_vec()), Some(a.positions().to_vec()));
+        }
+        // steps[i] is the step into frame i + 1.
+        let elsewhere = |steps: &[f32]| steps.iter().enumerate().filter(|(i, _)| i + 1 != flip).map(|(_, s)| *s).fold(0.0, f32::max);
+        let (at_flip_alone, at_flip_followed) = (steps_alone[flip - 1], steps_followed[flip - 1]);
+        assert!(at_flip_alone > 3.0 * elsewhere(&steps_alone), "{method} alone: {at_flip_alone} m at 175→185°, at most {} elsewhere", elsewhere(&steps_alone));
+        assert!(at_flip_followed < 1.5 * elsewhere(&steps_followed), "{method} followed: {at_flip_followed} m at 175→185°, at most {} elsewhere", elsewhere(&steps_followed));
+    }
+}
