@@ -5,12 +5,14 @@
 //   fig6-pip-zoom.png     close-up of the PIP joint at 120°, shaded and as a heat map (Fig. 6)
 //   fig7-gestures-{dqb,qb,lb}.png   the daily gestures (Fig. 7)
 //   viewer-split.png      the viewer itself, split view on the fist
+//   hand-look.png         the built-in hand before and after its look (regions, skin maps, nails): palm, back, fist
 //   fig9-grasp.png        the ball and the Utah teapot grasped, lifted, carried and set down (Fig. 9)
 //   dqs-twist-bend.png    three.js's linear skinning beside three-dqs on a twisted and a bent limb
 //   dqs-hand.png          the same on the WebXR generic hand (a glTF made elsewhere), its index finger twisted and bent
 //
-// `node scripts/figures.mjs hand` makes the first four only, `… grasp` Figure 9 only, `… dqs`
-// the last two (they need `make dqs-package`'s install); no argument, all of them.
+// `node scripts/figures.mjs hand` makes the first four only, `… look` the hand's look, `… grasp`
+// Figure 9 only, `… dqs` the last two (they need `make dqs-package`'s install); no argument,
+// all of them.
 //
 // Joint limits are switched off for Figure 5/6 so the PIP can reach 120° (its range is 0–110°).
 
@@ -33,7 +35,7 @@ const STAGES = [
   { at: (t) => t.carry_end + 0.1, held: true, caption: 'lifted and carried 20 cm' },
   { at: (t) => t.release + 0.75, held: false, caption: 'set down and let go' },
 ];
-const GROUPS = ['hand', 'grasp', 'dqs'];
+const GROUPS = ['hand', 'look', 'grasp', 'dqs'];
 const asked = process.argv.slice(2);
 for (const a of asked) if (!GROUPS.includes(a)) throw new Error(`unknown figure group ${JSON.stringify(a)}: ${GROUPS.join(', ')}`);
 const wanted = (group) => asked.length === 0 || asked.includes(group);
@@ -66,10 +68,54 @@ try {
     console.log(`wrote docs/figures/${file}`);
   };
   if (wanted('hand')) await handFigures(compose);
+  if (wanted('look')) await lookFigure(compose);
   if (wanted('grasp')) await graspFigure(compose);
   if (wanted('dqs')) await dqsFigure(compose);
 } finally {
   await browser.close();
+}
+
+/**
+ * The built-in hand in the viewer's plain skin material (before) and in its look from its file
+ * (after: back and palm in their skin maps with sheen, nails glossy): close on the palm, on the
+ * back of the fingers, the fist, and the index finger from the side, DQB.
+ */
+async function lookFigure(compose) {
+  const server = await startServer();
+  try {
+    const page = await browser.newPage({ viewport: { width: CELL, height: CELL } });
+    await page.goto(`${server.url}?figure`);
+    await waitState(page, 's.connected && s.framesReceived > 2 && s.looks[0] !== null');
+    const command = (c) => page.evaluate((c) => window.dqhand.send(c), c);
+    await command({ type: 'pause' });
+    await page.evaluate(() => window.dqhand.setting({ type: 'view', methods: ['dqb'] }));
+    const views = [
+      { gesture: 'open', view: [[0, 0, 1], 'middle-finger-metacarpal', 0.2], caption: 'palm' },
+      { gesture: 'open', view: [[0, 0, -1], 'middle-finger-phalanx-intermediate', 0.14], caption: 'back of the fingers' },
+      { gesture: 'fist', view: [[0.3, 0.2, 1], 'middle-finger-phalanx-proximal', 0.25], caption: 'fist' },
+      { gesture: 'point', view: ['side', 'index-finger-phalanx-intermediate', 0.12], caption: 'index finger, side' },
+    ];
+    const rows = [{ label: 'before', cells: [] }, { label: 'after', cells: [] }];
+    for (const v of views) {
+      const before = (await page.evaluate(() => window.dqhand.state().frame.sequence)) ?? 0;
+      await command({ type: 'gesture', name: v.gesture, seconds: 0 });
+      await waitState(page, `!s.frame.playing && s.frame.methods.join() === 'dqb' && s.frame.sequence > ${before + 3}`);
+      await page.evaluate((view) => window.dqhand.view(...view), v.view);
+      // The same pose and view in each: the plain material, then the look.
+      for (const [k, on] of [false, true].entries()) {
+        await page.evaluate((on) => window.dqhand.showLook(on), on);
+        await settle(page, 4);
+        rows[k].cells.push({ src: `data:image/png;base64,${(await page.screenshot()).toString('base64')}`, caption: v.caption });
+      }
+    }
+    await compose('hand-look.png', 'The built-in hand before and after its look (DQB, software WebGL)', rows, views.length, {
+      size: [CELL, CELL],
+      label: 60,
+      note: 'Before: one skin-coloured material. After: the regions of the hand\'s glTF (crates/dqhand/src/hand/surface_regions.rs) in their materials, the back and the palm with their generated albedo and normal maps (creases, palm lines, knuckle wrinkles, pores; skin_texture.rs) and sheen, the nails glossy and coated.',
+    });
+  } finally {
+    await server.stop();
+  }
 }
 
 /** Figures 5–7 and the viewer's split view, from one `dqhand demo` on the built-in hand. */

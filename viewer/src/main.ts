@@ -8,6 +8,7 @@ import { heldText, InputPanel } from './input';
 import { type Command, type Frame, type FrameHeader, type Hello, type Method, METHOD_LABELS, METHODS, type LearningMessage, type RecordingMessage } from './protocol';
 import { HandScene } from './scene';
 import { LocalConnection, type RelaySetup } from './local';
+import { loadLook } from './look';
 import { InputSender } from './sender';
 import { Webcam } from './webcam';
 import { WRIST_SLIDERS, wristCommand, wristSliderValues } from './wrist';
@@ -82,6 +83,9 @@ const events: ConnectionEvents = {
   },
   topology(t) {
     scene.setTopology(t);
+    // The look (regions, materials, skin maps) from the hand's file: the page's, or the server's.
+    const url = local ? local.handUrl(t.hand) : `/engine/hands/${t.hand === 1 ? 'left' : 'right'}.glb`;
+    void loadLook(url, t).then((look) => look && scene.setLook(t, look));
   },
   frame(f) {
     // The controls and statistics follow the first hand; the second is only drawn.
@@ -415,6 +419,8 @@ window.dqhand = {
         }
       : null,
     geometries: scene.renderer.info.memory.geometries,
+    /** Each hand's look from its file: its regions' material names in draw order, null without one (yet). */
+    looks: scene.looks(),
     /** The WebXR input: modes offered, the session, records sent, the side of the hand sent. */
     xr: xr.state(),
     /** The camera: on, status, frames given to MediaPipe and with a hand, records sent, hands seen, ms per detection, rate. */
@@ -439,6 +445,8 @@ window.dqhand = {
   send: (command: Command) => connection.send(command),
   /** Where each joint (`state().joints` order) of the first visible hand is drawn: fractions of the canvas from its top left. */
   jointsOnScreen: () => scene.jointsOnScreen(),
+  /** Draws the hands in their looks (true) or in the plain skin material (the figures' before and after). */
+  showLook: (on: boolean) => scene.showLook(on),
   /** Draws the second hand or leaves it out, to see what it draws. */
   showSecondHand: (on: boolean) => scene.showSecondHand(on),
   setting: (command: Command) => connection.setting(command),

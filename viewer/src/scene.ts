@@ -5,6 +5,7 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { disposeLook, type Look } from './look';
 import { SceneObjects } from './objects';
 import { type Frame, type HelloScene, type Method, METHODS, type SceneMessage, type Side, type Topology } from './protocol';
 
@@ -33,15 +34,19 @@ class HandView {
   readonly group = new THREE.Group();
   /** Engine coordinates inside (turned for viewing or not by `HandScene.place`). */
   readonly oriented = new THREE.Group();
-  /** The skin, its vertex arrays rewritten by each frame. */
-  readonly mesh: THREE.Mesh<THREE.BufferGeometry, THREE.MeshPhysicalMaterial>;
+  /** The skin, its vertex arrays rewritten by each frame; drawn in its look's materials, or the plain one. */
+  readonly mesh: THREE.Mesh<THREE.BufferGeometry, THREE.Material | THREE.Material[]>;
+  /** One skin-coloured material: before the look arrives, for a model without one, and under the heat map. */
+  private readonly plain: THREE.MeshPhysicalMaterial;
+  private look: Look | null = null;
+  private lookShown = true;
   /** The skeleton overlay: one segment from each joint to its parent. */
   readonly bones: THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial>;
   /** The skeleton overlay: a dot on each joint. */
   readonly jointDots: THREE.Points<THREE.BufferGeometry, THREE.PointsMaterial>;
   method: Method | null = null;
 
-  constructor(topology: Topology) {
+  constructor(readonly topology: Topology) {
     const n = topology.vertexCount;
     const geometry = new THREE.BufferGeometry();
     geometry.setIndex(new THREE.BufferAttribute(topology.indices, 1));
@@ -50,11 +55,11 @@ class HandView {
       attribute.setUsage(THREE.DynamicDrawUsage);
       geometry.setAttribute(name, attribute);
     }
-    const material = new THREE.MeshPhysicalMaterial({
+    this.plain = new THREE.MeshPhysicalMaterial({
       color: SKIN, roughness: 0.55, metalness: 0, sheen: 0.5, sheenRoughness: 0.5,
       sheenColor: new THREE.Color(0xff8f7a), clearcoat: 0.08, clearcoatRoughness: 0.5,
     });
-    this.mesh = new THREE.Mesh(geometry, material);
+    this.mesh = new THREE.Mesh(geometry, this.plain);
     this.mesh.castShadow = true;
     this.mesh.receiveShadow = true;
     this.mesh.frustumCulled = false;
@@ -83,7 +88,7 @@ class HandView {
     (normal.array as Float32Array).set(arrays.normals);
     position.needsUpdate = true;
     normal.needsUpdate = true;
-    const material = this.mesh.material;
+    const material = this.plain;
     const heatOn = arrays.distortion !== null;
     if (heatOn) {
       const color = g.getAttribute('color') as THREE.BufferAttribute;
@@ -101,6 +106,7 @@ class HandView {
       material.color.set(heatOn ? 0xffffff : SKIN);
       material.sheen = heatOn ? 0 : 0.5;
       material.needsUpdate = true;
+      this.drawMaterial();
     }
     const lines = this.bones.geometry.getAttribute('position') as THREE.BufferAttribute;
     const l = lines.array as Float32Array;
@@ -117,12 +123,39 @@ class HandView {
     dots.needsUpdate = true;
   }
 
-  /** Frees the GPU buffers of the skin, bones and joint dots (their geometries and materials). */
+  /** Draws the skin in `look`'s regions and materials (the heat map still in the plain one). */
+  setLook(look: Look): void {
+    const g = this.mesh.geometry;
+    g.setAttribute('uv', look.uv);
+    g.clearGroups();
+    look.groups.forEach((group, k) => g.addGroup(group.start, group.count, k));
+    this.look = look;
+    this.drawMaterial();
+  }
+
+  /** Draws the look, or the plain material (false), where there is a look and no heat map. */
+  showLook(on: boolean): void {
+    this.lookShown = on;
+    this.drawMaterial();
+  }
+
+  private drawMaterial(): void {
+    this.mesh.material = this.look && this.lookShown && !this.plain.vertexColors ? this.look.materials : this.plain;
+  }
+
+  /** The look's materials by name, in draw-group order; null before one arrives, or without one. */
+  lookNames(): string[] | null {
+    return this.look && this.look.materials.map((m) => m.name);
+  }
+
+  setWireframe(on: boolean): void {
+    for (const m of [this.plain, ...(this.look?.materials ?? [])]) (m as THREE.MeshStandardMaterial).wireframe = on;
+  }
+
+  /** Frees the GPU buffers of the skin, bones and joint dots (their geometries and own materials; a look's are its hand's). */
   dispose(): void {
-    for (const o of [this.mesh, this.bones, this.jointDots]) {
-      o.geometry.dispose();
-      o.material.dispose();
-    }
+    for (const o of [this.mesh, this.bones, this.jointDots]) o.geometry.dispose();
+    for (const m of [this.plain, this.bones.material, this.jointDots.material]) m.dispose();
   }
 }
 
@@ -134,6 +167,8 @@ export class HandScene {
   private readonly key: THREE.DirectionalLight;
   private readonly ground: THREE.Mesh;
   private views: HandView[] = [];
+  /** Each hand's look, drawn by its views: freed when they are replaced. */
+  private readonly applied: [Look | null, Look | null] = [null, null];
   private parents: Int32Array = new Int32Array(0);
   /** The second hand of a server driving two (its topology's hand 1), and its skeleton's parents; drawn in the world beside the first. */
   private second: { view: HandView; parents: Int32Array } | null = null;
@@ -185,7 +220,38 @@ export class HandScene {
     this.scene.add(this.ground);
   }
 
+  /**
+   * Draws hand `topology.hand` in `look` (its file's, for that topology: a look that arrives
+   * after another session's topology replaced it is dropped).
+   */
+  setLook(topology: Topology, look: Look): void {
+    const views = (topology.hand === 1 ? (this.second ? [this.second.view] : []) : this.views).filter((v) => v.topology === topology);
+    if (views.length === 0) return disposeLook(look);
+    this.dropLook(topology.hand);
+    this.applied[topology.hand] = look;
+    for (const v of views) v.setLook(look);
+  }
+
+  /** Frees hand `hand`'s look (its materials and their maps), its views replaced. */
+  private dropLook(hand: number): void {
+    const look = this.applied[hand];
+    this.applied[hand] = null;
+    if (look) disposeLook(look);
+  }
+
+  /** Draws every hand in its look (true) or in the plain skin material, as before the look (the figures' before and after). */
+  showLook(on: boolean): void {
+    for (const v of this.hands()) v.showLook(on);
+  }
+
+  /** Each hand's look (`HandView.lookNames`): the first's, then the second's where there is one. */
+  looks(): (string[] | null)[] {
+    return [this.views[0]?.lookNames() ?? null, ...(this.second ? [this.second.view.lookNames()] : [])];
+  }
+
   setTopology(topology: Topology): void {
+    this.dropLook(1);
+    if (topology.hand === 0) this.dropLook(0);
     if (this.second) {
       // A new session (its first hand's topology) or the second hand's replaced.
       this.scene.remove(this.second.view.group);
@@ -317,7 +383,7 @@ export class HandScene {
   }
 
   setWireframe(on: boolean): void {
-    for (const v of this.hands()) v.mesh.material.wireframe = on;
+    for (const v of this.hands()) v.setWireframe(on);
   }
 
   /**

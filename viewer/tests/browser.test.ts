@@ -24,6 +24,8 @@ interface State {
   visible: string[];
   /** Geometries the renderer holds on the GPU. */
   geometries: number;
+  /** Each hand's look: its regions' material names, or null. */
+  looks: (string[] | null)[];
   errors: string[];
   input: { source: string; gestures: string[]; tracking: string; gesture: string | null; accepted: number; rejected: number; log: string[] } | null;
   /** `wrist`: translation xyz (m), rotation xyzw, as the engine reports it. */
@@ -106,6 +108,11 @@ describe('the viewer page', () => {
     expect(covered).toBeGreaterThan(0.02);
     expect(covered).toBeLessThan(0.9);
     expect(await page.locator('#stats').textContent()).toMatch(/engine \d+ fps/);
+  });
+
+  test('the skin is drawn in its regions\' materials, from the hand\'s file', async () => {
+    // The demo's built-in hand: back and palm in their skin maps, the nails in their own.
+    await waitState(page, 's.looks[0] && s.looks[0].join() === "skin-back,skin-palm,nail"');
   });
 
   test('a gesture button reaches its pose', async () => {

@@ -51,6 +51,7 @@
 //! are `[x, y, z, w]`; joints carry WebXR hand joint names. The types are glam's, re-exported
 //! as [`glam`]. Minimum Rust: 1.89.
 
+pub mod appearance;
 mod error;
 mod warning;
 #[cfg(feature = "interaction")]

@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use glam::Affine3A;
 
+use crate::appearance::Appearance;
 use crate::kinematics::{ClampedAngle, HandKinematics, JointModel, KinematicsLayer, Limits, PoseTarget, Skeleton};
 use crate::skin::SkinnedMesh;
 
@@ -18,6 +19,9 @@ pub struct Model {
     pub mesh: Arc<SkinnedMesh>,
     /// Problems that were repaired while loading (for example renormalised weights).
     pub warnings: Vec<crate::Warning>,
+    /// The skin's regions and maps, where the model has them (the built-in hand; a loaded
+    /// file keeps its own materials out of the engine).
+    pub appearance: Option<Arc<Appearance>>,
 }
 
 impl Model {

@@ -742,9 +742,10 @@ fn angle_beyond_limits_is_clamped_only_with_anatomical_limits() {
 }
 
 #[test]
-fn several_meshes_and_primitives_are_concatenated_in_file_order() {
+fn primitives_over_the_same_attributes_share_their_vertices() {
     // The minimal quad with its primitive listed twice, plus a second mesh node on the same
-    // skin: 3 primitives of 4 vertices, kept in file order.
+    // skin: 3 primitives over the same 4 vertices (one mesh in several materials, as dqhand
+    // writes the built-in hand), their triangles kept in file order.
     let path = faulty_gltf("multi-primitive", Fault::None);
     let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let primitive = doc["meshes"][0]["primitives"][0].clone();
@@ -756,16 +757,42 @@ fn several_meshes_and_primitives_are_concatenated_in_file_order() {
 
     let model = io::load_gltf(&path).unwrap();
     let single = io::load_gltf(&faulty_gltf("single-primitive", Fault::None)).unwrap();
-    assert_eq!(model.mesh.vertex_count(), 12);
+    assert_eq!(model.mesh.vertex_count(), 4);
     assert_eq!(model.mesh.triangle_count(), 6);
     let parts: Vec<_> = model.mesh.parts().iter().map(|p| (p.name.as_str(), p.vertices.clone(), p.indices.clone())).collect();
-    assert_eq!(parts, vec![("quad", 0..4, 0..6), ("quad", 4..8, 6..12), ("second", 8..12, 12..18)]);
-    for v in 0..12 {
-        assert_eq!(model.mesh.position(v), single.mesh.position(v % 4));
-        assert_eq!(influences(&model, v), influences(&single, v % 4));
+    assert_eq!(parts, vec![("quad", 0..4, 0..6), ("quad", 0..4, 6..12), ("second", 0..4, 12..18)]);
+    for v in 0..4 {
+        assert_eq!(model.mesh.position(v), single.mesh.position(v));
+        assert_eq!(influences(&model, v), influences(&single, v));
     }
-    // Each primitive's indices are offset to its own vertices.
-    assert_eq!(&model.mesh.indices()[12..18], &[8, 9, 10, 8, 10, 11]);
+    // Each primitive's indices are its own, over the shared vertices.
+    assert_eq!(&model.mesh.indices()[12..18], &single.mesh.indices()[..6]);
+}
+
+#[test]
+fn primitives_over_their_own_attributes_are_concatenated_in_file_order() {
+    // The quad again, over a copy of its POSITION accessor: its own vertices, after the first's.
+    let path = faulty_gltf("copied-primitive", Fault::None);
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let mut primitive = doc["meshes"][0]["primitives"][0].clone();
+    let position = primitive["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    let copy = doc["accessors"][position].clone();
+    doc["accessors"].as_array_mut().unwrap().push(copy);
+    primitive["attributes"]["POSITION"] = json!(doc["accessors"].as_array().unwrap().len() - 1);
+    doc["meshes"][0]["primitives"].as_array_mut().unwrap().push(primitive);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+
+    let model = io::load_gltf(&path).unwrap();
+    let single = io::load_gltf(&faulty_gltf("single-primitive", Fault::None)).unwrap();
+    assert_eq!(model.mesh.vertex_count(), 8);
+    let parts: Vec<_> = model.mesh.parts().iter().map(|p| (p.vertices.clone(), p.indices.clone())).collect();
+    assert_eq!(parts, vec![(0..4, 0..6), (4..8, 6..12)]);
+    for v in 0..8 {
+        assert_eq!(model.mesh.position(v), single.mesh.position(v % 4));
+    }
+    // The second primitive's indices are offset to its own vertices.
+    let offset: Vec<u32> = single.mesh.indices()[..6].iter().map(|i| i + 4).collect();
+    assert_eq!(&model.mesh.indices()[6..12], &offset[..]);
 }
 
 /// The minimal glTF with `edit` applied to its JSON; returns the path.

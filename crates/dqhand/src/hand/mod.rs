@@ -11,16 +11,24 @@
 //!   mesh, 8,668 vertices by default (the paper's Table 2);
 //! * `weights`: skin weights from each bone's parts, at most four per vertex.
 //!
+//! * `surface_regions`: which triangles are nail, palm and back, ordered by region;
+//! * `skin_texture`: the back's and the palm's albedo and normal maps (creases, palm lines,
+//!   knuckle wrinkles, nails, pores), drawn when first asked for.
+//!
 //! UVs are a planar projection onto the palm plane (u across the hand, v along it), the same
-//! for the back and the palm: seamless, so glTF's vertex count is the mesh's.
+//! for the back and the palm, each region drawn with its own maps: seamless, so glTF's vertex
+//! count is the mesh's.
 
 mod anthropometry;
 mod shape;
+mod skin_texture;
+mod surface_regions;
 mod tessellation;
 mod weights;
 
 use glam::{Affine3A, Vec3};
 
+use crate::appearance::Appearance;
 use crate::kinematics::{webxr, HandKinematics, JointModel};
 use crate::model::Model;
 use crate::skin::{MeshData, SkinnedMesh};
@@ -94,15 +102,15 @@ impl HandParams {
 /// # Errors
 /// As [`build`]: parameters out of range.
 pub fn hand_kinematics(params: &HandParams, joint_model: JointModel) -> Result<HandKinematics> {
-    let (anatomy, _) = anatomy(params)?;
+    let anatomy = anatomy(params)?;
     HandKinematics::new(&anatomy.skeleton()?, &inverse_bind(&anatomy), joint_model)
 }
 
-/// The checked parameters' anatomy, and the direction of the thumb side (radial).
-fn anatomy(params: &HandParams) -> Result<(Anatomy, Vec3)> {
+/// The checked parameters' anatomy.
+fn anatomy(params: &HandParams) -> Result<Anatomy> {
     params.validate()?;
     let radial = Vec3::X * if params.side == Side::Right { -1.0 } else { 1.0 };
-    Ok((Anatomy::new(params.length, params.breadth, radial), radial))
+    Ok(Anatomy::new(params.length, params.breadth, radial))
 }
 
 /// The inverse of each joint's bind frame.
@@ -117,18 +125,16 @@ fn inverse_bind(anatomy: &Anatomy) -> Vec<Affine3A> {
 /// supported densities) a surface that fails to mesh as a closed surface of that many vertices.
 pub fn build(params: &HandParams) -> Result<Model> {
     let HandParams { length: l, breadth: b, side, vertices } = *params;
-    let (anatomy, radial) = anatomy(params)?;
+    let anatomy = anatomy(params)?;
     let skeleton = anatomy.skeleton()?;
     let shape = HandShape::new(&anatomy);
-    let surface = tessellation::tessellate(&shape, vertices)?;
+    let mut surface = tessellation::tessellate(&shape, vertices)?;
+    let regions = surface_regions::sort_by_region(&shape, &surface.positions, &mut surface.indices);
     // Falloff lengths: short across the finger joints, long on the palm.
     let sigma: Vec<f32> = webxr::JOINT_NAMES.iter().map(|n| if n.contains("phalanx") { 0.016 * b } else { 0.04 * b }).collect();
     let (joints, weights) = weights::skin_weights(&shape, &surface.positions, &sigma);
-    let uvs = surface
-        .positions
-        .iter()
-        .map(|p| [0.5 + radial.x * p[0] / (1.2 * b), -p[2] / (1.1 * l)])
-        .collect();
+    let plane = skin_texture::PalmPlane::new(&anatomy, &shape, l);
+    let uvs = surface.positions.iter().map(|&p| plane.uv(p.into())).collect();
     let mut data = MeshData {
         positions: surface.positions,
         normals: surface.normals,
@@ -147,5 +153,6 @@ pub fn build(params: &HandParams) -> Result<Model> {
         skeleton,
         mesh: std::sync::Arc::new(mesh),
         warnings,
+        appearance: Some(std::sync::Arc::new(Appearance::new(regions, move || skin_texture::draw(&anatomy, &shape, l)))),
     })
 }

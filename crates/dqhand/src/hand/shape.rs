@@ -21,6 +21,9 @@ use crate::kinematics::webxr;
 /// The palm's group; fingers are groups 1 (thumb) to 5 (little).
 const PALM: usize = 0;
 const GROUPS: usize = 6;
+/// Share of a nail plate's outline (its ellipse's squared radius) that is nail; the rest is
+/// under the skin's fold at the rim.
+pub(crate) const NAIL_OUTLINE: f32 = 0.8;
 
 /// One solid, in the local frame of its part.
 #[derive(Clone, Copy, Debug)]
@@ -109,6 +112,8 @@ fn smooth_min(a: f32, b: f32, k: f32) -> f32 {
 #[derive(Clone, Debug)]
 pub(crate) struct HandShape {
     parts: Vec<Part>,
+    /// The nail plates among the parts.
+    nails: Vec<usize>,
     /// Blend radius of each finger into the palm.
     web: f32,
     /// Blend radius between fingers: small, to round the crease where their bases overlap
@@ -126,6 +131,7 @@ impl HandShape {
     pub fn new(anatomy: &Anatomy) -> Self {
         let b = anatomy.breadth;
         let mut parts = Vec::new();
+        let mut nails = Vec::new();
         let frame = |j: usize| anatomy.frames[j];
         let joint = |name: &str| webxr::JOINT_NAMES.iter().position(|&n| n == name).unwrap_or(0);
         // A round cone from point `a` to `c` in the frame of joint `j` (for its up vector).
@@ -207,6 +213,7 @@ impl HandShape {
                     parts.push(cone(j, a.lerp(end, 0.4), end, waist, rc, squash, group, blend));
                     // The nail plate: a thin lens just proud of the distal two thirds of the back.
                     let nail = Solid::Ellipsoid { radii: Vec3::new(0.6 * rc, 0.1 * rc, 0.33 * len) };
+                    nails.push(parts.len());
                     parts.push(placed(j, Vec3::new(0.0, 0.84 * waist * squash, -0.6 * len), nail, 1.0, group, 0.12 * rc));
                 } else {
                     let mid = a.lerp(c, 0.5);
@@ -229,7 +236,7 @@ impl HandShape {
             let (c, r) = p.bounding;
             [lo.min(c - r - pad), hi.max(c + r + pad)]
         });
-        Self { parts, web: 0.09 * b, between: 0.045 * b, bounds, finest_feature: 0.011 * b }
+        Self { parts, nails, web: 0.09 * b, between: 0.045 * b, bounds, finest_feature: 0.011 * b }
     }
 
     /// Signed distance from `p` to the skin (negative inside).
@@ -257,6 +264,28 @@ impl HandShape {
     pub fn gradient(&self, p: Vec3, eps: f32) -> Vec3 {
         let d = |o: Vec3| self.distance(p + o) - self.distance(p - o);
         Vec3::new(d(Vec3::X * eps), d(Vec3::Y * eps), d(Vec3::Z * eps)) / (2.0 * eps)
+    }
+
+    /// Each nail plate: the map from world into its frame (−Z toward the fingertip, +Y out of
+    /// the nail) and its ellipsoid's semi-axes, of which [`Self::over_nail`] takes the share
+    /// [`NAIL_OUTLINE`] of the outline.
+    pub fn nail_plates(&self) -> impl Iterator<Item = (Affine3A, Vec3)> + '_ {
+        self.nails.iter().filter_map(|&i| match self.parts[i].solid {
+            Solid::Ellipsoid { radii } => Some((self.parts[i].to_local, radii)),
+            Solid::RoundCone { .. } => None,
+        })
+    }
+
+    /// Whether `p`, a point of the skin, lies on a nail: over a nail plate's outline (seen
+    /// along its finger's dorsal axis, short of its rim, where the skin folds over it) and on
+    /// the plate's dorsal half.
+    pub fn over_nail(&self, p: Vec3) -> bool {
+        self.nails.iter().any(|&i| {
+            let part = &self.parts[i];
+            let Solid::Ellipsoid { radii } = part.solid else { return false };
+            let q = part.to_local.transform_point3(p);
+            q.y > 0.0 && (q.x / radii.x).powi(2) + (q.z / radii.z).powi(2) <= NAIL_OUTLINE
+        })
     }
 
     /// Distance from `p` to each bone's own parts (`f32::INFINITY` for bones with none),

@@ -1,5 +1,7 @@
 //! glTF 2.0 export as `.glb`: the rigged, skinned model (rest pose, joint hierarchy, inverse
-//! bind matrices, JOINTS/WEIGHTS), or a posed static mesh. Vertex order and count are kept.
+//! bind matrices, JOINTS/WEIGHTS; with its appearance, one primitive per skin region over the
+//! same vertices, their materials and skin maps), or a posed static mesh. Vertex order and
+//! count are kept.
 
 use std::path::Path;
 
@@ -8,6 +10,7 @@ use serde_json::{json, Value};
 use super::{check_lengths, write_bytes};
 #[cfg(feature = "interaction")]
 use crate::collision::ProxyShape;
+use crate::appearance::{Appearance, SkinImage, SurfaceRegion};
 use crate::model::Model;
 use crate::Result;
 
@@ -102,6 +105,65 @@ impl Glb {
 /// (loaders that do not know it ignore it; the validator accepts it).
 pub const CENTRE_OF_ROTATION: &str = "_CENTRE_OF_ROTATION";
 
+/// Bytes of `image` as an RGB PNG (its alpha is opaque).
+fn png(image: &SkinImage) -> Vec<u8> {
+    let rgb: Vec<u8> = image.rgba.chunks_exact(4).flat_map(|c| [c[0], c[1], c[2]]).collect();
+    let mut out = Vec::new();
+    let mut encoder = ::png::Encoder::new(&mut out, image.width, image.height);
+    encoder.set_color(::png::ColorType::Rgb);
+    encoder.set_depth(::png::BitDepth::Eight);
+    encoder.set_compression(::png::Compression::High);
+    let mut writer = encoder.write_header().expect("a PNG header into memory");
+    writer.write_image_data(&rgb).expect("an image of its own size into memory");
+    writer.finish().expect("a PNG into memory");
+    out
+}
+
+impl Glb {
+    /// Appends `bytes` as a buffer view of their own (4-byte aligned); returns its index.
+    fn view(&mut self, bytes: &[u8]) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views.push(json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+}
+
+/// The materials, images, textures and samplers of `appearance`, one material per region in
+/// [`SurfaceRegion::ALL`] order: physically based skin with sheen (the soft, forward-scattered
+/// light of skin's fine hairs and oils, `KHR_materials_sheen`), and nails that are harder and
+/// coated (`KHR_materials_clearcoat`), drawn with the back's maps, where the nails are painted.
+fn appearance_materials(glb: &mut Glb, appearance: &Appearance) -> Value {
+    let maps = [appearance.back(), appearance.palm()];
+    let images: Vec<Value> = maps.iter().flat_map(|m| [&m.albedo, &m.normal]).map(|image| json!({ "bufferView": glb.view(&png(image)), "mimeType": "image/png" })).collect();
+    let textures: Vec<Value> = (0..images.len()).map(|i| json!({ "sampler": 0, "source": i })).collect();
+    let material = |region: SurfaceRegion| {
+        let side = usize::from(region == SurfaceRegion::Palm);
+        let (roughness, extensions) = match region {
+            SurfaceRegion::Nail => (0.35, json!({ "KHR_materials_clearcoat": { "clearcoatFactor": 0.3, "clearcoatRoughnessFactor": 0.3 } })),
+            _ => (0.6, json!({ "KHR_materials_sheen": { "sheenColorFactor": [0.9, 0.55, 0.45], "sheenRoughnessFactor": 0.5 } })),
+        };
+        json!({
+            "name": region.name(),
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": 2 * side }, "metallicFactor": 0.0, "roughnessFactor": roughness },
+            "normalTexture": { "index": 2 * side + 1 },
+            "extensions": extensions,
+        })
+    };
+    // Linear filtering with mipmaps, clamped: the UVs run to the map's edges at the wrist.
+    const LINEAR: u32 = 9729;
+    const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+    const CLAMP_TO_EDGE: u32 = 33071;
+    json!({
+        "materials": SurfaceRegion::ALL.map(material),
+        "images": images,
+        "textures": textures,
+        "samplers": [{ "magFilter": LINEAR, "minFilter": LINEAR_MIPMAP_LINEAR, "wrapS": CLAMP_TO_EDGE, "wrapT": CLAMP_TO_EDGE }],
+    })
+}
+
 /// A skin-toned, slightly rough PBR material.
 fn skin_material() -> Value {
     json!([{ "name": "skin", "pbrMetallicRoughness": { "baseColorFactor": [0.87, 0.67, 0.56, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6 } }])
@@ -109,10 +171,12 @@ fn skin_material() -> Value {
 
 /// Writes the model as a rigged, skinned GLB in its rest pose, which three.js and Blender load
 /// and animate: the joint hierarchy as nodes (rest TRS), one skin with the inverse bind
-/// matrices, one primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
+/// matrices, a primitive with POSITION, NORMAL, TEXCOORD_0, JOINTS_0/WEIGHTS_0 (and
 /// JOINTS_1/WEIGHTS_1 for vertices with more than four influences), and the CoR method's
 /// centres of rotation as [`CENTRE_OF_ROTATION`] (computed here if the mesh has none yet), so
-/// that whoever loads the file does not compute them again. Built with the
+/// that whoever loads the file does not compute them again; a model with an appearance (the
+/// built-in hand) has one primitive per region over those same attributes, with the
+/// regions' materials and maps (`appearance_materials`). Built with the
 /// `interaction` feature, each joint node with vertices of its own carries its collision proxy
 /// (`collision::fit_proxies`) in the node's frame as `extras.dqhand_collision`:
 /// `{"capsule": {"start", "end", "radius"}}` or `{"convex_hull": {"points", "triangles"}}`.
@@ -156,7 +220,18 @@ pub fn skinned_glb(model: &Model) -> Vec<u8> {
         attributes[format!("JOINTS_{set}")] = json!(ja);
         attributes[format!("WEIGHTS_{set}")] = json!(wa);
     }
-    let indices = glb.indices(mesh.indices());
+    // One primitive per region of the skin over the same vertices, or one for the whole mesh.
+    let appearance = model.appearance.as_deref().filter(|a| !mesh.uvs().is_empty() && a.regions.last().is_some_and(|r| r.1.end == mesh.indices().len()));
+    let primitives: Vec<Value> = match appearance {
+        Some(a) => a
+            .regions
+            .iter()
+            .filter(|(_, r)| !r.is_empty())
+            .map(|(region, r)| json!({ "attributes": attributes, "indices": glb.indices(&mesh.indices()[r.clone()]), "material": SurfaceRegion::ALL.iter().position(|x| x == region) }))
+            .collect(),
+        None => vec![json!({ "attributes": attributes, "indices": glb.indices(mesh.indices()), "material": 0 })],
+    };
+    let looks = appearance.map(|a| appearance_materials(&mut glb, a));
     let ibm: Vec<[f32; 16]> = mesh.inverse_bind().iter().map(|m| glam::Mat4::from(*m).to_cols_array()).collect();
     let ibm = glb.floats(&ibm, "MAT4", None);
 
@@ -190,15 +265,19 @@ pub fn skinned_glb(model: &Model) -> Vec<u8> {
     nodes.push(json!({ "name": "hand", "mesh": 0, "skin": 0 }));
     let mut roots: Vec<usize> = (0..joints.len()).filter(|&i| joints[i].parent.is_none()).collect();
     roots.push(mesh_node);
-    let doc = json!({
+    let mut doc = json!({
         "scene": 0,
         "scenes": [{ "nodes": roots }],
         "nodes": nodes,
         // The model's description as the mesh's name: a loader shows what the file holds.
-        "meshes": [{ "name": model.description, "primitives": [{ "attributes": attributes, "indices": indices, "material": 0 }] }],
+        "meshes": [{ "name": model.description, "primitives": primitives }],
         "materials": skin_material(),
         "skins": [{ "name": "hand", "inverseBindMatrices": ibm, "joints": (0..joints.len()).collect::<Vec<_>>(), "skeleton": roots[0] }],
     });
+    if let Some(Value::Object(looks)) = looks {
+        doc.as_object_mut().expect("an object").extend(looks);
+        doc["extensionsUsed"] = json!(["KHR_materials_clearcoat", "KHR_materials_sheen"]);
+    }
     glb.finish(doc)
 }
 

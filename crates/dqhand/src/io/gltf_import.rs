@@ -4,8 +4,9 @@
 //! and every triangle primitive of the meshes bound to the first skin: POSITION, NORMAL,
 //! TEXCOORD_0, JOINTS_0/1 and WEIGHTS_0/1, and the CoR method's centres of rotation where
 //! dqhand wrote them ([`super::CENTRE_OF_ROTATION`]; computed when first used where any
-//! primitive lacks them). Primitives are concatenated in file order, so
-//! vertex order and count are kept. Every accessor is bounds-checked before it is read, so a
+//! primitive lacks them). Primitives are concatenated in file order, those over the same
+//! vertex attributes (one mesh in several materials) sharing their vertices, so vertex order
+//! and count are kept. Every accessor is bounds-checked before it is read, so a
 //! truncated or inconsistent file gives an error, never a panic.
 
 use std::collections::HashMap;
@@ -157,6 +158,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     }
     // CoR's centres, kept only if every primitive has them (else computed when first used).
     let mut all_centres: Vec<[f32; 3]> = Vec::new();
+    // Each set of vertex attributes read: its accessors, first vertex and vertex count.
+    let mut shared: Vec<(Vec<(String, usize)>, usize, usize)> = Vec::new();
     for (name, prim) in &primitives {
         let where_ = format!("mesh {name:?} primitive {}", prim.index());
         let sets = influence_sets(prim, name)?;
@@ -178,6 +181,16 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
         }
         check_accessor(prim.indices(), &format!("{where_} index"), gltf_file::INDEX_KIND, &buffers)?;
         let reader = prim.reader(get);
+        // A primitive over the same vertex attributes as an earlier one (one mesh in several
+        // materials, as dqhand writes the built-in hand) shares its vertices.
+        let key: Vec<(String, usize)> = prim.attributes().map(|(semantic, a)| (semantic.to_string(), a.index())).collect();
+        if let Some(&(_, base, n)) = shared.iter().find(|(k, _, _)| *k == key) {
+            let indices = gltf_file::vertex_order(&reader, n, &where_)?;
+            let start = data.indices.len();
+            data.parts.push(Part { name: name.clone(), vertices: base..base + n, indices: start..start + indices.len() });
+            data.indices.extend(indices.iter().map(|&i| i + base as u32));
+            continue;
+        }
         let positions: Vec<[f32; 3]> =
             reader.read_positions().ok_or_else(|| bad(format!("{where_} has no POSITION accessor")))?.collect();
         let n = positions.len();
@@ -211,6 +224,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
             return Err(bad(format!("{where_}: NORMAL, TEXCOORD_0 or {CENTRE_OF_ROTATION} count differs from POSITION ({n})")));
         }
         let start = data.indices.len();
+        shared.push((key, base as usize, n));
         data.parts.push(Part { name: name.clone(), vertices: base as usize..base as usize + n, indices: start..start + indices.len() });
         data.indices.extend(indices.iter().map(|i| i + base));
         // Normals and UVs are kept only if every primitive has them.
@@ -248,7 +262,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<Model> {
     // kept to one short line, as descriptions are shown.
     let mesh_name: String = first.mesh().and_then(|m| m.name()).unwrap_or("").chars().filter(|c| !c.is_control()).take(120).collect();
     let description = if mesh_name.trim().is_empty() { format!("glTF file {name}") } else { format!("{} (glTF file {name})", mesh_name.trim()) };
-    Ok(Model { description, skeleton, mesh: std::sync::Arc::new(mesh), warnings })
+    Ok(Model { description, skeleton, mesh: std::sync::Arc::new(mesh), warnings, appearance: None })
 }
 
 /// How many JOINTS/WEIGHTS sets (of four influences) a primitive has: 1 or 2.
