@@ -24,15 +24,20 @@ async function validate(file) {
 const out = mkdtempSync(path.join(tmpdir(), 'dqhand-gltf-'));
 execFileSync(dqhand, ['demo', '--out', out]);
 
-test('the rigged, skinned hand is valid glTF 2.0 with one skin and 25 joints', async () => {
+test('the rigged, skinned hand is valid glTF 2.0 with one skin and 25 joints, in its three regions\' materials and maps', async () => {
   const file = path.join(out, 'hand.glb');
   const report = await validate(file);
-  // What the validator counts (its report.info has no skin count: hasSkins and maxInfluences).
-  const { hasSkins, maxInfluences, drawCallCount, totalVertexCount, animationCount } = report.info;
+  // What the validator counts (its report.info has no skin count: hasSkins and maxInfluences):
+  // a draw call per region (back, palm, nails), each over the same 8,668 vertices, which it
+  // counts once per draw call.
+  const { hasSkins, maxInfluences, drawCallCount, totalVertexCount, totalTriangleCount, animationCount, materialCount, hasTextures } = report.info;
   assert.deepEqual(
-    { hasSkins, maxInfluences, drawCallCount, totalVertexCount, animationCount },
-    { hasSkins: true, maxInfluences: 4, drawCallCount: 1, totalVertexCount: 8668, animationCount: 0 },
+    { hasSkins, maxInfluences, drawCallCount, totalVertexCount, totalTriangleCount, animationCount, materialCount, hasTextures },
+    { hasSkins: true, maxInfluences: 4, drawCallCount: 3, totalVertexCount: 3 * 8668, totalTriangleCount: 2 * 8668 - 4, animationCount: 0, materialCount: 3, hasTextures: true },
   );
+  // The maps: four PNGs (albedo and normals of the back and of the palm), read by the validator.
+  const images = report.info.resources.filter((r) => r.image);
+  assert.deepEqual(images.map((r) => [r.mimeType, r.image.format]), Array(4).fill(['image/png', 'rgb']));
   // The skin itself, from the file's JSON: one, on the hand's mesh node, 25 joints that are
   // nodes of the file, and an inverse bind matrix for each.
   const json = JSON.parse(readGlbJson(file));
@@ -47,6 +52,8 @@ test('the rigged, skinned hand is valid glTF 2.0 with one skin and 25 joints', a
   assert.deepEqual(skinned.map((n) => [n.skin, n.mesh]), [[0, 0]]);
   const { attributes } = json.meshes[0].primitives[0];
   assert.ok('JOINTS_0' in attributes && 'WEIGHTS_0' in attributes, JSON.stringify(attributes));
+  // The regions share one set of vertex attributes.
+  assert.ok(json.meshes[0].primitives.every((p) => JSON.stringify(p.attributes) === JSON.stringify(attributes)));
 });
 
 test('every posed mesh of the demo is valid glTF 2.0', async () => {

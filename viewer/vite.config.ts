@@ -27,6 +27,9 @@ function mediapipeFiles(): Plugin {
 export default defineConfig({
   base: './',
   plugins: [mediapipeFiles()],
+  // The npm package's sources the page shares (its look.ts) import three: this one, not a copy
+  // (the package's folder has no node_modules of its own when the viewer is built).
+  resolve: { dedupe: ['three'] },
   build: { outDir: 'dist', emptyOutDir: true, chunkSizeWarningLimit: 1024 },
   test: { include: ['tests/**/*.test.ts'], testTimeout: 120_000, hookTimeout: 120_000, fileParallelism: false },
 });

@@ -2,7 +2,8 @@
 // copied in place from the module's memory each frame (one copy each, nothing allocated; the
 // attributes own their arrays, so the module's memory growing never leaves them dangling).
 
-import { BufferAttribute, BufferGeometry, DynamicDrawUsage, Mesh, MeshStandardMaterial, type Material } from 'three';
+import { BufferAttribute, BufferGeometry, DynamicDrawUsage, Mesh, MeshStandardMaterial, type Material, type Object3D } from 'three';
+import { lookOf } from './look.js';
 import type { SkinSource } from './engine.js';
 
 /** The skin's colour (a light skin tone, lit). */
@@ -13,7 +14,7 @@ export const SKIN_COLOUR = 0xe0a98f;
  * the hand where the tracked one is): leave the mesh's own transform at the identity, or put it
  * under a parent to move the whole world. Call `update()` after each `step` (or `setAngles`).
  */
-export class HandMesh extends Mesh<BufferGeometry, Material> {
+export class HandMesh extends Mesh<BufferGeometry, Material | Material[]> {
   constructor(
     readonly source: SkinSource,
     readonly hand = 0,
@@ -40,7 +41,22 @@ export class HandMesh extends Mesh<BufferGeometry, Material> {
     this.geometry.computeBoundingBox();
   }
 
-  /** Frees the geometry (the material is the caller's when given). */
+  /**
+   * Draws the hand in the look of its glTF file (`root`: GLTFLoader's `gltf.scene` of the same
+   * file the engine loaded): each region in its material and maps. False, and nothing changed,
+   * where the file is not this mesh or has no maps.
+   */
+  useLook(root: Object3D): boolean {
+    const look = lookOf(root, { vertexCount: this.source.vertexCount(this.hand), indices: this.source.indices(this.hand) });
+    if (!look) return false;
+    this.geometry.setAttribute('uv', look.uv);
+    this.geometry.clearGroups();
+    look.groups.forEach((group, k) => this.geometry.addGroup(group.start, group.count, k));
+    this.material = look.materials;
+    return true;
+  }
+
+  /** Frees the geometry (the material is the caller's when given, or its file's look's). */
   dispose(): void {
     this.geometry.dispose();
   }
