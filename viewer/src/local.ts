@@ -72,7 +72,7 @@ export class LocalConnection {
   private async start(scene: string, twoHands: boolean, config: string | null): Promise<void> {
     const relayed = this.relayed;
     try {
-      const urls = [this.handUrl(0), ...(twoHands || (relayed && relayed.hands.length > 1) ? [this.handUrl(1)] : [])];
+      const urls = relayed?.hands ?? ['./hands/right.glb', ...(twoHands ? ['./hands/left.glb'] : [])];
       const [, right, left] = await Promise.all([loadEngine(), handFile(urls[0]), urls[1] ? handFile(urls[1]) : undefined]);
       // The demo's hand may be its --model: the built-in one generated instead would be another.
       if (relayed && (!right || (urls[1] && !left))) throw new Error(`${urls[right ? 1 : 0]}: the demo's hand could not be loaded`);

@@ -419,7 +419,7 @@ window.dqhand = {
         }
       : null,
     geometries: scene.renderer.info.memory.geometries,
-    /** Each hand's look from its file: its regions' material names in draw order, null without one (yet). */
+    /** Each hand's look from its file: its regions' material names in draw order while drawn in them, null otherwise. */
     looks: scene.looks(),
     /** The WebXR input: modes offered, the session, records sent, the side of the hand sent. */
     xr: xr.state(),

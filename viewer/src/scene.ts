@@ -130,6 +130,7 @@ class HandView {
     g.clearGroups();
     look.groups.forEach((group, k) => g.addGroup(group.start, group.count, k));
     this.look = look;
+    this.setWireframe(this.wireframe);
     this.drawMaterial();
   }
 
@@ -139,16 +140,19 @@ class HandView {
     this.drawMaterial();
   }
 
+  private wireframe = false;
+
   private drawMaterial(): void {
     this.mesh.material = this.look && this.lookShown && !this.plain.vertexColors ? this.look.materials : this.plain;
   }
 
-  /** The look's materials by name, in draw-group order; null before one arrives, or without one. */
+  /** The look's materials by name, in draw-group order, while the skin is drawn in them; null otherwise (none yet, none at all, the heat map, `showLook(false)`). */
   lookNames(): string[] | null {
-    return this.look && this.look.materials.map((m) => m.name);
+    return this.look && this.mesh.material === this.look.materials ? this.look.materials.map((m) => m.name) : null;
   }
 
   setWireframe(on: boolean): void {
+    this.wireframe = on;
     for (const m of [this.plain, ...(this.look?.materials ?? [])]) (m as THREE.MeshStandardMaterial).wireframe = on;
   }
 
@@ -169,6 +173,9 @@ export class HandScene {
   private views: HandView[] = [];
   /** Each hand's look, drawn by its views: freed when they are replaced. */
   private readonly applied: [Look | null, Look | null] = [null, null];
+  /** What every view is drawn with: wireframe, and the look or the plain material. */
+  private wireframe = false;
+  private lookShown = true;
   private parents: Int32Array = new Int32Array(0);
   /** The second hand of a server driving two (its topology's hand 1), and its skeleton's parents; drawn in the world beside the first. */
   private second: { view: HandView; parents: Int32Array } | null = null;
@@ -241,7 +248,15 @@ export class HandScene {
 
   /** Draws every hand in its look (true) or in the plain skin material, as before the look (the figures' before and after). */
   showLook(on: boolean): void {
+    this.lookShown = on;
     for (const v of this.hands()) v.showLook(on);
+  }
+
+  /** A new view drawn as the others are: wireframe or not, the look shown or not. */
+  private styled(view: HandView): HandView {
+    view.setWireframe(this.wireframe);
+    view.showLook(this.lookShown);
+    return view;
   }
 
   /** Each hand's look (`HandView.lookNames`): the first's, then the second's where there is one. */
@@ -260,7 +275,7 @@ export class HandScene {
       this.secondFrame = null;
     }
     if (topology.hand === 1) {
-      this.second = { view: new HandView(topology), parents: topology.parents };
+      this.second = { view: this.styled(new HandView(topology)), parents: topology.parents };
       this.second.view.group.visible = false; // until its first frame
       this.place(this.second.view);
       this.scene.add(this.second.view.group);
@@ -270,7 +285,7 @@ export class HandScene {
       this.scene.remove(v.group);
       v.dispose();
     }
-    this.views = METHODS.map(() => new HandView(topology));
+    this.views = METHODS.map(() => this.styled(new HandView(topology)));
     for (const v of this.views) {
       this.place(v);
       this.scene.add(v.group);
@@ -383,6 +398,7 @@ export class HandScene {
   }
 
   setWireframe(on: boolean): void {
+    this.wireframe = on;
     for (const v of this.hands()) v.setWireframe(on);
   }
 

@@ -199,7 +199,9 @@ describe('the viewer page', () => {
     await settle(page);
     const reds = await countColour(page, { r: [181, 255], g: [0, 109], b: [0, 89] });
     expect(reds).toBeGreaterThan(50); // a fist stretches the skin over the knuckles
+    expect((await state()).looks[0]).toBeNull(); // the heat map in the plain material
     await page.uncheck('#heatmap');
+    await waitState(page, 's.looks[0] && s.looks[0].join() === "skin-back,skin-palm,nail"'); // and the look back
   });
 
   test('wireframe and skeleton overlays change what is drawn', async () => {

@@ -25,8 +25,12 @@ fn describe(file: &str, model: &Model) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{file}: {}", model.description);
     let _ = writeln!(s, "meshes: {} primitive(s)", mesh.parts().len());
-    for p in mesh.parts() {
-        let _ = writeln!(s, "  {:?}: {} vertices, {} triangles", p.name, p.vertices.len(), p.indices.len() / 3);
+    for (k, p) in mesh.parts().iter().enumerate() {
+        // Primitives over the same vertices (one mesh in several materials) say so.
+        let _ = match mesh.parts()[..k].iter().position(|q| q.vertices == p.vertices) {
+            Some(first) => writeln!(s, "  {:?}: {} triangles, over primitive {first}'s vertices", p.name, p.indices.len() / 3),
+            None => writeln!(s, "  {:?}: {} vertices, {} triangles", p.name, p.vertices.len(), p.indices.len() / 3),
+        };
     }
     let _ = writeln!(s, "total: {} vertices, {} triangles", mesh.vertex_count(), mesh.triangle_count());
     let per_joint = mesh.vertices_per_joint();

@@ -4,12 +4,11 @@
 //! one for the palm (the built-in hand's UVs are one projection onto the palm plane, seamless,
 //! so the back and the palm read the same coordinates and need their own images).
 //!
-//! The maps are made when first asked for (a few hundred milliseconds for the built-in hand):
-//! skinning, collision and the tests never need them; the glTF export and the viewer do.
+//! The maps are drawn when asked for (a few hundred milliseconds for the built-in hand), not
+//! kept: skinning and collision never need them; the glTF export does, once per file.
 
 use std::fmt;
 use std::ops::Range;
-use std::sync::OnceLock;
 
 /// Which part of the skin a triangle belongs to, each drawn with its own material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -37,15 +36,15 @@ impl SurfaceRegion {
     }
 }
 
-/// An 8-bit RGBA image, rows top to bottom (glTF's texture coordinates: v down).
+/// An 8-bit RGB image, rows top to bottom (glTF's texture coordinates: v down).
 #[derive(Clone, PartialEq, Eq)]
 pub struct SkinImage {
     /// Width in texels.
     pub width: u32,
     /// Height in texels.
     pub height: u32,
-    /// `4 · width · height` bytes.
-    pub rgba: Vec<u8>,
+    /// `3 · width · height` bytes.
+    pub rgb: Vec<u8>,
 }
 
 impl fmt::Debug for SkinImage {
@@ -58,7 +57,7 @@ impl fmt::Debug for SkinImage {
 /// of one side of the hand.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SkinMaps {
-    /// Base colour, sRGB, opaque.
+    /// Base colour, sRGB.
     pub albedo: SkinImage,
     /// Tangent-space normals, `0.5 · n + 0.5` per channel.
     pub normal: SkinImage,
@@ -67,36 +66,40 @@ pub struct SkinMaps {
 /// The regions of a mesh's triangles and the maps of its two sides.
 pub struct Appearance {
     /// Each region's triangles: a range of the mesh's flat index array (a multiple of three),
-    /// in [`SurfaceRegion::ALL`] order, together the whole array.
+    /// in [`SurfaceRegion::ALL`] order, together the whole array ([`Self::covers`]).
     pub regions: Vec<(SurfaceRegion, Range<usize>)>,
-    maps: OnceLock<[SkinMaps; 2]>,
     draw: Box<dyn Fn() -> [SkinMaps; 2] + Send + Sync>,
 }
 
 impl fmt::Debug for Appearance {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Appearance").field("regions", &self.regions).field("maps drawn", &self.maps.get().is_some()).finish()
+        f.debug_struct("Appearance").field("regions", &self.regions).finish_non_exhaustive()
     }
 }
 
 impl Appearance {
-    /// `regions` as [`Self::regions`]; `draw` makes the back's and the palm's maps, once, when
-    /// first asked for.
+    /// `regions` as [`Self::regions`]; `draw` draws the back's and the palm's maps.
     pub fn new(regions: Vec<(SurfaceRegion, Range<usize>)>, draw: impl Fn() -> [SkinMaps; 2] + Send + Sync + 'static) -> Self {
-        Self { regions, maps: OnceLock::new(), draw: Box::new(draw) }
+        Self { regions, draw: Box::new(draw) }
     }
 
-    /// The back's maps (also the nails').
-    pub fn back(&self) -> &SkinMaps {
-        &self.maps()[0]
+    /// The back's maps (also the nails') and the palm's, drawn anew.
+    #[must_use]
+    pub fn maps(&self) -> [SkinMaps; 2] {
+        (self.draw)()
     }
 
-    /// The palm's maps.
-    pub fn palm(&self) -> &SkinMaps {
-        &self.maps()[1]
-    }
-
-    fn maps(&self) -> &[SkinMaps; 2] {
-        self.maps.get_or_init(|| (self.draw)())
+    /// Whether the regions are whole triangles that follow each other from the start of an
+    /// index array of `len` entries to its end: what a mesh with this appearance must have.
+    #[must_use]
+    pub fn covers(&self, len: usize) -> bool {
+        let mut end = 0;
+        for (_, r) in &self.regions {
+            if r.start != end || r.end < r.start || r.start % 3 != 0 || r.end % 3 != 0 {
+                return false;
+            }
+            end = r.end;
+        }
+        end == len
     }
 }

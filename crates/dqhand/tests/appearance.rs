@@ -40,6 +40,7 @@ fn every_finger_has_a_nail_on_the_back_of_its_last_phalanx() {
         let world = model.skeleton.rest_world();
         let regions = regions(&model);
         let mut area = [0.0f32; 5];
+        let mut sides = [0.0f32; 2];
         for (t, tri) in model.mesh.indices().chunks_exact(3).enumerate() {
             let [a, b, c] = [0, 1, 2].map(|k| Vec3::from(positions[tri[k] as usize]));
             let (centre, normal) = ((a + b + c) / 3.0, (b - a).cross(c - a));
@@ -57,10 +58,12 @@ fn every_finger_has_a_nail_on_the_back_of_its_last_phalanx() {
                     assert!(normal.normalize().dot(dorsal) > 0.3, "{side:?}: a nail triangle facing {normal} on finger {f}, whose back is {dorsal}");
                     area[f] += normal.length() / 2.0;
                 }
-                SurfaceRegion::Palm => assert!(normal.y < 0.0, "a palm triangle faces down"),
-                SurfaceRegion::Back => assert!(normal.y >= 0.0, "a back triangle faces up"),
+                SurfaceRegion::Palm => sides[1] += normal.length() / 2.0,
+                SurfaceRegion::Back => sides[0] += normal.length() / 2.0,
             }
         }
+        // The back and the palm are each about half the skin.
+        assert!((0.75..1.33).contains(&(sides[0] / sides[1])), "{side:?}: back {:.0} cm², palm {:.0} cm²", sides[0] * 1e4, sides[1] * 1e4);
         // A nail of an adult hand: some 40–120 mm² (the thumb's largest).
         for (f, a) in area.iter().enumerate() {
             assert!((25e-6..160e-6).contains(a), "{side:?}: finger {f}'s nail is {:.0} mm²", a * 1e6);
@@ -72,7 +75,7 @@ fn every_finger_has_a_nail_on_the_back_of_its_last_phalanx() {
 /// The albedo's luminance (sRGB bytes, Rec. 709 weights) at texture coordinates `uv`.
 fn luminance(image: &SkinImage, uv: [f32; 2]) -> f32 {
     let (x, y) = ((uv[0] * image.width as f32) as usize, (uv[1] * image.height as f32) as usize);
-    let p = &image.rgba[4 * (y.min(image.height as usize - 1) * image.width as usize + x.min(image.width as usize - 1))..][..3];
+    let p = &image.rgb[3 * (y.min(image.height as usize - 1) * image.width as usize + x.min(image.width as usize - 1))..][..3];
     0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
 }
 
@@ -106,11 +109,11 @@ fn the_creases_lie_at_the_joints_where_the_meshs_uvs_put_them() {
     let model = hand(HandParams::default());
     let world = model.skeleton.rest_world();
     let appearance = model.appearance.as_ref().unwrap();
-    let (palm, back) = (appearance.palm(), appearance.back());
+    let [back, palm] = appearance.maps();
+    let (back, palm) = (&back, &palm);
     let uv = uv_map(&model);
     for map in [&palm.albedo, &palm.normal, &back.albedo, &back.normal] {
-        assert_eq!(map.rgba.len(), 4 * (map.width * map.height) as usize);
-        assert!(map.rgba.chunks_exact(4).all(|p| p[3] == 255), "opaque");
+        assert_eq!(map.rgb.len(), 3 * (map.width * map.height) as usize);
     }
     for finger in ["index-finger", "middle-finger", "ring-finger", "pinky-finger"] {
         let [pip, dip] = ["intermediate", "distal"].map(|b| Vec3::from(world[joint(&format!("{finger}-phalanx-{b}"))].translation));
@@ -125,7 +128,7 @@ fn the_creases_lie_at_the_joints_where_the_meshs_uvs_put_them() {
             let (x, y) = ((uv[0] * palm.normal.width as f32) as usize, (uv[1] * palm.normal.height as f32) as usize);
             (0..9usize)
                 .map(|dy| {
-                    let p = &palm.normal.rgba[4 * ((y + dy - 4) * palm.normal.width as usize + x)..][..3];
+                    let p = &palm.normal.rgb[3 * ((y + dy - 4) * palm.normal.width as usize + x)..][..3];
                     (f32::from(p[0]) - 127.5).hypot(f32::from(p[1]) - 127.5)
                 })
                 .fold(0.0, f32::max)
@@ -140,13 +143,14 @@ fn each_nail_is_painted_where_its_own_skin_reads_the_back_map() {
     for side in [Side::Right, Side::Left] {
         let model = hand(HandParams { side, ..HandParams::default() });
         let appearance = model.appearance.as_ref().unwrap();
-        let albedo = &appearance.back().albedo;
+        let [back, _] = appearance.maps();
+        let albedo = &back.albedo;
         let positions = model.mesh.positions();
         let world = model.skeleton.rest_world();
         // Red less blue: a pink nail bed is bluer than skin.
         let redness = |uv: [f32; 2]| {
             let (x, y) = ((uv[0] * albedo.width as f32) as usize, (uv[1] * albedo.height as f32) as usize);
-            let p = &albedo.rgba[4 * (y * albedo.width as usize + x)..][..3];
+            let p = &albedo.rgb[3 * (y * albedo.width as usize + x)..][..3];
             f32::from(p[0]) - f32::from(p[2])
         };
         let range = |r: SurfaceRegion| appearance.regions.iter().find(|x| x.0 == r).unwrap().1.clone();
@@ -195,4 +199,18 @@ fn the_glb_has_a_primitive_per_region_over_the_same_vertices() {
     assert_eq!(back.mesh.vertex_count(), model.mesh.vertex_count());
     assert_eq!(back.mesh.indices(), model.mesh.indices());
     assert_eq!(back.mesh.parts().len(), 3);
+}
+
+#[test]
+fn a_sparse_and_a_dense_hand_keep_their_regions_whole() {
+    for vertices in [1_000, 20_000] {
+        let model = hand(HandParams { vertices, ..HandParams::default() });
+        let appearance = model.appearance.as_ref().unwrap();
+        assert!(appearance.covers(model.mesh.indices().len()), "{vertices}: {:?}", appearance.regions);
+        let nails = appearance.regions.iter().find(|r| r.0 == SurfaceRegion::Nail).unwrap().1.len() / 3;
+        assert!(nails > 0, "{vertices} vertices: no nail triangles");
+        let bytes = dqhand::io::skinned_glb(&model);
+        let doc = gltf::Gltf::from_slice(&bytes).expect("the GLB parses");
+        assert_eq!(doc.meshes().next().unwrap().primitives().count(), 3);
+    }
 }

@@ -3,7 +3,7 @@
 // attributes own their arrays, so the module's memory growing never leaves them dangling).
 
 import { BufferAttribute, BufferGeometry, DynamicDrawUsage, Mesh, MeshStandardMaterial, type Material, type Object3D } from 'three';
-import { lookOf } from './look.js';
+import { disposeLook, lookOf, type Look } from './look.js';
 import type { SkinSource } from './engine.js';
 
 /** The skin's colour (a light skin tone, lit). */
@@ -41,23 +41,31 @@ export class HandMesh extends Mesh<BufferGeometry, Material | Material[]> {
     this.geometry.computeBoundingBox();
   }
 
+  /** The look drawn (`useLook`), or null: the material given. */
+  look: Look | null = null;
+
   /**
    * Draws the hand in the look of its glTF file (`root`: GLTFLoader's `gltf.scene` of the same
-   * file the engine loaded): each region in its material and maps. False, and nothing changed,
-   * where the file is not this mesh or has no maps.
+   * file the engine loaded): each region in its material and maps, in place of the material
+   * given (which stays the caller's). Null, and nothing changed, where the file is not this
+   * mesh or has no maps. The look is the mesh's: `dispose()` frees it.
    */
-  useLook(root: Object3D): boolean {
+  useLook(root: Object3D): Look | null {
     const look = lookOf(root, { vertexCount: this.source.vertexCount(this.hand), indices: this.source.indices(this.hand) });
-    if (!look) return false;
+    if (!look) return null;
+    if (this.look) disposeLook(this.look);
+    this.look = look;
     this.geometry.setAttribute('uv', look.uv);
     this.geometry.clearGroups();
     look.groups.forEach((group, k) => this.geometry.addGroup(group.start, group.count, k));
     this.material = look.materials;
-    return true;
+    return look;
   }
 
-  /** Frees the geometry (the material is the caller's when given, or its file's look's). */
+  /** Frees the geometry and the look (the material given is the caller's). */
   dispose(): void {
     this.geometry.dispose();
+    if (this.look) disposeLook(this.look);
+    this.look = null;
   }
 }

@@ -153,6 +153,6 @@ pub fn build(params: &HandParams) -> Result<Model> {
         skeleton,
         mesh: std::sync::Arc::new(mesh),
         warnings,
-        appearance: Some(std::sync::Arc::new(Appearance::new(regions, move || skin_texture::draw(&anatomy, &shape, l)))),
+        appearance: Some(std::sync::Arc::new(Appearance::new(regions, move || skin_texture::draw(&anatomy, &shape, l, plane)))),
     })
 }

@@ -134,10 +134,9 @@ struct Side {
     blushes: Vec<Blush>,
 }
 
-/// Draws the back's and the palm's maps of a hand `length` long, `shape` modelled around
-/// `anatomy`.
-pub(crate) fn draw(anatomy: &Anatomy, shape: &HandShape, length: f32) -> [SkinMaps; 2] {
-    let plane = PalmPlane::new(anatomy, shape, length);
+/// Draws the back's and the palm's maps, on `plane`, of a hand `length` long, `shape` modelled
+/// around `anatomy`.
+pub(crate) fn draw(anatomy: &Anatomy, shape: &HandShape, length: f32, plane: PalmPlane) -> [SkinMaps; 2] {
     let (back, palm) = features(anatomy, length, plane.mm);
     let nails = nail_coordinates(shape, plane);
     [paint(&back, plane, &nails, 1), paint(&palm, plane, &[], 2)]
@@ -164,13 +163,14 @@ fn nail_coordinates(shape: &HandShape, plane: PalmPlane) -> Vec<Option<Vec2>> {
         for row in rows {
             for col in cols.clone() {
                 let p = plane.point((col as f32 + 0.5) / w as f32, (row as f32 + 0.5) / h as f32);
+                // (The field is a lower bound of the distance: no step passes the skin.)
                 let mut y = top;
                 let skin = loop {
                     let d = shape.distance(Vec3::new(p.x, y, p.y));
-                    if d < 1e-5 {
-                        break (y > bottom).then_some(Vec3::new(p.x, y, p.y));
+                    if d < 0.01 * plane.mm {
+                        break Some(Vec3::new(p.x, y, p.y));
                     }
-                    y -= d.max(2e-5);
+                    y -= d.max(0.02 * plane.mm);
                     if y < bottom {
                         break None;
                     }
@@ -252,7 +252,7 @@ fn features(anatomy: &Anatomy, l: f32, mm: f32) -> (Side, Side) {
     let r_mcp = |f: usize| anatomy.radius[joint(&format!("{}-phalanx-proximal", webxr::FINGERS[f]))];
     let (index, middle, ring, little) = (mcp(1), mcp(2), mcp(3), mcp(4));
     let ulnar = -radial;
-    let deep = |g: Groove| Groove { width: 0.45 * mm, depth: 0.4 * mm, ..g };
+    let deep = |g: Groove| Groove::new(g.points, 0.45 * mm, 0.4 * mm);
     let distal = Groove::curve(little + ulnar * 1.1 * r_mcp(4) + proximal * 0.035 * l, ring + proximal * 0.05 * l, index.lerp(middle, 0.5) + proximal * 0.02 * l, 0.0, 0.0);
     let start = index + radial * 1.1 * r_mcp(1) + proximal * 0.085 * l;
     let proximal_line = Groove::curve(start, middle + proximal * 0.12 * l, ring + ulnar * 0.4 * r_mcp(3) + proximal * 0.17 * l, 0.0, 0.0);
@@ -301,8 +301,8 @@ fn paint(side: &Side, plane: PalmPlane, nails: &[Option<Vec2>], seed: u32) -> Sk
     let texel = Vec2::new(plane.across / w as f32, plane.along / h as f32);
     let mm = plane.mm;
     let mut height = vec![0.0f32; w * h];
-    let mut albedo = vec![0u8; 4 * w * h];
-    height.par_chunks_mut(w).zip(albedo.par_chunks_mut(4 * w)).enumerate().for_each(|(row, (heights, colours))| {
+    let mut albedo = vec![0u8; 3 * w * h];
+    height.par_chunks_mut(w).zip(albedo.par_chunks_mut(3 * w)).enumerate().for_each(|(row, (heights, colours))| {
         let v = (row as f32 + 0.5) / h as f32;
         let z = plane.point(0.5, v).y;
         let grooves: Vec<&Groove> = side.grooves.iter().filter(|g| (g.reach.0.y..=g.reach.1.y).contains(&z)).collect();
@@ -337,23 +337,22 @@ fn paint(side: &Side, plane: PalmPlane, nails: &[Option<Vec2>], seed: u32) -> Sk
                 depth = 0.1 * mm * (1.0 - ((rim - 1.0) / (CUTICLE - 1.0)).abs().min(1.0));
             }
             heights[col] = -depth;
-            let c = &mut colours[4 * col..4 * col + 4];
-            c.copy_from_slice(&[srgb(colour.x), srgb(colour.y), srgb(colour.z), 255]);
+            colours[3 * col..3 * col + 3].copy_from_slice(&[srgb(colour.x), srgb(colour.y), srgb(colour.z)]);
         }
     });
     // Tangent-space normals: +X along u, +Y up the image (against v), +Z out of the skin.
-    let mut normal = vec![0u8; 4 * w * h];
-    normal.par_chunks_mut(4 * w).enumerate().for_each(|(row, out)| {
+    let mut normal = vec![0u8; 3 * w * h];
+    normal.par_chunks_mut(3 * w).enumerate().for_each(|(row, out)| {
         for col in 0..w {
             let at = |c: usize, r: usize| height[r.min(h - 1) * w + c.min(w - 1)];
             let du = (at(col + 1, row) - at(col.saturating_sub(1), row)) / (2.0 * texel.x);
             let dv = (at(col, row + 1) - at(col, row.saturating_sub(1))) / (2.0 * texel.y);
             let n = Vec3::new(-du, dv, 1.0).normalize();
             let byte = |x: f32| (127.5 + 127.5 * x).round().clamp(0.0, 255.0) as u8;
-            out[4 * col..4 * col + 4].copy_from_slice(&[byte(n.x), byte(n.y), byte(n.z), 255]);
+            out[3 * col..3 * col + 3].copy_from_slice(&[byte(n.x), byte(n.y), byte(n.z)]);
         }
     });
-    SkinMaps { albedo: SkinImage { width: WIDTH, height: HEIGHT, rgba: albedo }, normal: SkinImage { width: WIDTH, height: HEIGHT, rgba: normal } }
+    SkinMaps { albedo: SkinImage { width: WIDTH, height: HEIGHT, rgb: albedo }, normal: SkinImage { width: WIDTH, height: HEIGHT, rgb: normal } }
 }
 
 fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
@@ -376,8 +375,9 @@ mod tests {
             let c = Vec3::from(to_local.inverse().translation);
             let [u, v] = plane.uv(c);
             let (col, row) = ((u * WIDTH as f32) as usize, (v * HEIGHT as f32) as usize);
-            let painted = (row.saturating_sub(40)..row + 40).flat_map(|r| (col.saturating_sub(40)..col + 40).map(move |c| (r, c))).filter(|&(r, c)| nails[r * WIDTH as usize + c].is_some()).count();
             assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v), "a nail at {c} is off the maps: {u} {v}");
+            let (rows, cols) = (row.saturating_sub(40)..(row + 40).min(HEIGHT as usize), col.saturating_sub(40)..(col + 40).min(WIDTH as usize));
+            let painted = rows.flat_map(|r| cols.clone().map(move |c| (r, c))).filter(|&(r, c)| nails[r * WIDTH as usize + c].is_some()).count();
             // A nail some 10 mm by 12 mm, about 40 by 50 texels; the thumb's foreshortened.
             assert!(painted > 500, "a nail at {c} of {radii} has {painted} texels");
         }

@@ -29,8 +29,8 @@ struct Glb {
 }
 
 impl Glb {
-    /// Appends one accessor over `bytes` (4-byte aligned); returns its index.
-    fn accessor(&mut self, bytes: &[u8], count: usize, component: u32, kind: &str, target: Option<u32>, bounds: Option<([f32; 3], [f32; 3])>) -> usize {
+    /// Appends `bytes` as a buffer view of their own (4-byte aligned); returns its index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         while self.bin.len() % 4 != 0 {
             self.bin.push(0);
         }
@@ -40,7 +40,13 @@ impl Glb {
         }
         self.bin.extend_from_slice(bytes);
         self.views.push(view);
-        let mut acc = json!({ "bufferView": self.views.len() - 1, "componentType": component, "count": count, "type": kind });
+        self.views.len() - 1
+    }
+
+    /// Appends one accessor over `bytes` (in a view of their own); returns its index.
+    fn accessor(&mut self, bytes: &[u8], count: usize, component: u32, kind: &str, target: Option<u32>, bounds: Option<([f32; 3], [f32; 3])>) -> usize {
+        let view = self.view(bytes, target);
+        let mut acc = json!({ "bufferView": view, "componentType": component, "count": count, "type": kind });
         if let Some((min, max)) = bounds {
             acc["min"] = json!(min);
             acc["max"] = json!(max);
@@ -105,30 +111,17 @@ impl Glb {
 /// (loaders that do not know it ignore it; the validator accepts it).
 pub const CENTRE_OF_ROTATION: &str = "_CENTRE_OF_ROTATION";
 
-/// Bytes of `image` as an RGB PNG (its alpha is opaque).
+/// Bytes of `image` as an RGB PNG.
 fn png(image: &SkinImage) -> Vec<u8> {
-    let rgb: Vec<u8> = image.rgba.chunks_exact(4).flat_map(|c| [c[0], c[1], c[2]]).collect();
     let mut out = Vec::new();
     let mut encoder = ::png::Encoder::new(&mut out, image.width, image.height);
     encoder.set_color(::png::ColorType::Rgb);
     encoder.set_depth(::png::BitDepth::Eight);
     encoder.set_compression(::png::Compression::High);
     let mut writer = encoder.write_header().expect("a PNG header into memory");
-    writer.write_image_data(&rgb).expect("an image of its own size into memory");
+    writer.write_image_data(&image.rgb).expect("an image of its own size into memory");
     writer.finish().expect("a PNG into memory");
     out
-}
-
-impl Glb {
-    /// Appends `bytes` as a buffer view of their own (4-byte aligned); returns its index.
-    fn view(&mut self, bytes: &[u8]) -> usize {
-        while self.bin.len() % 4 != 0 {
-            self.bin.push(0);
-        }
-        self.views.push(json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
-        self.bin.extend_from_slice(bytes);
-        self.views.len() - 1
-    }
 }
 
 /// The materials, images, textures and samplers of `appearance`, one material per region in
@@ -136,8 +129,8 @@ impl Glb {
 /// light of skin's fine hairs and oils, `KHR_materials_sheen`), and nails that are harder and
 /// coated (`KHR_materials_clearcoat`), drawn with the back's maps, where the nails are painted.
 fn appearance_materials(glb: &mut Glb, appearance: &Appearance) -> Value {
-    let maps = [appearance.back(), appearance.palm()];
-    let images: Vec<Value> = maps.iter().flat_map(|m| [&m.albedo, &m.normal]).map(|image| json!({ "bufferView": glb.view(&png(image)), "mimeType": "image/png" })).collect();
+    let maps = appearance.maps();
+    let images: Vec<Value> = maps.iter().flat_map(|m| [&m.albedo, &m.normal]).map(|image| json!({ "bufferView": glb.view(&png(image), None), "mimeType": "image/png" })).collect();
     let textures: Vec<Value> = (0..images.len()).map(|i| json!({ "sampler": 0, "source": i })).collect();
     let material = |region: SurfaceRegion| {
         let side = usize::from(region == SurfaceRegion::Palm);
@@ -221,7 +214,7 @@ pub fn skinned_glb(model: &Model) -> Vec<u8> {
         attributes[format!("WEIGHTS_{set}")] = json!(wa);
     }
     // One primitive per region of the skin over the same vertices, or one for the whole mesh.
-    let appearance = model.appearance.as_deref().filter(|a| !mesh.uvs().is_empty() && a.regions.last().is_some_and(|r| r.1.end == mesh.indices().len()));
+    let appearance = model.appearance.as_deref().filter(|a| !mesh.uvs().is_empty() && a.covers(mesh.indices().len()));
     let primitives: Vec<Value> = match appearance {
         Some(a) => a
             .regions

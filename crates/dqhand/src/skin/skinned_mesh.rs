@@ -60,9 +60,7 @@ impl MeshData {
             return; // Left for `SkinnedMesh::new` to report.
         }
         let count = |v: usize| self.weights[v * self.stride..][..self.stride].iter().filter(|&&w| w > 0.0).count();
-        let mut ranges: Vec<_> = if self.parts.is_empty() { vec![0..n] } else { self.parts.iter().map(|p| p.vertices.clone()).collect() };
-        // (Parts in several materials over the same vertices share a range.)
-        ranges.dedup();
+        let ranges = if self.parts.is_empty() { vec![0..n] } else { self.parts.iter().map(|p| p.vertices.clone()).collect() };
         let mut order: Vec<usize> = (0..n).collect();
         for r in ranges.into_iter().filter(|r| r.start <= r.end && r.end <= n) {
             order[r].sort_by_key(|&v| count(v));
