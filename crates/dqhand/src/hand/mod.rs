@@ -9,11 +9,10 @@
 //! * `tessellation`: that surface meshed (surface nets), simplified to an exact vertex count
 //!   (meshoptimizer), relaxed and projected back onto the surface: one closed, 2-manifold
 //!   mesh, 8,668 vertices by default (the paper's Table 2);
-//! * `weights`: skin weights from each bone's parts, at most four per vertex.
-//!
+//! * `weights`: skin weights from each bone's parts, at most four per vertex;
 //! * `surface_regions`: which triangles are nail, palm and back, ordered by region;
 //! * `skin_texture`: the back's and the palm's albedo and normal maps (creases, palm lines,
-//!   knuckle wrinkles, nails, pores), drawn when first asked for.
+//!   knuckle wrinkles, nails, pores), drawn when asked for, not kept.
 //!
 //! UVs are a planar projection onto the palm plane (u across the hand, v along it), the same
 //! for the back and the palm, each region drawn with its own maps: seamless, so glTF's vertex
