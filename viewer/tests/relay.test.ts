@@ -134,7 +134,8 @@ describe('another device on /input, and Record', () => {
     expect(saved.records).toBe(lines.length);
     expect(path.dirname(saved.path!)).toBe(recordings());
     expect(readFileSync(saved.path!, 'utf8').split('\n').filter(Boolean)).toHaveLength(lines.length);
-    const replay = spawnSync(dqhandBin(), ['replay', '--input', saved.path!], { encoding: 'utf8' });
+    // Replayed under the live input's config: a replay judges lateness by the recorded arrivals.
+    const replay = spawnSync(dqhandBin(), ['replay', '--input', saved.path!, '--config', path.join(dir, 'config.json')], { encoding: 'utf8' });
     expect(replay.status).toBe(0);
     expect(replay.stderr).toContain(`${lines.length} records, ${lines.length} taken`);
     expect(s.errors).toEqual([]);
