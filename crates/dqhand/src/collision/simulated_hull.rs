@@ -1,5 +1,5 @@
-//! The shape the physics simulates a hull proxy as: a few of its vertices' hull, rounded by
-//! how far the rest lie outside it, so it holds the whole proxy.
+//! The shape the physics simulates a hull proxy or a mesh object as: a few of its vertices' hull,
+//! rounded by how far the rest lie outside it, so it holds the whole proxy (or object).
 //!
 //! A hull proxy is the hull of every skin vertex its joint carries (957 vertices on the built-in
 //! hand's wrist). rapier transforms every one of them for the collider's box twice a step, and
