@@ -20,6 +20,7 @@ use dqhand::interaction::ManipulationLoop;
 use dqhand::kinematics::JointModel;
 use dqhand::model::Model;
 use dqhand::scene::Scene;
+use dqhand::skin::Crew;
 use glam::Vec3;
 use serde_json::{json, Value};
 
@@ -135,6 +136,10 @@ pub struct Args {
     /// Input configuration (filters, grace times) to measure instead of the default one.
     #[arg(long)]
     config: Option<std::path::PathBuf>,
+    /// Threads each hand's fingers close on (the caller's and helpers; 1: the caller's alone).
+    /// Default: the cores, at most five (one per finger).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 /// One run: what was done and what it measured.
@@ -161,6 +166,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let model = Arc::new(ModelSource::Builtin(HandParams::default()).load()?);
     let config = args.config.as_deref().map(InputConfig::load).transpose()?.unwrap_or_default();
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    let threads = args.threads.unwrap_or(cores.min(5));
+    anyhow::ensure!((1..=64).contains(&threads), "--threads {threads}: from 1 to 64");
+    let crew = (threads > 1).then(|| Crew::new(threads, Crew::SPIN).map(Arc::new)).transpose()?;
+    let bench = Bench { config, crew };
     let mut runs = Vec::new();
     for (index, object) in all.objects.iter().enumerate().filter(|(_, o)| args.objects.is_empty() || args.objects.contains(&o.name)) {
         let kind = kind(&object.name);
@@ -170,7 +180,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         for approach in approaches() {
             for &speed in &args.speeds {
                 let task = GraspTask { object: object.name.clone(), approach: approach.palm, fingers: approach.fingers, speed, lift: LIFT_M, carry: CARRY, pinch: kind == Kind::Pinch, drop: 0.0, aim: Vec3::ZERO };
-                let score = measure(&model, &scene, &task, &config, None)?;
+                let score = measure(&model, &scene, &task, &bench, None)?;
                 runs.push(Run { object: object.name.clone(), kind, approach: approach.name, speed, headset: false, score });
             }
         }
@@ -181,14 +191,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let seed = 10 * index as u64 + APPROACHES.iter().position(|a| a.name == approach.name).unwrap_or(0) as u64;
             let aim = off_centre(approach.palm, seed) * AIM_OFF_M;
             let task = GraspTask { object: object.name.clone(), approach: approach.palm, fingers: approach.fingers, speed: 0.5, lift: LIFT_M, carry: CARRY, pinch: kind == Kind::Pinch, drop: 0.0, aim };
-            let score = measure(&model, &scene, &task, &config, Some(seed))?;
+            let score = measure(&model, &scene, &task, &bench, Some(seed))?;
             runs.push(Run { object: object.name.clone(), kind, approach: approach.name, speed: 0.5, headset: true, score });
         }
         if DROPPED.contains(&object.name.as_str()) && (args.approaches.is_empty() || args.approaches.iter().any(|n| n == "above")) {
             let above = &APPROACHES[0];
             for headset in [false, true] {
                 let task = GraspTask { object: object.name.clone(), approach: above.palm, fingers: above.fingers, speed: 0.5, lift: LIFT_M, carry: CARRY, pinch: false, drop: DROP_M, aim: Vec3::ZERO };
-                let score = measure(&model, &scene, &task, &config, headset.then_some(10 * index as u64 + 9))?;
+                let score = measure(&model, &scene, &task, &bench, headset.then_some(10 * index as u64 + 9))?;
                 runs.push(Run { object: object.name.clone(), kind: Kind::Drop, approach: above.name, speed: 0.5, headset, score });
             }
         }
@@ -197,13 +207,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let left = Arc::new(ModelSource::Builtin(HandParams { side: Side::Left, ..HandParams::default() }).load()?);
         for kind in [Kind::Between, Kind::HandOver] {
             for headset in [false, true] {
-                let (object, score) = measure_two([&left, &model], kind, &config, headset.then_some(100 + kind.hands() as u64 * 10 + kind as u64))?;
+                let (object, score) = measure_two([&left, &model], kind, &bench, headset.then_some(100 + kind.hands() as u64 * 10 + kind as u64))?;
                 runs.push(Run { object, kind, approach: "both", speed: 0.5, headset, score });
             }
         }
     }
-    let lags = LAG_SPEEDS.iter().enumerate().map(|(k, &speed)| measure_lag(&model, &all, speed, k as u64 + 1, &config)).collect::<anyhow::Result<Vec<_>>>()?;
-    let report = report(&runs, &lags);
+    let lags = LAG_SPEEDS.iter().enumerate().map(|(k, &speed)| measure_lag(&model, &all, speed, k as u64 + 1, &bench)).collect::<anyhow::Result<Vec<_>>>()?;
+    let report = report(&runs, &lags, threads);
     if args.json {
         println!("{report}");
     } else {
@@ -219,22 +229,39 @@ fn off_centre(approach: Vec3, seed: u64) -> Vec3 {
     (v - approach * v.dot(approach)).normalize_or(approach.any_orthonormal_vector())
 }
 
+/// What every run is measured with.
+struct Bench {
+    config: InputConfig,
+    /// The threads the fingers close on, beside the caller's.
+    crew: Option<Arc<Crew>>,
+}
+
+impl Bench {
+    /// `manip` measured as the bench measures.
+    fn with_crew(&self, manip: ManipulationLoop) -> ManipulationLoop {
+        match &self.crew {
+            Some(crew) => manip.with_crew(Arc::clone(crew)),
+            None => manip,
+        }
+    }
+}
+
 /// One run; with a seed, as a headset tracks it ([`HeadsetTracking::QUEST_LIKE`]).
-fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask, config: &InputConfig, headset: Option<u64>) -> anyhow::Result<RunScore> {
+fn measure(model: &Arc<Model>, scene: &Scene, task: &GraspTask, bench: &Bench, headset: Option<u64>) -> anyhow::Result<RunScore> {
     let objects = ObjectColliders::new(scene)?;
     let script = grasp_script::grasp(model.clone(), "objects", &objects, task, Side::Right)?;
     let script = match headset {
         Some(seed) => HeadsetTracking::QUEST_LIKE.track(&script, seed),
         None => script,
     };
-    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, config.clone(), None, scene, GraspParams::default())?;
+    let mut manip = bench.with_crew(ManipulationLoop::new(model.clone(), JointModel::Full, None, bench.config.clone(), None, scene, GraspParams::default())?);
     // Where it comes to rest: carried there, and set down or dropped onto the table.
     Ok(score(&mut manip, &script, 0, scene.objects[0].position + task.carry))
 }
 
 /// A two-hand run of `kind` on the `two-hands` scene by `models` (left, right); with a seed,
 /// as a headset tracks both hands. Returns the object's name and the score.
-fn measure_two(models: [&Arc<Model>; 2], kind: Kind, config: &InputConfig, headset: Option<u64>) -> anyhow::Result<(String, RunScore)> {
+fn measure_two(models: [&Arc<Model>; 2], kind: Kind, bench: &Bench, headset: Option<u64>) -> anyhow::Result<(String, RunScore)> {
     let scene = Scene::named(TWO_HANDS_SCENE)?;
     let objects = ObjectColliders::new(&scene)?;
     let pair = [&**models[0], &**models[1]];
@@ -248,7 +275,7 @@ fn measure_two(models: [&Arc<Model>; 2], kind: Kind, config: &InputConfig, heads
     };
     let index = scene.objects.iter().position(|o| o.name == object).expect("the two-hands scene has both");
     let hands = models.map(|m| (Arc::clone(m), None));
-    let mut manip = ManipulationLoop::two_handed(hands, JointModel::Full, config.clone(), None, &scene, GraspParams::default())?;
+    let mut manip = bench.with_crew(ManipulationLoop::two_handed(hands, JointModel::Full, bench.config.clone(), None, &scene, GraspParams::default())?);
     Ok((object.to_owned(), score(&mut manip, &script, index, scene.objects[index].position + carried)))
 }
 
@@ -258,11 +285,11 @@ const TWO_HAND_CARRY: Vec3 = Vec3::new(0.0, 0.0, 0.2);
 const HAND_OVER_CARRY: Vec3 = Vec3::new(0.0, 0.0, 0.12);
 
 /// A free hand swept at `speed` 35 cm above the table, nothing near it.
-fn measure_lag(model: &Arc<Model>, all: &Scene, speed: f32, seed: u64, config: &InputConfig) -> anyhow::Result<LagScore> {
+fn measure_lag(model: &Arc<Model>, all: &Scene, speed: f32, seed: u64, bench: &Bench) -> anyhow::Result<LagScore> {
     let scene = Scene { table: all.table, objects: Vec::new(), actions: Vec::new() };
     let height = all.table.map_or(0.0, |t| t.height);
     let sweep = grasp_script::sweep(model, Vec3::new(-0.8, height + 0.35, 0.0), Vec3::X, speed, Side::Right, seed)?;
-    let mut manip = ManipulationLoop::new(model.clone(), JointModel::Full, None, config.clone(), None, &scene, GraspParams::default())?;
+    let mut manip = bench.with_crew(ManipulationLoop::new(model.clone(), JointModel::Full, None, bench.config.clone(), None, &scene, GraspParams::default())?);
     Ok(lag(&mut manip, &sweep))
 }
 
@@ -274,7 +301,7 @@ fn us(d: Option<Distribution>) -> Value {
     d.map_or(Value::Null, |d| json!({"median": d.median * 1e6, "p95": d.p95 * 1e6, "p99": d.p99 * 1e6, "max": d.max * 1e6, "frames": d.count}))
 }
 
-fn report(runs: &[Run], lags: &[LagScore]) -> Value {
+fn report(runs: &[Run], lags: &[LagScore], threads: usize) -> Value {
     let grasps: Vec<&Run> = runs.iter().filter(|r| r.kind != Kind::Strike).collect();
     let drift = |kind: Kind| runs.iter().filter(|r| r.kind == kind && r.score.release_frames.is_some()).map(|r| r.score.release_drift_m).fold(0.0, f32::max);
     let successes = grasps.iter().filter(|r| r.score.success).count();
@@ -304,6 +331,7 @@ fn report(runs: &[Run], lags: &[LagScore]) -> Value {
     json!({
         "synthetic": "scripted approach-grasp-lift-carry-release sequences from dqhand's own kinematics (dqhand::interaction::grasp_script); not captured from a person",
         "build": if cfg!(debug_assertions) { "debug" } else { "release" },
+        "threads": threads,
         "grasps": grasps.len(), "successes": successes, "success_rate": rate,
         "headset_grasps": grasps.iter().filter(|r| r.headset).count(), "headset_successes": grasps.iter().filter(|r| r.headset && r.score.success).count(), "success_pass": !grasps.is_empty() && rate >= SUCCESS_TARGET,
         "max_penetration_mm": mm(max_penetration), "mean_penetration_mm": mm(mean_penetration), "penetration_pass": max_penetration <= PENETRATION_TARGET_M,
@@ -335,6 +363,7 @@ fn print_tables(r: &Value) {
     if r["build"] == "debug" {
         println!("debug build: the timings below are not meaningful; build with `cargo build --release -p dqhand-cli`");
     }
+    println!("fingers closed on {} thread(s) a hand (--threads)", r["threads"]);
     println!();
     println!(
         "{:<8} {:<8} {:<6} {:>6} {:>8} {:>8} {:>10} {:>10} {:>8} {:>9} {:>8} {:>7} {:>9} {:>9} {:>10} {:>6} {:>10} {:>10}",

@@ -31,6 +31,8 @@
 //!
 //! The tracked pose is left as it is: the grasp logic reads it.
 
+use std::sync::{Arc, Mutex, PoisonError};
+
 use glam::{Affine3A, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{self, NonlinearRigidMotion};
@@ -40,6 +42,7 @@ use super::hand_proxies::pose_of;
 use super::{HandPart, HandProxies, ObjectCollider, ObjectColliders, FINGERS};
 use crate::kinematics::{forward_kinematics, forward_kinematics_of, HandKinematics, Motion, Pose, Transform};
 use crate::math::DualQuat;
+use crate::skin::Crew;
 
 /// Proxies closer than this to an object touch it (m).
 pub const CONTACT_DISTANCE: f32 = 0.002;
@@ -130,16 +133,52 @@ struct FingerChain {
 /// A bound that must be measured.
 const UNMEASURED: (f32, f32) = (f32::NEG_INFINITY, 0.0);
 
+/// One finger's closure (stage 2) with buffers of its own, so that the five may close at
+/// once ([`ContactConstraint::set_crew`]), each on its own copy of the pose, and give back
+/// their DOFs.
+#[derive(Clone)]
+struct FingerCloser {
+    chain: FingerChain,
+    /// The pose it tries: the frame's rendered pose so far, its own DOFs as it closes.
+    trial: Pose,
+    /// The local and world transforms of the poses that conservative advancement tries.
+    trial_locals: Vec<Transform>,
+    trial_world: Vec<Affine3A>,
+    /// The objects within its reach in its last closure (none where it kept its grip
+    /// without closing).
+    near: Vec<usize>,
+    /// Its own queries' buffers and remembered directions.
+    query: ProxyMeshQuery,
+    /// How many of its leading closing joints its last closure stopped on contacts with the
+    /// held object.
+    held_prefix: usize,
+    /// Whether its last closure reached the tracked angles untouched.
+    free: bool,
+}
+
+/// What every finger's closure reads: the frame's hand so far, the last one, and the scene.
+struct ClosureScene<'a> {
+    kinematics: &'a HandKinematics,
+    proxies: &'a HandProxies,
+    /// The tracked angles, the rendered wrist.
+    rendered: &'a Pose,
+    previous: &'a Pose,
+    tracked: &'a Pose,
+    /// The last frame's contacts.
+    contacts: &'a [Contact],
+    objects: &'a ObjectColliders,
+    held: Option<usize>,
+    /// Whether the hand is still on the held object (see [`ContactConstraint::solve`]).
+    still: bool,
+}
+
 /// Solves the rendered pose from the tracked one each frame; every buffer is allocated once.
 #[derive(Clone)]
 pub struct ContactConstraint {
     proxies: HandProxies,
-    fingers: [FingerChain; 5],
+    fingers: [FingerCloser; 5],
     /// The rendered hand, posed once per solve.
     kinematics: HandKinematics,
-    /// The local and world transforms of the poses that conservative advancement tries.
-    trial_locals: Vec<Transform>,
-    trial_world: Vec<Affine3A>,
     tracked_world: Vec<Affine3A>,
     tracked: Pose,
     rendered: Pose,
@@ -153,11 +192,6 @@ pub struct ContactConstraint {
     /// The object that carried the rendered hand (its grip) in the last solve, and its pose
     /// there: the contacts with it were found at that pose.
     carried: Option<(usize, parry3d::math::Pose)>,
-    /// Per finger: how many of its leading closing joints its last closure stopped on contacts
-    /// with the held object.
-    held_prefix: [usize; 5],
-    /// Per finger: whether its last closure reached the tracked angles untouched.
-    free: [bool; 5],
     /// How far the wrist may have moved (m, any proxy point) since its last cast: motions too
     /// small to cast add up to [`STILL_M`] at most.
     uncast: f32,
@@ -168,10 +202,11 @@ pub struct ContactConstraint {
     /// The last frame's contacts (a second buffer, swapped with `contacts`).
     last_contacts: Vec<Contact>,
     closure: [Closure; 5],
-    near: Vec<usize>,
     mesh_query: ProxyMeshQuery,
     /// The proxy (index in [`HandProxies::colliders`]) that last stopped the wrist: cast first.
     first_stop: usize,
+    /// Threads the fingers close on ([`Self::set_crew`]); none: the caller's alone.
+    crew: Option<Arc<Crew>>,
 }
 
 impl ContactConstraint {
@@ -251,21 +286,33 @@ impl ContactConstraint {
             FingerChain { dofs, others, joints: subtree, turns, proxies, reach, bounds }
         });
         let n = skeleton.len();
-        let moved_by = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.joints.contains(&j))).collect();
+        let moved_by: Vec<Option<usize>> = (0..n).map(|j| fingers.iter().position(|c: &FingerChain| c.joints.contains(&j))).collect();
+        debug_assert!(
+            fingers.iter().enumerate().all(|(f, c)| c.joints.iter().all(|&j| moved_by[j] == Some(f)) && c.turns.iter().all(|&i| fingers.iter().enumerate().all(|(g, d)| g == f || !d.turns.contains(&i)))),
+            "the fingers' chains share no joint and no DOF (they close in parallel)"
+        );
+        let query = ProxyMeshQuery::new(&proxies);
+        let fingers = fingers.map(|chain| FingerCloser {
+            chain,
+            trial: Pose::rest(rig.dofs().len()),
+            trial_locals: skeleton.rest_locals(),
+            trial_world: vec![Affine3A::IDENTITY; n],
+            near: Vec::new(),
+            query: query.clone(),
+            held_prefix: 0,
+            free: false,
+        });
         Self {
-            mesh_query: ProxyMeshQuery::new(&proxies),
+            mesh_query: query,
             first_stop: 0,
+            crew: None,
             contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             last_contacts: Vec::with_capacity(proxies.colliders().len() * 4),
             carried: None,
-            held_prefix: [0; 5],
-            free: [false; 5],
             uncast: 0.0,
             moved_by,
             proxies,
             fingers,
-            trial_locals: skeleton.rest_locals(),
-            trial_world: vec![Affine3A::IDENTITY; n],
             tracked_world: vec![Affine3A::IDENTITY; n],
             tracked: Pose::rest(rig.dofs().len()),
             rendered: Pose::rest(rig.dofs().len()),
@@ -274,9 +321,17 @@ impl ContactConstraint {
             grip: None,
             held_back_since: None,
             closure: [Closure::default(); 5],
-            near: Vec::new(),
             kinematics,
         }
+    }
+
+    /// Closes the fingers (stage 2) across `crew`'s threads (none: on the caller's alone)
+    /// where two or more have objects within reach. Their chains share no joint and no DOF,
+    /// so each closes on its own copy of the pose and the rendered pose is the one closed
+    /// finger after finger. Around the teapot the five closures take 0.5–0.9 ms in turn, most
+    /// of such a frame (docs/performance.md). Allocates nothing per frame, as the crew does not.
+    pub fn set_crew(&mut self, crew: Option<Arc<Crew>>) {
+        self.crew = crew;
     }
 
     /// Forgets the last rendered hand (its wrist, grip, contacts and joints kept on contacts): the next
@@ -288,8 +343,9 @@ impl ContactConstraint {
         self.grip = None;
         self.carried = None;
         self.contacts.clear();
-        self.held_prefix = [0; 5];
-        self.free = [false; 5];
+        for finger in &mut self.fingers {
+            (finger.held_prefix, finger.free) = (0, false);
+        }
         self.uncast = 0.0;
     }
 
@@ -313,18 +369,27 @@ impl ContactConstraint {
     pub fn track(&mut self, tracked: &Pose, tracked_world: &[Affine3A]) {
         self.tracked.clone_from(tracked);
         self.tracked_world.copy_from_slice(tracked_world);
-        for (f, chain) in self.fingers.iter().enumerate() {
-            self.closure[f].tracked = chain.dofs.iter().map(|&(i, _)| tracked.angles[i]).sum();
+        for (f, finger) in self.fingers.iter().enumerate() {
+            self.closure[f].tracked = finger.chain.dofs.iter().map(|&(i, _)| tracked.angles[i]).sum();
         }
     }
 
     /// Solves the rendered pose for the tracked pose of [`Self::track`] at time `now` (s)
     /// against `objects`; `held`, the object in the hand, moves with the hand, so it does not
     /// stop the wrist, and the fingers that touched it keep their grip (the module
-    /// documentation, stage 2). Allocates nothing once `near` has grown to the scene.
+    /// documentation, stage 2). Allocates nothing once the fingers' `near` have grown to the scene.
     pub fn solve(&mut self, objects: &ObjectColliders, held: Option<usize>, now: f64) {
-        if self.near.capacity() < objects.len() {
-            self.near.reserve(objects.len());
+        // A finger far from everything closes in microseconds: a split pays only where two or
+        // more had objects within reach in their last closure. The crew is woken now, to join
+        // the closure from its start.
+        let split = self.fingers.iter().filter(|finger| !finger.near.is_empty()).count() >= 2;
+        if let Some(crew) = self.crew.as_ref().filter(|_| split) {
+            crew.wake_ahead();
+        }
+        for finger in &mut self.fingers {
+            if finger.near.capacity() < objects.len() {
+                finger.near.reserve(objects.len());
+            }
         }
         let target = self.tracked.wrist.unwrap_or_else(|| self.kinematics.rig().rest_wrist());
         let (wrist, carrier) = match self.grip {
@@ -350,36 +415,46 @@ impl ContactConstraint {
         self.previous.clone_from(&self.rendered);
         self.rendered.clone_from(&self.tracked);
         self.rendered.wrist = Some(wrist);
+        let scene = ClosureScene {
+            kinematics: &self.kinematics,
+            proxies: &self.proxies,
+            rendered: &self.rendered,
+            previous: &self.previous,
+            tracked: &self.tracked,
+            contacts: &self.contacts,
+            objects,
+            held,
+            still: still_on.is_some(),
+        };
+        let closure = self.closure;
+        match self.crew.as_ref().filter(|_| split) {
+            Some(crew) => {
+                // One lock per finger, each taken by the one piece that closes it: uncontended.
+                let fingers = self.fingers.each_mut().map(Mutex::new);
+                crew.run(fingers.len(), &|f| fingers[f].lock().unwrap_or_else(PoisonError::into_inner).close(f, closure[f], &scene));
+            }
+            None => {
+                for (f, finger) in self.fingers.iter_mut().enumerate() {
+                    finger.close(f, closure[f], &scene);
+                }
+            }
+        }
         // Per finger: its rendered angles are the last frame's.
         let mut kept = [false; 5];
-        for (f, kept) in kept.iter_mut().enumerate() {
-            self.close_finger(f, objects, held, still_on.is_some());
-            let chain = &self.fingers[f];
+        for (finger, kept) in self.fingers.iter().zip(&mut kept) {
+            let chain = &finger.chain;
+            for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
+                self.rendered.angles[i] = finger.trial.angles[i];
+            }
             let same = |i: usize| self.rendered.angles[i].to_bits() == self.previous.angles[i].to_bits();
             *kept = chain.dofs.iter().all(|&(i, _)| same(i)) && chain.others.iter().all(|&i| same(i));
         }
         self.kinematics.pose(&self.rendered);
         self.find_contacts(objects, still_on, kept);
         self.carried = carrier.map(|o| (o, objects.collider(o).pose));
-        for (f, chain) in self.fingers.iter().enumerate() {
-            self.closure[f].rendered = chain.dofs.iter().map(|&(i, _)| self.rendered.angles[i]).sum();
+        for (f, finger) in self.fingers.iter().enumerate() {
+            self.closure[f].rendered = finger.chain.dofs.iter().map(|&(i, _)| self.rendered.angles[i]).sum();
         }
-    }
-
-    /// Forward kinematics of a pose conservative advancement tries (the rendered angles so
-    /// far), into the trial transforms: a step of the search, not the rendered hand.
-    fn forward_trial(&mut self) {
-        let rig = self.kinematics.rig();
-        rig.locals(&self.rendered, self.kinematics.limits(), &mut self.trial_locals);
-        forward_kinematics(rig.skeleton(), &self.trial_locals, &mut self.trial_world);
-    }
-
-    /// [`Self::forward_trial`] of only `chain`'s joints, the rest as the last trial left them:
-    /// a step of its closure, which turns nothing else.
-    fn forward_trial_of(&mut self, chain: &FingerChain) {
-        let rig = self.kinematics.rig();
-        rig.locals_of(&self.rendered, self.kinematics.limits(), &chain.joints, &chain.turns, &mut self.trial_locals);
-        forward_kinematics_of(rig.skeleton(), &chain.joints, &self.trial_locals, &mut self.trial_world);
     }
 
     /// Stage 1: the first time of impact of the palm on its way to `target`.
@@ -483,194 +558,6 @@ impl ContactConstraint {
         })
     }
 
-    /// Stage 2 for finger `f`: conservative advancement of its closure.
-    ///
-    /// A finger that touched the `held` object last frame keeps its grip until the tracked
-    /// finger opens past it: the closure starts from the finger as last rendered, the joints up
-    /// to a phalanx touching there stay, and the distal ones close on (it wraps the object
-    /// further). Closing it from open again would ask the object the same questions every
-    /// frame, and a slightly different path may end on a different contact (the tracked
-    /// finger has gone into the object), turning the object in the hand. Its abduction stays
-    /// too: it would slide the touching phalanx sideways, unchecked.
-    ///
-    /// While the hand is `still` on the held object (see [`Self::solve`]), the leading joints of
-    /// a gripping finger that stopped on contacts with it last frame stop there again at once:
-    /// they are kept without a query, and only the joints past them close (none, when every
-    /// joint had stopped on it).
-    fn close_finger(&mut self, f: usize, objects: &ObjectColliders, held: Option<usize>, still: bool) {
-        let mut chain = std::mem::take(&mut self.fingers[f]);
-        if chain.dofs.is_empty() {
-            self.fingers[f] = chain;
-            return;
-        }
-        let opening = self.closure[f].tracked < self.closure[f].rendered;
-        let gripping = held.is_some_and(|h| !opening && self.contacts.iter().any(|c| c.object == h && c.part == HandPart::Finger(f)));
-        let kept = if gripping && still { self.held_prefix[f].min(chain.dofs.len()) } else { 0 };
-        if kept == chain.dofs.len() {
-            for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
-                self.rendered.angles[i] = self.previous.angles[i];
-            }
-            self.free[f] = false;
-            self.fingers[f] = chain;
-            return;
-        }
-        // The closure runs from `start` to the tracked angles (`self.rendered` holds those).
-        let mut target = [0.0f32; 4];
-        let mut start = [0.0f32; 4];
-        for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-            target[k] = self.rendered.angles[i];
-            self.rendered.angles[i] = 0.0;
-        }
-        if gripping {
-            for &i in &chain.others {
-                self.rendered.angles[i] = self.previous.angles[i];
-            }
-        }
-        self.forward_trial();
-        let root = Vec3::from(self.trial_world[chain.dofs[0].1].translation);
-        let reach = Aabb::from_half_extents(root, Vec3::splat(chain.reach));
-        self.near.clear();
-        self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
-        let mut active = kept;
-        // The leading joints stopped on the held object so far.
-        let mut prefix = kept;
-        let mut s: f32 = 0.0;
-        if !self.near.is_empty() {
-            let set = |angles: &mut [f32], active: usize, s: f32, start: &[f32; 4], target: &[f32; 4]| {
-                for (k, &(i, _)) in chain.dofs.iter().enumerate().skip(active) {
-                    angles[i] = start[k] + (target[k] - start[k]) * s;
-                }
-            };
-            // Where the closure starts: open, else as last rendered, else the tracked angles
-            // (clear after a snap of the wrist); the first whose proxies are clear. When
-            // none is (an object has moved into the finger), the finger stays as last
-            // rendered, the least change, and the physics pushes the object off it; but an
-            // object let go passes through the fingers round it (`ScenePhysics::release`),
-            // so where only meshes are that near, whose signed distances tell how deep, the
-            // finger takes the start they overlap clearly the least ([`SWITCH_OVERLAP`]).
-            // A finger of a hand holding something that reached the tracked angles untouched
-            // last frame tries as last rendered first: from open it would meet the object on
-            // its way to angles clear of it, and flicker between the two every other frame
-            // (the little finger curled under a ball held from above). Not while nothing is
-            // held: closing from where they were drawn let the 4 cm ball through the fingers
-            // on the approach. The starts are kinds 0 (open), 1 (last rendered) and 2
-            // (tracked), tried in `order`; `checking` is the place in `order` of the one being
-            // tried until one is clear, and `tried` holds per kind its nearest distance and
-            // whether nothing but a mesh was within the stop distance (a primitive's or the
-            // table's reads 0 at any depth). A gripping finger starts as last rendered,
-            // touching.
-            let free = self.free[f] && held.is_some();
-            let order = if free { [1, 0, 2] } else { [0, 1, 2] };
-            let mut checking = Some(0);
-            let mut tried = [(0.0f32, false); 3];
-            starting_angles(order[0], &chain.dofs, &self.previous, &self.tracked, &mut start);
-            if gripping {
-                for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                    start[k] = self.previous.angles[i];
-                    if k < kept {
-                        self.rendered.angles[i] = start[k];
-                    }
-                }
-                checking = None;
-            }
-            chain.bounds.fill(UNMEASURED);
-            for _ in 0..MAX_ADVANCES {
-                set(&mut self.rendered.angles, active, s, &start, &target);
-                self.forward_trial_of(&chain);
-                // The nearest proxy measured (its distance, last DOF and the object), and the
-                // largest step no point of any can overrun. A proxy is measured only where its
-                // bound may have come down to the stop distance: the others cannot stop the
-                // finger here, and their bounds still limit the step.
-                let mut nearest = (f32::INFINITY, 0, usize::MAX);
-                let mut meshes_only = true;
-                let mut step = f32::INFINITY;
-                for ((p, last, levers), (bound, at)) in chain.proxies.iter().zip(chain.bounds.iter_mut()) {
-                    if *last < active {
-                        continue;
-                    }
-                    let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
-                    let mut remaining = *bound - speed * (s - *at);
-                    if remaining <= STOP_DISTANCE {
-                        let proxy = &self.proxies.colliders()[*p];
-                        let pose = pose_of(&self.trial_world[proxy.joint]);
-                        let (mut d, mut to) = (f32::INFINITY, usize::MAX);
-                        for &o in &self.near {
-                            let c = objects.collider(o);
-                            // (Against a mesh, exact only where it stops the finger: above, a
-                            // lower bound steps nearly as far, and saves measuring the triangles within
-                            // millimetres of a palm's hull, which the search could not tell
-                            // apart, at every step.)
-                            let (here, signed) = match c.triangles() {
-                                Some(mesh) => (self.mesh_query.distance_at_least(*p, &pose, mesh, &c.pose, STOP_DISTANCE, MESH_LOOKOUT), true),
-                                None => (c.distance_at_least(&pose, proxy, STOP_DISTANCE), false),
-                            };
-                            meshes_only &= signed || here > STOP_DISTANCE;
-                            if here < d {
-                                (d, to) = (here, o);
-                            }
-                        }
-                        (*bound, *at, remaining) = (d, s, d);
-                        if d < nearest.0 {
-                            nearest = (d, *last, to);
-                        }
-                    }
-                    if speed > 0.0 {
-                        step = step.min(remaining / speed);
-                    }
-                }
-                if let Some(at) = checking.take() {
-                    if nearest.0 <= STOP_DISTANCE {
-                        tried[order[at]] = (nearest.0, meshes_only);
-                        // The next start to try; after the last, as last rendered unless
-                        // another overlaps only meshes, clearly less (the least; ties: open).
-                        let next = match at {
-                            0 | 1 => order[at + 1],
-                            _ if !tried[1].1 => 1,
-                            _ => [2, 0].into_iter().filter(|&b| tried[b].1 && tried[b].0 > tried[1].0 + SWITCH_OVERLAP).max_by(|&a, &b| tried[a].0.total_cmp(&tried[b].0)).unwrap_or(1),
-                        };
-                        starting_angles(next, &chain.dofs, &self.previous, &self.tracked, &mut start);
-                        if at == 2 {
-                            break;
-                        }
-                        checking = Some(at + 1);
-                        chain.bounds.fill(UNMEASURED);
-                        continue;
-                    }
-                }
-                if nearest.0 <= STOP_DISTANCE {
-                    // Contact: the joints up to the touching phalanx stop here; the rest close on.
-                    for k in active..chain.dofs.len() {
-                        start[k] = self.rendered.angles[chain.dofs[k].0];
-                    }
-                    if prefix == active && held == Some(nearest.2) {
-                        prefix = nearest.1 + 1;
-                    }
-                    active = nearest.1 + 1;
-                    s = 0.0;
-                    chain.bounds.fill(UNMEASURED);
-                    if active >= chain.dofs.len() {
-                        break;
-                    }
-                    continue;
-                }
-                if s + step >= 1.0 {
-                    s = 1.0;
-                    break;
-                }
-                s += step;
-            }
-            set(&mut self.rendered.angles, active, s, &start, &target);
-        } else {
-            for (k, &(i, _)) in chain.dofs.iter().enumerate() {
-                self.rendered.angles[i] = target[k];
-            }
-            prefix = 0;
-        }
-        self.held_prefix[f] = prefix;
-        self.free[f] = self.near.is_empty() || (active == 0 && s >= 1.0);
-        self.fingers[f] = chain;
-    }
-
     /// The contacts of the rendered pose. Where the hand was `still_on` an object (carried by
     /// it last frame and this one, at the pose given), the contacts with it of every joint the
     /// fingers `kept` still (per finger) are last frame's, moved with the object: rigidly
@@ -748,6 +635,215 @@ impl ContactConstraint {
     }
 }
 
+impl FingerCloser {
+    /// Forward kinematics of a pose conservative advancement tries (its trial angles), into
+    /// the trial transforms: a step of the search, not the rendered hand.
+    fn forward_trial(&mut self, kinematics: &HandKinematics) {
+        let rig = kinematics.rig();
+        rig.locals(&self.trial, kinematics.limits(), &mut self.trial_locals);
+        forward_kinematics(rig.skeleton(), &self.trial_locals, &mut self.trial_world);
+    }
+
+    /// [`Self::forward_trial`] of only `chain`'s joints, the rest as the last trial left them:
+    /// a step of its closure, which turns nothing else.
+    fn forward_trial_of(&mut self, chain: &FingerChain, kinematics: &HandKinematics) {
+        let rig = kinematics.rig();
+        rig.locals_of(&self.trial, kinematics.limits(), &chain.joints, &chain.turns, &mut self.trial_locals);
+        forward_kinematics_of(rig.skeleton(), &chain.joints, &self.trial_locals, &mut self.trial_world);
+    }
+
+    /// Stage 2 for finger `f`: conservative advancement of its closure.
+    ///
+    /// A finger that touched the `held` object last frame keeps its grip until the tracked
+    /// finger opens past it: the closure starts from the finger as last rendered, the joints up
+    /// to a phalanx touching there stay, and the distal ones close on (it wraps the object
+    /// further). Closing it from open again would ask the object the same questions every
+    /// frame, and a slightly different path may end on a different contact (the tracked
+    /// finger has gone into the object), turning the object in the hand. Its abduction stays
+    /// too: it would slide the touching phalanx sideways, unchecked.
+    ///
+    /// While the hand is `still` on the held object (see [`Self::solve`]), the leading joints of
+    /// a gripping finger that stopped on contacts with it last frame stop there again at once:
+    /// they are kept without a query, and only the joints past them close (none, when every
+    /// joint had stopped on it).
+    fn close(&mut self, f: usize, closure: Closure, scene: &ClosureScene) {
+        let ClosureScene { kinematics, proxies, previous, tracked, objects, held, still, .. } = *scene;
+        self.trial.clone_from(scene.rendered);
+        let mut chain = std::mem::take(&mut self.chain);
+        if chain.dofs.is_empty() {
+            self.chain = chain;
+            return;
+        }
+        let opening = closure.tracked < closure.rendered;
+        let gripping = held.is_some_and(|h| !opening && scene.contacts.iter().any(|c| c.object == h && c.part == HandPart::Finger(f)));
+        let kept = if gripping && still { self.held_prefix.min(chain.dofs.len()) } else { 0 };
+        if kept == chain.dofs.len() {
+            for i in chain.dofs.iter().map(|&(i, _)| i).chain(chain.others.iter().copied()) {
+                self.trial.angles[i] = previous.angles[i];
+            }
+            self.free = false;
+            self.near.clear();
+            self.chain = chain;
+            return;
+        }
+        // The closure runs from `start` to the tracked angles (`self.trial` holds those).
+        let mut target = [0.0f32; 4];
+        let mut start = [0.0f32; 4];
+        for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+            target[k] = self.trial.angles[i];
+            self.trial.angles[i] = 0.0;
+        }
+        if gripping {
+            for &i in &chain.others {
+                self.trial.angles[i] = previous.angles[i];
+            }
+        }
+        self.forward_trial(kinematics);
+        let root = Vec3::from(self.trial_world[chain.dofs[0].1].translation);
+        let reach = Aabb::from_half_extents(root, Vec3::splat(chain.reach));
+        self.near.clear();
+        self.near.extend(objects.near(&reach, CONTACT_DISTANCE, None).map(|(i, _)| i));
+        let mut active = kept;
+        // The leading joints stopped on the held object so far.
+        let mut prefix = kept;
+        let mut s: f32 = 0.0;
+        if !self.near.is_empty() {
+            let set = |angles: &mut [f32], active: usize, s: f32, start: &[f32; 4], target: &[f32; 4]| {
+                for (k, &(i, _)) in chain.dofs.iter().enumerate().skip(active) {
+                    angles[i] = start[k] + (target[k] - start[k]) * s;
+                }
+            };
+            // Where the closure starts: open, else as last rendered, else the tracked angles
+            // (clear after a snap of the wrist); the first whose proxies are clear. When
+            // none is (an object has moved into the finger), the finger stays as last
+            // rendered, the least change, and the physics pushes the object off it; but an
+            // object let go passes through the fingers round it (`ScenePhysics::release`),
+            // so where only meshes are that near, whose signed distances tell how deep, the
+            // finger takes the start they overlap clearly the least ([`SWITCH_OVERLAP`]).
+            // A finger of a hand holding something that reached the tracked angles untouched
+            // last frame tries as last rendered first: from open it would meet the object on
+            // its way to angles clear of it, and flicker between the two every other frame
+            // (the little finger curled under a ball held from above). Not while nothing is
+            // held: closing from where they were drawn let the 4 cm ball through the fingers
+            // on the approach. The starts are kinds 0 (open), 1 (last rendered) and 2
+            // (tracked), tried in `order`; `checking` is the place in `order` of the one being
+            // tried until one is clear, and `tried` holds per kind its nearest distance and
+            // whether nothing but a mesh was within the stop distance (a primitive's or the
+            // table's reads 0 at any depth). A gripping finger starts as last rendered,
+            // touching.
+            let free = self.free && held.is_some();
+            let order = if free { [1, 0, 2] } else { [0, 1, 2] };
+            let mut checking = Some(0);
+            let mut tried = [(0.0f32, false); 3];
+            starting_angles(order[0], &chain.dofs, previous, tracked, &mut start);
+            if gripping {
+                for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                    start[k] = previous.angles[i];
+                    if k < kept {
+                        self.trial.angles[i] = start[k];
+                    }
+                }
+                checking = None;
+            }
+            chain.bounds.fill(UNMEASURED);
+            for _ in 0..MAX_ADVANCES {
+                set(&mut self.trial.angles, active, s, &start, &target);
+                self.forward_trial_of(&chain, kinematics);
+                // The nearest proxy measured (its distance, last DOF and the object), and the
+                // largest step no point of any can overrun. A proxy is measured only where its
+                // bound may have come down to the stop distance: the others cannot stop the
+                // finger here, and their bounds still limit the step.
+                let mut nearest = (f32::INFINITY, 0, usize::MAX);
+                let mut meshes_only = true;
+                let mut step = f32::INFINITY;
+                for ((p, last, levers), (bound, at)) in chain.proxies.iter().zip(chain.bounds.iter_mut()) {
+                    if *last < active {
+                        continue;
+                    }
+                    let speed: f32 = (active..=*last).map(|k| (target[k] - start[k]).abs() * levers[k]).sum();
+                    let mut remaining = *bound - speed * (s - *at);
+                    if remaining <= STOP_DISTANCE {
+                        let proxy = &proxies.colliders()[*p];
+                        let pose = pose_of(&self.trial_world[proxy.joint]);
+                        let (mut d, mut to) = (f32::INFINITY, usize::MAX);
+                        for &o in &self.near {
+                            let c = objects.collider(o);
+                            // (Against a mesh, exact only where it stops the finger: above, a
+                            // lower bound steps nearly as far, and saves measuring the triangles within
+                            // millimetres of a palm's hull, which the search could not tell
+                            // apart, at every step.)
+                            let (here, signed) = match c.triangles() {
+                                Some(mesh) => (self.query.distance_at_least(*p, &pose, mesh, &c.pose, STOP_DISTANCE, MESH_LOOKOUT), true),
+                                None => (c.distance_at_least(&pose, proxy, STOP_DISTANCE), false),
+                            };
+                            meshes_only &= signed || here > STOP_DISTANCE;
+                            if here < d {
+                                (d, to) = (here, o);
+                            }
+                        }
+                        (*bound, *at, remaining) = (d, s, d);
+                        if d < nearest.0 {
+                            nearest = (d, *last, to);
+                        }
+                    }
+                    if speed > 0.0 {
+                        step = step.min(remaining / speed);
+                    }
+                }
+                if let Some(at) = checking.take() {
+                    if nearest.0 <= STOP_DISTANCE {
+                        tried[order[at]] = (nearest.0, meshes_only);
+                        // The next start to try; after the last, as last rendered unless
+                        // another overlaps only meshes, clearly less (the least; ties: open).
+                        let next = match at {
+                            0 | 1 => order[at + 1],
+                            _ if !tried[1].1 => 1,
+                            _ => [2, 0].into_iter().filter(|&b| tried[b].1 && tried[b].0 > tried[1].0 + SWITCH_OVERLAP).max_by(|&a, &b| tried[a].0.total_cmp(&tried[b].0)).unwrap_or(1),
+                        };
+                        starting_angles(next, &chain.dofs, previous, tracked, &mut start);
+                        if at == 2 {
+                            break;
+                        }
+                        checking = Some(at + 1);
+                        chain.bounds.fill(UNMEASURED);
+                        continue;
+                    }
+                }
+                if nearest.0 <= STOP_DISTANCE {
+                    // Contact: the joints up to the touching phalanx stop here; the rest close on.
+                    for k in active..chain.dofs.len() {
+                        start[k] = self.trial.angles[chain.dofs[k].0];
+                    }
+                    if prefix == active && held == Some(nearest.2) {
+                        prefix = nearest.1 + 1;
+                    }
+                    active = nearest.1 + 1;
+                    s = 0.0;
+                    chain.bounds.fill(UNMEASURED);
+                    if active >= chain.dofs.len() {
+                        break;
+                    }
+                    continue;
+                }
+                if s + step >= 1.0 {
+                    s = 1.0;
+                    break;
+                }
+                s += step;
+            }
+            set(&mut self.trial.angles, active, s, &start, &target);
+        } else {
+            for (k, &(i, _)) in chain.dofs.iter().enumerate() {
+                self.trial.angles[i] = target[k];
+            }
+            prefix = 0;
+        }
+        self.held_prefix = prefix;
+        self.free = self.near.is_empty() || (active == 0 && s >= 1.0);
+        self.chain = chain;
+    }
+}
+
 /// A finger's closing angles (`dofs`' pose indices) at start `kind` of its closure: 0 open,
 /// 1 as last rendered (`previous`), 2 the tracked angles.
 fn starting_angles(kind: usize, dofs: &[(usize, usize)], previous: &Pose, tracked: &Pose, start: &mut [f32; 4]) {
@@ -788,22 +884,23 @@ mod tests {
         let mut c = ContactConstraint::new(HandProxies::new(&fit_proxies(&model, PROXY_MARGIN), &model.skeleton), kinematics);
         let mut rng = crate::math::Rng::new(3);
         for f in 0..5 {
-            let chain = std::mem::take(&mut c.fingers[f]);
+            let (finger, kinematics) = (&mut c.fingers[f], &c.kinematics);
+            let chain = std::mem::take(&mut finger.chain);
             assert!(!chain.dofs.is_empty() && chain.proxies.iter().all(|(p, ..)| chain.joints.contains(&c.proxies.colliders()[*p].joint)), "finger {f}");
-            for a in &mut c.rendered.angles {
+            for a in &mut finger.trial.angles {
                 *a = rng.uniform(-0.3, 1.2) as f32;
             }
-            c.forward_trial();
+            finger.forward_trial(kinematics);
             for &(i, _) in &chain.dofs {
-                c.rendered.angles[i] = rng.uniform(0.0, 1.5) as f32;
+                finger.trial.angles[i] = rng.uniform(0.0, 1.5) as f32;
             }
-            let before = c.trial_world.clone();
-            c.forward_trial_of(&chain);
-            let alone = c.trial_world.clone();
-            c.forward_trial();
-            assert_eq!(alone, c.trial_world, "finger {f}: posed alone, not as the whole hand");
+            let before = finger.trial_world.clone();
+            finger.forward_trial_of(&chain, kinematics);
+            let alone = finger.trial_world.clone();
+            finger.forward_trial(kinematics);
+            assert_eq!(alone, finger.trial_world, "finger {f}: posed alone, not as the whole hand");
             assert!(chain.joints.iter().all(|&j| alone[j] != before[j]), "finger {f}: a joint of the closure did not move");
-            c.fingers[f] = chain;
+            finger.chain = chain;
         }
     }
 }

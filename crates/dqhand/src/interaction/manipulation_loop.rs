@@ -28,6 +28,7 @@ use crate::math::rigid_fit;
 use crate::model::Model;
 use crate::physics::ScenePhysics;
 use crate::scene::{Scene, SceneCommand};
+use crate::skin::Crew;
 use crate::{Error, Result};
 
 /// The longest physics step taken at once, s: a stall in the records must not launch objects.
@@ -145,6 +146,20 @@ impl ManipulationLoop {
             last: None,
             reset_due: false,
         })
+    }
+
+    /// The same loop closing each hand's fingers across `crew`'s threads
+    /// ([`ContactConstraint::set_crew`]: the same frames, sooner where fingers close on
+    /// objects). One crew serves any number of loops; a second loop's frame that meets the
+    /// crew busy runs on its own thread.
+    ///
+    /// [`ContactConstraint::set_crew`]: crate::collision::ContactConstraint::set_crew
+    #[must_use]
+    pub fn with_crew(mut self, crew: Arc<Crew>) -> Self {
+        for hand in &mut self.hands {
+            hand.constraint.set_crew(Some(Arc::clone(&crew)));
+        }
+        self
     }
 
     /// The hand a record of `side` drives: the one of that side, the only one in a loop of

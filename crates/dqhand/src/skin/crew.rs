@@ -15,7 +15,9 @@
 //! So the caller times the job's first piece and wakes parked helpers only where the work
 //! left outlasts what waking them costs, as measured on this crew's earlier wakes
 //! ([`worth_waking`]), or where jobs come in a stream (the last two each began within the
-//! spin of the one before), which a woken helper then stays awake for.
+//! spin of the one before), which a woken helper then stays awake for. A caller that knows
+//! its next job is long (the fingers' closure of `collision::ContactConstraint`, hundreds of
+//! µs) wakes them ahead of it ([`Crew::wake_ahead`]), so that they join it from its start.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering::*};
@@ -232,6 +234,13 @@ impl Crew {
         self.helpers.len() + 1
     }
 
+    /// Jobs offered to the helpers so far; a job run on the caller alone (a crew of one
+    /// thread, or one busy with another caller's job) is not counted.
+    #[must_use]
+    pub fn jobs(&self) -> usize {
+        self.shared.epoch.load(Relaxed)
+    }
+
     /// What waking a parked helper has cost in this crew, as medians of its last wakes: the
     /// time from the wake until the helper ran, and the wake call on the caller. `None` until
     /// measured.
@@ -284,7 +293,9 @@ impl Crew {
         s.offered_at[0].store(now, Relaxed);
         let spin = u64::try_from(s.spin.as_nanos()).unwrap_or(u64::MAX);
         let stream = previous[1] > 0 && now.saturating_sub(previous[0]) < spin && previous[0].saturating_sub(previous[1]) < spin;
-        let parked = s.parked.load(SeqCst);
+        // Helpers woken within the spin (by `wake_ahead`) are on their way: not woken again.
+        let roused = s.wakes.load(Relaxed) > 0 && now.saturating_sub(s.woken_at.load(Relaxed)) < spin;
+        let parked = if roused { 0 } else { s.parked.load(SeqCst) };
         if parked > 0 && stream {
             self.wake();
         } else if parked > 0 {
@@ -308,6 +319,15 @@ impl Crew {
         job.work(0, usize::MAX);
         drop(withdraw);
         assert!(!s.poisoned.load(Acquire), "a crew thread panicked");
+    }
+
+    /// Wakes the parked helpers now, ahead of a job the caller is about to offer and knows to
+    /// outlast waking them: they then join it from its start, not after its first piece has
+    /// been timed, and spin until it comes (for [`Self::SPIN`]).
+    pub fn wake_ahead(&self) {
+        if self.shared.parked.load(SeqCst) > 0 {
+            self.wake();
+        }
     }
 
     /// Wakes the parked helpers, timing the call.
@@ -351,14 +371,17 @@ fn helper(home: usize, s: &Shared) {
                 continue;
             }
             let mut guard = s.lock.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            // The wakes read before it counts itself parked: a caller that sees it parked and
+            // wakes it counts a wake it then sees.
+            let wakes = s.wakes.load(SeqCst);
             // Counted before looking: a caller that has seen no helper parked has already
             // offered its job, so this look finds it.
             s.parked.fetch_add(1, SeqCst);
-            let wakes = s.wakes.load(SeqCst);
             // The time from the first wake call after parking until this wait returned, taken
             // whether or not a job is still on offer by then.
             let mut joined = None;
-            while !offered(seen) && !s.stop.load(SeqCst) {
+            // Until a job is offered, or a wake ahead of one (`wake_ahead`) comes.
+            while !offered(seen) && !s.stop.load(SeqCst) && s.wakes.load(SeqCst) == wakes {
                 guard = s.wake.wait(guard).unwrap_or_else(std::sync::PoisonError::into_inner);
                 if joined.is_none() && s.wakes.load(SeqCst) != wakes {
                     joined = Some(Duration::from_nanos(s.nanos().saturating_sub(s.woken_at.load(SeqCst))));
@@ -366,6 +389,8 @@ fn helper(home: usize, s: &Shared) {
             }
             s.parked.fetch_sub(1, SeqCst);
             drop(guard);
+            // Woken, it spins for the job to come (woken ahead of it, it may not be there yet).
+            last = Instant::now();
             if let Some(joined) = joined {
                 s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).join.push(joined);
             }
@@ -425,6 +450,7 @@ mod tests {
             let crew = Crew::new(3, spin).unwrap();
             assert_eq!(crew.threads(), 3);
             each_piece_once(&crew, 2000, 7);
+            assert_eq!(crew.jobs(), 2000);
             each_piece_once(&crew, 10, 0);
             // After the helpers have parked.
             std::thread::sleep(spin + Duration::from_millis(5));
@@ -492,6 +518,23 @@ mod tests {
         // in `REMEASURE` wakes anyway; without the measurement every one of these jobs would
         // wake the helper.
         assert!(wakes(&crew) - before <= 12, "{} of 100 jobs of instant pieces woke the helper", wakes(&crew) - before);
+    }
+
+    /// A helper woken ahead of a job spins until it comes, and is not woken again for it.
+    #[test]
+    fn a_helper_woken_ahead_waits_for_the_job() {
+        let spin = Duration::from_secs(1);
+        let crew = Crew::new(2, spin).unwrap();
+        let parked = |crew: &Crew| crew.shared.parked.load(SeqCst);
+        let wait_until = |done: &dyn Fn() -> bool| (0..2000).any(|_| done() || (std::thread::sleep(Duration::from_millis(1)), false).1);
+        assert!(wait_until(&|| parked(&crew) == 1), "the helper parked at the start");
+        crew.wake_ahead();
+        assert!(wait_until(&|| parked(&crew) == 0), "the helper woke");
+        // Longer than a wake, shorter than the spin.
+        std::thread::sleep(Duration::from_millis(20));
+        assert_eq!(parked(&crew), 0, "the helper went back to sleep before the job came");
+        assert!(pieces_elsewhere(&crew, 8, Duration::from_micros(300)) > 0, "no piece ran on the helper");
+        assert_eq!(crew.shared.wakes.load(SeqCst), 1, "woken again for the job");
     }
 
     #[test]

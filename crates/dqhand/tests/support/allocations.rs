@@ -1,11 +1,13 @@
 //! A global allocator that counts each thread's allocations, for the per-frame tests (each
 //! test runs on a thread of its own), and records where each was made while a thread asks
-//! (`TRACING`). Include it in one test binary per crate.
+//! (`TRACING`); it also counts every thread's together, which only a binary of one test
+//! can read (the others' would add to it).
 #![allow(dead_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::backtrace::Backtrace;
 use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
 /// Counts the allocations of each thread (tests run on threads of their own); while
 /// its `TRACING` is on, also records where each one was made.
@@ -19,12 +21,20 @@ thread_local! {
     pub static TRACES: RefCell<Vec<Backtrace>> = const { RefCell::new(Vec::new()) };
 }
 
+/// Every thread's allocations so far.
+static ALL: AtomicUsize = AtomicUsize::new(0);
+
 pub fn allocations() -> usize {
     ALLOCATIONS.with(Cell::get)
 }
 
+pub fn all_threads_allocations() -> usize {
+    ALL.load(Relaxed)
+}
+
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALL.fetch_add(1, Relaxed);
         match TRACING.try_with(Cell::get) {
             Ok((_, true)) => {}
             Ok((true, false)) => {
