@@ -1,6 +1,6 @@
 //! The fingers closed across a crew of threads ([`ContactConstraint::set_crew`]) over a grasp
-//! of the teapot: the rendered hand is the one closed finger after finger, bit for bit, and
-//! no thread allocates. A binary of one test, since it counts every thread's allocations
+//! of the teapot: the rendered hand is the one the same constraint closes finger after finger
+//! without a crew, bit for bit, and no thread allocates. A binary of one test, since it counts every thread's allocations
 //! (tests running beside it would add theirs).
 
 use std::sync::Arc;
@@ -64,4 +64,5 @@ fn fingers_closed_on_a_crew_render_the_same_hand_and_allocate_nothing() {
     assert_eq!(allocated, 0, "allocations on any thread while the fingers closed on the crew, over {} frames", script.records.len());
     assert!(touching > 30, "the hand touched the teapot in {touching} frames");
     assert!(crew.jobs() > 30, "the fingers were split across the crew in {} frames", crew.jobs());
+    assert!(crew.pieces_helped() > 0, "no finger closed on a helper thread");
 }

@@ -136,6 +136,10 @@ struct Shared {
     job: AtomicPtr<Job<'static>>,
     /// Jobs offered so far: a helper takes part in each once.
     epoch: AtomicUsize,
+    /// Pieces the helpers have run.
+    helped: AtomicUsize,
+    /// Helpers that have started.
+    started: AtomicUsize,
     /// Helpers between taking `job` and being done with it: the caller waits for none
     /// before its job leaves the stack.
     active: AtomicUsize,
@@ -203,6 +207,8 @@ impl Crew {
         let shared = Arc::new(Shared {
             job: AtomicPtr::new(core::ptr::null_mut()),
             epoch: AtomicUsize::new(0),
+            helped: AtomicUsize::new(0),
+            started: AtomicUsize::new(0),
             active: AtomicUsize::new(0),
             parked: AtomicUsize::new(0),
             lock: Mutex::new(()),
@@ -224,7 +230,11 @@ impl Crew {
                 let shared = Arc::clone(&shared);
                 std::thread::Builder::new().name(format!("dqhand-crew-{i}")).spawn(move || helper(i, &shared))
             })
-            .collect::<std::io::Result<_>>()?;
+            .collect::<std::io::Result<Vec<_>>>()?;
+        // Started before the first job: a thread's start (which allocates) is not a job's.
+        while shared.started.load(Acquire) < helpers.len() {
+            std::thread::yield_now();
+        }
         Ok(Self { shared, helpers })
     }
 
@@ -239,6 +249,12 @@ impl Crew {
     #[must_use]
     pub fn jobs(&self) -> usize {
         self.shared.epoch.load(Relaxed)
+    }
+
+    /// Pieces of those jobs the helpers ran (the caller ran the rest).
+    #[must_use]
+    pub fn pieces_helped(&self) -> usize {
+        self.shared.helped.load(Relaxed)
     }
 
     /// What waking a parked helper has cost in this crew, as medians of its last wakes: the
@@ -361,12 +377,17 @@ impl Drop for Crew {
 /// Helper `home`'s life: take part in each job on offer once, spin `spin` after it, then
 /// park.
 fn helper(home: usize, s: &Shared) {
+    s.started.fetch_add(1, Release);
     let (mut seen, mut last) = (0, Instant::now());
+    let spin = u64::try_from(s.spin.as_nanos()).unwrap_or(u64::MAX);
     let offered = |seen: usize| s.epoch.load(SeqCst) != seen && !s.job.load(SeqCst).is_null();
     while !s.stop.load(Relaxed) {
         let epoch = s.epoch.load(Acquire);
         if epoch == seen || s.job.load(Relaxed).is_null() {
-            if last.elapsed() < s.spin {
+            // It spins for `spin` after its last job and after the last wake (one ahead of a
+            // job may come before it).
+            let woken = s.wakes.load(Relaxed) > 0 && s.nanos().saturating_sub(s.woken_at.load(Relaxed)) < spin;
+            if last.elapsed() < s.spin || woken {
                 core::hint::spin_loop();
                 continue;
             }
@@ -389,8 +410,6 @@ fn helper(home: usize, s: &Shared) {
             }
             s.parked.fetch_sub(1, SeqCst);
             drop(guard);
-            // Woken, it spins for the job to come (woken ahead of it, it may not be there yet).
-            last = Instant::now();
             if let Some(joined) = joined {
                 s.costs.lock().unwrap_or_else(std::sync::PoisonError::into_inner).join.push(joined);
             }
@@ -406,8 +425,9 @@ fn helper(home: usize, s: &Shared) {
             // still waiting in `Withdraw` and the job is alive.
             let job = unsafe { &*job };
             // A panicking piece is the caller's to report; the helper stays for the next job.
-            if std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work(home, usize::MAX))).is_err() {
-                s.poisoned.store(true, Release);
+            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.work(home, usize::MAX))) {
+                Ok(ran) => _ = s.helped.fetch_add(ran, Relaxed),
+                Err(_) => s.poisoned.store(true, Release),
             }
         }
         s.active.fetch_sub(1, SeqCst);
@@ -533,7 +553,9 @@ mod tests {
         // Longer than a wake, shorter than the spin.
         std::thread::sleep(Duration::from_millis(20));
         assert_eq!(parked(&crew), 0, "the helper went back to sleep before the job came");
-        assert!(pieces_elsewhere(&crew, 8, Duration::from_micros(300)) > 0, "no piece ran on the helper");
+        let elsewhere = pieces_elsewhere(&crew, 8, Duration::from_micros(300));
+        assert!(elsewhere > 0, "no piece ran on the helper");
+        assert_eq!(crew.pieces_helped(), elsewhere);
         assert_eq!(crew.shared.wakes.load(SeqCst), 1, "woken again for the job");
     }
 
