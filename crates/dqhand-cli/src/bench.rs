@@ -18,7 +18,7 @@ use dqhand::engine::ModelSource;
 use dqhand::gesture::Sequence;
 use dqhand::kinematics::{HandKinematics, JointModel, KinematicsLayer, Pose, Transform};
 use dqhand::model::Model;
-use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method, SkinnedMesh, Strategy};
+use dqhand::skin::{Crew, Deformed, Deformer, Kernel, Method, SelfContactPass, SkinnedMesh, Strategy};
 use glam::{Affine3A, Quat};
 use serde_json::json;
 
@@ -200,6 +200,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .zip(&mut back_to_back)
         .map(|(&i, samples)| json!({ "threads": variants[i].threads, "normals": variants[i].normals, "us_per_frame": percentile(samples, 0.5), "p90_us": percentile(samples, 0.9) }))
         .collect();
+    // The contact pass after DQB (untimed), frame by frame over the same animation.
+    let contact_pass = {
+        let mut pass = SelfContactPass::new(mesh, &model.skeleton);
+        let (mut deformer, mut out) = (Deformer::new(Method::Dqb, mesh), Deformed::new(mesh));
+        let (mut samples, mut pushes) = (Vec::with_capacity(args.frames), Vec::with_capacity(args.frames));
+        for f in 0..args.frames {
+            animation.pose(f);
+            deformer.deform(mesh, animation.skinning(), &mut out);
+            let t = Instant::now();
+            let report = pass.apply(animation.skinning(), &mut out);
+            samples.push(t.elapsed().as_secs_f64() * 1e6);
+            pushes.push(report.pushed as f64);
+        }
+        json!({ "us_per_frame": percentile(&mut samples, 0.5), "p90_us": percentile(&mut samples, 0.9), "max_us": percentile(&mut samples, 1.0), "pushes_median": percentile(&mut pushes, 0.5), "pushes_max": percentile(&mut pushes, 1.0) })
+    };
     let rows: Vec<serde_json::Value> = variants
         .iter_mut()
         .map(|v| {
@@ -249,6 +264,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "roofline": roofline,
         "variants": rows,
         "threads_back_to_back": back_to_back,
+        "contact_pass": contact_pass,
         "crew_wake": crews.iter().map(|(t, c)| {
             let costs = c.wake_costs();
             json!({ "threads": t, "join_us": costs.map(|(j, _)| j.as_secs_f64() * 1e6), "wake_call_us": costs.map(|(_, w)| w.as_secs_f64() * 1e6) })
@@ -275,6 +291,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     println!("DQB/LB {:.3}   DQB/QB {:.3}   (paper: 1.056 and 1.024, rendering included)", table3(Method::Dqb) / table3(Method::Lb), table3(Method::Dqb) / table3(Method::Qb));
     println!("CoR/DQB {:.3}   (target ≤ 1.2); CoR's centres of rotation computed in {centres_ms:.0} ms on {cores} threads", table3(Method::Cor) / table3(Method::Dqb));
+    println!(
+        "contact pass after DQB (skin out of skin, one thread): {:.1} µs median, p90 {:.1}, max {:.1} (target ≤ 50); {:.0} vertices pushed per frame, median ({:.0} at most)",
+        stat(&contact_pass, "us_per_frame"),
+        stat(&contact_pass, "p90_us"),
+        stat(&contact_pass, "max_us"),
+        stat(&contact_pass, "pushes_median"),
+        stat(&contact_pass, "pushes_max")
+    );
     let heads = Method::ALL.map(|m| format!("{:>8}", m.as_str().to_uppercase())).join(" ");
     println!("\nkernels: one thread; positions and normals | positions only");
     println!("{:<9} {heads} | {heads}", "kernel");

@@ -9,33 +9,7 @@ use parry3d::shape::{SharedShape, SupportMap};
 
 use super::hull_support::HullSupport;
 use super::{Proxy, ProxyShape};
-use crate::kinematics::Skeleton;
-
-/// The five fingers, in WebXR name order (the thumb first).
-pub const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "pinky"];
-
-/// The part of the hand a proxy belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum HandPart {
-    /// The wrist and the four finger metacarpals: they move with the wrist (the ring and little
-    /// ones also turn a little at their CMC joints as those fingers close).
-    Palm,
-    /// A finger's phalanges (index into [`FINGERS`]); the thumb's include its metacarpal,
-    /// which moves at the CMC joint.
-    Finger(usize),
-}
-
-impl HandPart {
-    /// The part of the joint called `name` (a WebXR name).
-    #[must_use]
-    pub fn of(name: &str) -> Self {
-        match FINGERS.iter().position(|f| name.starts_with(f)) {
-            Some(0) => HandPart::Finger(0),
-            Some(f) if name.contains("phalanx") => HandPart::Finger(f),
-            _ => HandPart::Palm,
-        }
-    }
-}
+use crate::kinematics::{HandPart, Skeleton};
 
 /// One proxy as a parry shape.
 #[derive(Clone)]
@@ -158,15 +132,5 @@ mod tests {
             }
         }
         assert!(hulls >= 5, "{hulls} hulls");
-    }
-
-    #[test]
-    fn parts_follow_webxr_names() {
-        assert_eq!(HandPart::of("wrist"), HandPart::Palm);
-        assert_eq!(HandPart::of("index-finger-metacarpal"), HandPart::Palm);
-        assert_eq!(HandPart::of("thumb-metacarpal"), HandPart::Finger(0));
-        assert_eq!(HandPart::of("thumb-phalanx-distal"), HandPart::Finger(0));
-        assert_eq!(HandPart::of("ring-finger-phalanx-intermediate"), HandPart::Finger(3));
-        assert_eq!(HandPart::of("pinky-finger-phalanx-distal"), HandPart::Finger(4));
     }
 }

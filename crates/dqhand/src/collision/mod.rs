@@ -25,7 +25,8 @@ mod support_pair;
 mod triangle_tree;
 
 pub use contact_constraint::{Closure, Contact, ContactConstraint, CONTACT_DISTANCE, SNAP_AFTER_S, STOP_DISTANCE};
-pub use hand_proxies::{pose_of, HandPart, HandProxies, ProxyCollider, FINGERS};
+pub use crate::kinematics::{HandPart, FINGERS};
+pub use hand_proxies::{pose_of, HandProxies, ProxyCollider};
 pub use object_colliders::{ObjectCollider, ObjectColliders, TableTop};
 pub use proxy::{fit_proxies, Proxy, ProxyShape, PROXY_MARGIN};
 pub use proxy_mesh_query::{MeshNearest, ProxyMeshQuery};

@@ -4,6 +4,7 @@
 
 mod forward_kinematics;
 mod hand_kinematics;
+mod hand_part;
 mod hand_rig;
 mod joint_model;
 mod joint_positions;
@@ -18,6 +19,7 @@ pub mod webxr;
 
 pub use forward_kinematics::{forward_kinematics, forward_kinematics_of};
 pub use hand_kinematics::{ClampedAngle, HandKinematics};
+pub use hand_part::{HandPart, FINGERS};
 pub use hand_rig::{HandRig, Limits, RigDof};
 pub use joint_model::{Dof, JointModel, Motion};
 pub use joint_positions::JointPositions;

@@ -13,6 +13,6 @@ mod self_intersection;
 
 pub use distortion::{edge_distortion, VertexDistortion};
 pub use joint_region::JointRegion;
-pub use report::{format_value, measure, FrameMetrics, Report, Sweep};
+pub use report::{format_value, hand_parts, measure, FrameMetrics, Report, Sweep};
 pub use self_contact::{self_contact, SelfContact};
 pub use self_intersection::count_self_intersections;

@@ -10,9 +10,9 @@ use serde_json::{json, Value};
 use super::{count_self_intersections, edge_distortion, self_contact, JointRegion, SelfContact};
 use crate::geometry::{check_closed, edges, enclosed_volume};
 use crate::gesture::{gesture, GESTURES};
-use crate::kinematics::{HandRig, JointModel, KinematicsLayer, Limits, Pose, Transform};
+use crate::kinematics::{HandPart, HandRig, JointModel, KinematicsLayer, Limits, Pose, Transform};
 use crate::model::Model;
-use crate::skin::{Deformed, Deformer, Method};
+use crate::skin::{Deformed, Deformer, Method, SelfContactPass};
 use crate::{Error, Result};
 
 /// What one sweep moves.
@@ -118,19 +118,20 @@ pub struct Report {
     pub rest_self_contact: Option<SelfContact>,
     /// The same in every gesture of the library, per method (none for a mesh not closed).
     pub self_contact: Vec<(&'static str, [SelfContact; 4])>,
+    /// The same after the contact pass ([`SelfContactPass`]).
+    pub self_contact_after_pass: Vec<(&'static str, [SelfContact; 4])>,
 }
 
 /// Each vertex's part of the hand, for [`self_contact`]: its heaviest joint's finger (0 the
 /// thumb, its metacarpal included, which moves; to 4 the little finger), else 5, the palm (the
-/// wrist and the finger metacarpals).
-fn hand_parts(model: &Model) -> Vec<u8> {
-    const FINGERS: [&str; 5] = ["thumb-", "index-finger-", "middle-finger-", "ring-finger-", "pinky-finger-"];
+/// wrist and the finger metacarpals): [`HandPart`].
+#[must_use]
+pub fn hand_parts(model: &Model) -> Vec<u8> {
     let joints = model.skeleton.joints();
     (0..model.mesh.vertex_count())
-        .map(|v| {
-            let name = model.mesh.influences(v).next().map_or("", |(j, _)| joints[j].name.as_str());
-            let moving = name.contains("phalanx") || name == "thumb-metacarpal";
-            FINGERS.iter().position(|f| moving && name.starts_with(f)).map_or(5, |f| f as u8)
+        .map(|v| match model.mesh.influences(v).next().map(|(j, _)| HandPart::of(&joints[j].name)) {
+            Some(HandPart::Finger(f)) => f as u8,
+            _ => 5,
         })
         .collect()
 }
@@ -219,7 +220,8 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         sweeps.push(Sweep { name: spec.name, parameter: spec.parameter, values: spec.values, joint: spec.joint, frames });
     }
     let mut intersections = Vec::new();
-    let mut contact = Vec::new();
+    let (mut contact, mut after_pass) = (Vec::new(), Vec::new());
+    let mut pass = SelfContactPass::new(mesh, &model.skeleton);
     for g in &GESTURES {
         hand.pose(&g.pose(JointModel::Full));
         deform(&mut deformers, hand.layer(), false, &mut outputs);
@@ -229,11 +231,15 @@ pub fn measure(model: Arc<Model>) -> Result<Report> {
         }
         if closed.is_ok() {
             contact.push((g.name, Method::ALL.map(|m| self_contact(posed(m), mesh.indices(), &parts))));
+            for o in &mut outputs {
+                pass.apply(hand.layer().skinning(), o);
+            }
+            after_pass.push((g.name, Method::ALL.map(|m| self_contact(outputs[m.index()].positions(), mesh.indices(), &parts))));
         }
     }
     let rest_intersections = count_self_intersections(&rest_positions, mesh.indices());
     let rest_self_contact = closed.is_ok().then(|| self_contact(&rest_positions, mesh.indices(), &parts));
-    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections, rest_self_contact, self_contact: contact })
+    Ok(Report { vertices: mesh.vertex_count(), closed, sweeps, rest_intersections, intersections, rest_self_contact, self_contact: contact, self_contact_after_pass: after_pass })
 }
 
 /// Writes the local transforms of one sweep value.
@@ -311,6 +317,7 @@ impl Report {
             "self_contact": {
                 "rest": self.rest_self_contact.as_ref().map(contact_json),
                 "gestures": self.self_contact.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]), "cor": contact_json(&c[3]) })).collect::<Vec<_>>(),
+                "after_contact_pass": self.self_contact_after_pass.iter().map(|(g, c)| json!({ "gesture": g, "lb": contact_json(&c[0]), "qb": contact_json(&c[1]), "dqb": contact_json(&c[2]), "cor": contact_json(&c[3]) })).collect::<Vec<_>>(),
             },
             "headline": self.headline().iter().map(|(label, v)| json!({ "measure": label, "lb": v[0], "qb": v[1], "dqb": v[2], "cor": v[3] })).collect::<Vec<_>>(),
         })
@@ -378,6 +385,10 @@ impl Report {
             let rest = self.rest_self_contact.unwrap_or_default();
             rows.push((format!("skin inside skin between parts, {g}: deepest (mm; rest {:.2})", rest.depth_m * 1000.0), c.map(|x| Some(x.depth_m * 1000.0))));
             rows.push((format!("skin inside skin between parts, {g}: shared volume (mm³; rest {:.1})", rest.volume_m3 * 1e9), c.map(|x| Some((x.volume_m3 * 1e9) as f32))));
+        }
+        for (g, c) in self.self_contact_after_pass.iter().filter(|(g, _)| INTERSECTION_GESTURES.contains(g)) {
+            rows.push((format!("the same after the contact pass, {g}: deepest (mm)"), c.map(|x| Some(x.depth_m * 1000.0))));
+            rows.push((format!("the same after the contact pass, {g}: shared volume (mm³)"), c.map(|x| Some((x.volume_m3 * 1e9) as f32))));
         }
         rows
     }

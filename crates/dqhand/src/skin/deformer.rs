@@ -47,6 +47,13 @@ impl Deformed {
         &self.positions[..self.vertex_count]
     }
 
+    /// Positions and, unless [`Self::positions_only`], normals to change after the
+    /// deformation (the contact pass), #V each.
+    pub(crate) fn buffers_mut(&mut self) -> (&mut [[f32; 3]], Option<&mut [[f32; 3]]>) {
+        let n = self.vertex_count;
+        (&mut self.positions[..n], (!self.normals.is_empty()).then(|| &mut self.normals[..n]))
+    }
+
     /// Deformed unit normals, #V; empty for [`Self::positions_only`] buffers.
     #[must_use]
     pub fn normals(&self) -> &[[f32; 3]] {

@@ -1,0 +1,296 @@
+//! The contact pass after skinning: skin of one part of the hand that a deformer has put
+//! inside another part's skin (a fingertip in the palm, the thumb in the index finger of a
+//! fist) is moved out of it, onto its surface, so that the skin never passes through itself.
+//!
+//! Each bone's rest skin is a field round its axis ([`PhalanxField`]); a vertex inside
+//! another part's bone there is pushed out along that bone's radius to its surface plus
+//! [`CLEARANCE`]. Of two parts in contact one yields, by a fixed order (every finger to the
+//! palm, the thumb to every finger, and between the others the one farther from the thumb):
+//! the skin that stays is then the one the fields describe, and the yielding skin ends on it,
+//! flattened against it as a pad presses on a finger (Vaillant et al. 2013 meet at a
+//! contact surface between both fields; here one side gives, which needs no composition).
+//! A pushed vertex only ever moves from the inside of the other part's skin towards its
+//! surface, so it stays where the posed skin already was: the pass cannot put skin into an
+//! object the skin was clear of (the manipulation loop's contact constraint holds).
+//!
+//! Pressed skin's normal is the surface it rests on, turned to face it. The volume a pushed
+//! part loses is not given back (no bulge round the contact): `dqhand metrics` reports it.
+//!
+//! Per frame the pass poses each field's capsule once, bounds each cluster of a yielding
+//! bone's posed vertices by a sphere, and reads the fields only for vertices of clusters whose
+//! sphere meets a field's capsule; it allocates nothing.
+
+use glam::{Affine3A, Vec3, Vec3A};
+
+use super::deformer::Deformed;
+use super::phalanx_field::{PhalanxField, SECTORS};
+use super::SkinnedMesh;
+use crate::kinematics::{HandPart, Skeleton};
+
+/// How far outside the skin it yields to a pushed vertex ends (m).
+pub const CLEARANCE: f32 = 0.0002;
+
+/// The most a bone's posed skin is taken to bulge out of its rest field (m): a cluster
+/// farther than that from a field's rest capsule cannot reach it.
+const MAX_BULGE: f32 = 0.005;
+
+/// A vertex with at least this weight on a bone is skin of that bone too (the web between two
+/// fingers, a knuckle's skin on its metacarpal): it does not yield to it. Less is the blend's
+/// tail, which reaches a knuckle pressed on the next finger.
+const SHARED_WEIGHT: f32 = 0.02;
+
+/// Sectors per cluster round a bone, and cells per cluster along it.
+const CLUSTER_SECTORS: usize = SECTORS / 4;
+const CLUSTER_CELLS: usize = 3;
+
+/// What one pass did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactPassReport {
+    /// Pushes: vertices moved, once per skin each left.
+    pub pushed: usize,
+    /// The farthest one moved (m).
+    pub deepest_m: f32,
+}
+
+/// Some vertices of one bone, near each other at rest.
+#[derive(Clone, Debug)]
+struct Cluster {
+    /// Its vertices: `members[start..end]`.
+    start: u32,
+    end: u32,
+    /// The fields its bone's vertices yield to (indices into `fields`): `yields[yield_start..yield_end]`.
+    yield_start: u32,
+    yield_end: u32,
+}
+
+/// The contact pass for one skinned hand mesh; build once, apply after every deformation.
+#[derive(Clone, Debug)]
+pub struct SelfContactPass {
+    /// Per bone that carries skin of a part that others yield to: its joint and field.
+    fields: Vec<(usize, PhalanxField)>,
+    /// Per field, whether its skin bends with a finger's joints, and so is grown as posed
+    /// (the palm's moves with its bones: its weights are the wrist's and the metacarpals').
+    bends: Vec<bool>,
+    /// Per field, the steps along its axis that a cluster may reach this frame (first, last;
+    /// empty where first > last).
+    needed: Vec<(usize, usize)>,
+    /// Per field, its bone's own vertices (heaviest there) and their rest distances from
+    /// its axis, step by step along it at rest: step `s` of field `f` has
+    /// `own[own_steps[own_start[f] + s]..own_steps[own_start[f] + s + 1]]`.
+    own: Vec<(u32, f32)>,
+    own_steps: Vec<u32>,
+    own_start: Vec<u32>,
+    /// Vertex indices, cluster by cluster, and per member the joints it is skinned to with at
+    /// least [`SHARED_WEIGHT`] (bit `j` for joint `j` < 64).
+    members: Vec<u32>,
+    skinned_to: Vec<u64>,
+    clusters: Vec<Cluster>,
+    yields: Vec<u32>,
+    /// Per yielding bone, its clusters (`clusters[start..end]`).
+    bones: Vec<(u32, u32)>,
+    /// Per cluster, the sphere round its posed vertices this frame (centre, radius); per
+    /// yielding bone, the sphere round its clusters'.
+    spheres: Vec<(Vec3A, f32)>,
+    bone_spheres: Vec<(Vec3A, f32)>,
+    /// This frame's (cluster, field) pairs that may meet, the fields grown by [`MAX_BULGE`].
+    candidates: Vec<(u32, u32)>,
+}
+
+/// The part order of who yields to whom: a part yields to every part later in it.
+fn rank(part: HandPart) -> usize {
+    match part {
+        HandPart::Finger(0) => 0,
+        HandPart::Finger(f) => 5 - f,
+        HandPart::Palm => 5,
+    }
+}
+
+impl SelfContactPass {
+    /// The pass for `mesh` on `skeleton` (a WebXR hand: its joints' names give the parts),
+    /// built from the rest skin: the fields of the bones skin may yield to, each narrowed
+    /// where it would hold another part's rest skin (a field's cell is a 15° sector, wider
+    /// than a concave skin there), so a hand at rest is left as it is.
+    ///
+    /// # Panics
+    /// If `skeleton` has fewer joints than the mesh's influences name.
+    #[must_use]
+    pub fn new(mesh: &SkinnedMesh, skeleton: &Skeleton) -> Self {
+        let joints = skeleton.joints();
+        let n = mesh.vertex_count();
+        let heaviest: Vec<usize> = (0..n).map(|v| mesh.influences(v).next().map_or(0, |(j, _)| j)).collect();
+        let part: Vec<HandPart> = joints.iter().map(|j| HandPart::of(&j.name)).collect();
+        let rest: Vec<Vec3> = (0..n).map(|v| mesh.position(v)).collect();
+        // A joint yields to `b` where `b`'s part ranks above its own and `b` is not its parent
+        // (a proximal phalanx's skin runs on into its metacarpal's).
+        let yields_to = |a: usize, b: usize| rank(part[b]) > rank(part[a]) && joints[a].parent != Some(b);
+        let mut triangles: Vec<Vec<[Vec3; 3]>> = vec![Vec::new(); joints.len()];
+        for t in mesh.indices().chunks_exact(3) {
+            let corners = [0, 1, 2].map(|k| rest[t[k] as usize]);
+            let mut owners = t.iter().map(|&v| heaviest[v as usize]).collect::<Vec<_>>();
+            owners.dedup();
+            for o in owners {
+                triangles[o].push(corners);
+            }
+        }
+        let mut fields: Vec<(usize, PhalanxField)> = (0..joints.len())
+            .filter(|&b| (0..joints.len()).any(|a| yields_to(a, b)))
+            .filter_map(|b| PhalanxField::new(&triangles[b]).map(|f| (b, f)))
+            .collect();
+        // Clusters: each yielding bone's vertices by where they sit round its own axis at rest.
+        let own_fields: Vec<Option<PhalanxField>> = triangles.iter().map(|t| PhalanxField::new(t)).collect();
+        let mask = |v: usize| mesh.influences(v).filter(|&(j, w)| j < 64 && w >= SHARED_WEIGHT).fold(0u64, |m, (j, _)| m | 1 << j);
+        let (mut members, mut clusters, mut yields, mut bones) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (a, own_field) in own_fields.iter().enumerate() {
+            let targets: Vec<u32> = fields.iter().enumerate().filter(|(_, (b, _))| yields_to(a, *b)).map(|(i, _)| i as u32).collect();
+            let Some(field) = own_field.as_ref().filter(|_| !targets.is_empty()) else { continue };
+            let mut keyed: Vec<(usize, u32)> = (0..n).filter(|&v| heaviest[v] == a).map(|v| (field.locate(field.rest_local(rest[v])).map_or(0, |p| cluster_of(p.cell())), v as u32)).collect();
+            keyed.sort_unstable();
+            let yield_start = yields.len() as u32;
+            yields.extend_from_slice(&targets);
+            let first = clusters.len() as u32;
+            for run in keyed.chunk_by(|x, y| x.0 == y.0) {
+                let start = members.len() as u32;
+                members.extend(run.iter().map(|&(_, v)| v));
+                clusters.push(Cluster { start, end: members.len() as u32, yield_start, yield_end: yields.len() as u32 });
+            }
+            bones.push((first, clusters.len() as u32));
+        }
+        let skinned_to: Vec<u64> = members.iter().map(|&v| mask(v as usize)).collect();
+        // At rest no skin is inside another part's: narrow each field where it says otherwise.
+        for c in &clusters {
+            for (&v, &to) in members[c.start as usize..c.end as usize].iter().zip(&skinned_to[c.start as usize..c.end as usize]) {
+                for &f in &yields[c.yield_start as usize..c.yield_end as usize] {
+                    let (b, field) = &mut fields[f as usize];
+                    if skinned(to, *b) {
+                        continue;
+                    }
+                    if let Some(p) = field.locate(field.rest_local(rest[v as usize])).filter(|p| field.inside(p, 2.0 * CLEARANCE).is_some()) {
+                        field.exclude(&p, 2.0 * CLEARANCE);
+                    }
+                }
+            }
+        }
+        let (mut own, mut own_steps, mut own_start) = (Vec::new(), Vec::new(), Vec::new());
+        for (b, field) in &fields {
+            let mut located: Vec<(usize, u32, f32)> = (0..n).filter(|&v| heaviest[v] == *b).filter_map(|v| field.locate(field.rest_local(rest[v])).map(|p| (p.step(), v as u32, PhalanxField::distance(&p)))).collect();
+            located.sort_unstable_by_key(|&(s, v, _)| (s, v));
+            own_start.push(own_steps.len() as u32);
+            let base = own.len();
+            for s in 0..=field.steps() {
+                own_steps.push((base + located.partition_point(|l| l.0 < s)) as u32);
+            }
+            own.extend(located.iter().map(|&(_, v, d)| (v, d)));
+        }
+        let bends = fields.iter().map(|(b, _)| matches!(part[*b], HandPart::Finger(_))).collect();
+        Self {
+            bends,
+            needed: vec![(1, 0); fields.len()],
+            fields,
+            own,
+            own_steps,
+            own_start,
+            members,
+            skinned_to,
+            spheres: vec![(Vec3A::ZERO, 0.0); clusters.len()],
+            candidates: Vec::with_capacity(yields.len() + clusters.iter().map(|c| (c.yield_end - c.yield_start) as usize).sum::<usize>()),
+            clusters,
+            yields,
+            bone_spheres: vec![(Vec3A::ZERO, 0.0); bones.len()],
+            bones,
+        }
+    }
+
+    /// Moves the skin `out` that `skinning` (one transform per joint, `world · inverse_bind`)
+    /// deformed out of the other parts' skin; its normals, where it has them, face what it
+    /// rests on. Allocates nothing.
+    pub fn apply(&mut self, skinning: &[Affine3A], out: &mut Deformed) -> ContactPassReport {
+        let (positions, mut normals) = out.buffers_mut();
+        let at = |v: u32| Vec3A::from(positions[v as usize]);
+        for (&(first, end), bone) in self.bones.iter().zip(&mut self.bone_spheres) {
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for (c, sphere) in self.clusters[first as usize..end as usize].iter().zip(&mut self.spheres[first as usize..end as usize]) {
+                let (l, h) = self.members[c.start as usize..c.end as usize].iter().map(|&v| at(v)).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
+                *sphere = ((l + h) * 0.5, (h - l).length() * 0.5);
+                (lo, hi) = (lo.min(l), hi.max(h));
+            }
+            *bone = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+        }
+        for ((b, field), needed) in self.fields.iter_mut().zip(&mut self.needed) {
+            field.pose(&skinning[*b]);
+            *needed = (usize::MAX, 0);
+        }
+        // The pairs that may meet, as the fields were at rest and grown by the most bulge.
+        self.candidates.clear();
+        for (&(first, end), &(centre, radius)) in self.bones.iter().zip(&self.bone_spheres) {
+            let c = &self.clusters[first as usize];
+            for &f in &self.yields[c.yield_start as usize..c.yield_end as usize] {
+                let field = &self.fields[f as usize].1;
+                if field.meets(centre, radius, MAX_BULGE).is_none() {
+                    continue;
+                }
+                for k in first..end {
+                    let (centre, radius) = self.spheres[k as usize];
+                    if let Some((lo, hi)) = field.meets(centre, radius, MAX_BULGE) {
+                        self.candidates.push((k, f));
+                        let needed = &mut self.needed[f as usize];
+                        *needed = (needed.0.min(lo), needed.1.max(hi));
+                    }
+                }
+            }
+        }
+        // The steps of the fields they may meet, grown with their own skin as posed there (and
+        // a step either side: skin slides along a bent joint).
+        for (f, (_, field)) in self.fields.iter_mut().enumerate() {
+            let (lo, hi) = self.needed[f];
+            if lo > hi || !self.bends[f] {
+                continue;
+            }
+            let steps = &self.own_steps[self.own_start[f] as usize..];
+            let (lo, hi) = (lo.saturating_sub(1), (hi + 1).min(field.steps() - 1));
+            for &(v, rest) in &self.own[steps[lo] as usize..steps[hi + 1] as usize] {
+                if let Some(a) = field.locate(field.local(at(v))) {
+                    field.grow(&a, (PhalanxField::distance(&a) - rest).min(MAX_BULGE));
+                }
+            }
+        }
+        let mut report = ContactPassReport::default();
+        for &(k, f) in &self.candidates {
+            let (c, (centre, radius)) = (&self.clusters[k as usize], self.spheres[k as usize]);
+            let (joint, field) = &self.fields[f as usize];
+            if field.meets(centre, radius, 0.0).is_none() {
+                continue;
+            }
+            let range = c.start as usize..c.end as usize;
+            for (&v, &to) in self.members[range.clone()].iter().zip(&self.skinned_to[range]) {
+                if skinned(to, *joint) {
+                    continue;
+                }
+                let local = field.local(Vec3A::from(positions[v as usize]));
+                if field.clear_of_step(local, CLEARANCE) {
+                    continue;
+                }
+                let Some(a) = field.locate(local) else { continue };
+                let Some(depth) = field.inside(&a, CLEARANCE) else { continue };
+                let (moved, outward) = field.pushed(&a, depth + CLEARANCE);
+                positions[v as usize] = moved.to_array();
+                if let Some(n) = normals.as_deref_mut().map(|n| &mut n[v as usize]) {
+                    *n = (-outward).normalize_or_zero().to_array();
+                }
+                report.pushed += 1;
+                report.deepest_m = report.deepest_m.max(depth + CLEARANCE);
+            }
+        }
+        report
+    }
+}
+
+/// Whether a vertex skinned to the joints of bit mask `to` is skinned to joint `j`.
+fn skinned(to: u64, j: usize) -> bool {
+    j < 64 && to & 1 << j != 0
+}
+
+/// The cluster of a cell of a bone's own field.
+fn cluster_of(cell: usize) -> usize {
+    let (along, round) = (cell / SECTORS, cell % SECTORS);
+    (along / CLUSTER_CELLS) * (SECTORS / CLUSTER_SECTORS) + round / CLUSTER_SECTORS
+}
