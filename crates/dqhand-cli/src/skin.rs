@@ -10,7 +10,7 @@ use anyhow::Context;
 use dqhand::engine::ModelSource;
 use dqhand::io::PoseFile;
 use dqhand::kinematics::Limits;
-use dqhand::skin::{Deformed, Deformer, Method};
+use dqhand::skin::{Deformed, Deformer, Method, SelfContactPass};
 
 /// Arguments of `dqhand skin`.
 #[derive(clap::Args)]
@@ -39,6 +39,10 @@ pub struct Args {
     /// Use joint angles as given instead of clamping them to anatomical limits.
     #[arg(long)]
     no_limits: bool,
+    /// Move the skin of each part of the hand out of the others' after skinning (the contact
+    /// pass: a fist's fingertips lie on the palm, not in it).
+    #[arg(long)]
+    contact_pass: bool,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -58,13 +62,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     crate::warn_clamped(&origin.display().to_string(), &clamped);
     let mut out = Deformed::new(&model.mesh);
     Deformer::new(args.method, &model.mesh).deform(&model.mesh, &layer, &mut out);
+    let pushed = args.contact_pass.then(|| SelfContactPass::new(&model.mesh, &model.skeleton).apply(layer.skinning(), &mut out).pushed);
     dqhand::io::write_posed(&args.out, out.positions(), out.normals(), model.mesh.uvs(), model.mesh.indices())?;
     println!(
-        "wrote {} ({} vertices, {} triangles, {})",
+        "wrote {} ({} vertices, {} triangles, {}{})",
         args.out.display(),
         model.mesh.vertex_count(),
         model.mesh.triangle_count(),
-        args.method
+        args.method,
+        pushed.map_or_else(String::new, |n| format!("; the contact pass moved {n} vertices out of other skin"))
     );
     Ok(())
 }
@@ -92,6 +98,13 @@ fn batch(args: &Args, model: dqhand::model::Model, path: &Path) -> anyhow::Resul
     let t = Instant::now();
     deformer.deform_batch(&pool, mesh, &skinning, &mut out);
     let seconds = t.elapsed().as_secs_f64();
+    if args.contact_pass {
+        let mut pass = SelfContactPass::new(mesh, &model.skeleton);
+        let joints = mesh.inverse_bind().len();
+        for (o, skinning) in out.iter_mut().zip(skinning.chunks_exact(joints)) {
+            pass.apply(skinning, o);
+        }
+    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create the directory", args.out.display()))?;
     for (i, o) in out.iter().enumerate() {
         let file = args.out.join(format!("pose-{i:05}.{}", args.format));

@@ -197,6 +197,26 @@ fn skin_accepts_no_limits() {
 }
 
 #[test]
+fn skin_contact_pass_moves_a_fists_skin() {
+    let dir = temp_dir("skin-contact-pass");
+    let pose = dir.join("fist.json");
+    let mut angles = serde_json::Map::new();
+    for finger in ["index-finger", "middle-finger", "ring-finger", "pinky-finger"] {
+        for (bone, deg) in [("phalanx-proximal", 90), ("phalanx-intermediate", 100), ("phalanx-distal", 70)] {
+            angles.insert(format!("{finger}-{bone}.flex"), json!(deg));
+        }
+    }
+    write_json(&pose, &json!({ "angles_deg": angles }));
+    let (plain, passed) = (dir.join("plain.obj"), dir.join("passed.obj"));
+    let printed = run_ok(&["skin", "--pose", &path_arg(&pose), "--out", &path_arg(&plain)]);
+    assert!(!printed.contains("contact pass"), "{printed}");
+    let printed = run_ok(&["skin", "--pose", &path_arg(&pose), "--contact-pass", "--out", &path_arg(&passed)]);
+    let moved: usize = printed.split("the contact pass moved ").nth(1).and_then(|s| s.split(' ').next()).and_then(|n| n.parse().ok()).unwrap_or_else(|| panic!("{printed}"));
+    assert!(moved > 0, "{printed}");
+    assert_ne!(std::fs::read(&plain).unwrap(), std::fs::read(&passed).unwrap(), "--contact-pass made no difference");
+}
+
+#[test]
 fn skin_without_pose_writes_the_rest_pose() {
     let out = temp_dir("skin-rest").join("rest.ply");
     run_ok(&["skin", "--out", &path_arg(&out)]);
@@ -232,6 +252,7 @@ fn bench_json_reports_every_method() {
     // and the roofline.
     let avx512 = dqhand::skin::Kernel::best() == dqhand::skin::Kernel::Avx512;
     positive_number(&report, "/cor_centres_ms");
+    positive_number(&report, "/contact_pass/us_per_frame");
     for method in ["lb", "qb", "dqb", "cor"] {
         let chosen = &report["chosen_strategy"][method];
         match chosen.as_str() {

@@ -47,9 +47,10 @@ fn the_pass_takes_skin_out_of_skin_and_moves_nothing_else() {
         *g = (g.0 && before.vertices == 0, g.1 + pass.pushed, g.2.max(pass.deepest_m));
         // Never deeper, never more shared space.
         assert!(after.depth_m <= before.depth_m + 1e-5 && after.volume_m3 <= before.volume_m3 * 1.001 + 1e-12, "{method:?} {gesture}: {before:?} → {after:?}");
-        // Under DQB, LB and CoR the fists and the folded fingers come out within 2 mm, and
-        // the space shared falls by more than half where there was some (QB throws skin
-        // centimetres off the bones, which the rest fields do not follow).
+        // Under DQB, LB and CoR, where fingers curl into the palm or onto each other (more than
+        // 100 mm³ shared), the skin comes out within 3 mm and shares less than half as much
+        // (QB throws skin centimetres off the bones, which the rest fields do not follow; the
+        // three and four, 30–54 mm³ by the folded thumb's web, are left as they are).
         if method != Method::Qb && before.volume_m3 > 1e-7 {
             assert!(after.depth_m < 0.003 && after.volume_m3 < 0.5 * before.volume_m3, "{method:?} {gesture}: {before:?} → {after:?}");
         }
@@ -60,10 +61,24 @@ fn the_pass_takes_skin_out_of_skin_and_moves_nothing_else() {
     // Where no method puts skin in another part's (the open hand, the pinch), the open hand is
     // left as it is and no vertex moves by more than the target depth. (Under QB alone, the
     // "three" has pushes that the metric does not confirm.)
+    assert_eq!(clear["open_palm"], (true, 0, 0.0), "the open hand");
     let untouched: Vec<_> = clear.iter().filter(|(_, (clear, _, _))| *clear).collect();
-    assert!(untouched.len() >= 2 && untouched.iter().all(|(g, (_, pushed, deepest))| (**g != "open_palm" || *pushed == 0) && *deepest < 0.0005), "{untouched:?}");
+    assert!(untouched.len() >= 2 && untouched.iter().all(|(_, (_, _, deepest))| *deepest < 0.0005), "{untouched:?}");
     let (before, after) = fist_dqb.expect("the fist under DQB");
     assert!(after.volume_m3 < 0.1 * before.volume_m3 && after.depth_m < 0.5 * before.depth_m, "the fist under DQB: {before:?} → {after:?}");
+}
+
+/// At rest (the bind pose the fields were built on) nothing moves, under any method.
+#[test]
+fn the_rest_pose_is_left_as_it_is() {
+    let model = &*HAND;
+    let skinning = vec![glam::Affine3A::IDENTITY; model.mesh.inverse_bind().len()];
+    let mut pass = SelfContactPass::new(&model.mesh, &model.skeleton);
+    for method in Method::ALL {
+        let mut out = Deformed::new(&model.mesh);
+        Deformer::new(method, &model.mesh).deform(&model.mesh, &skinning, &mut out);
+        assert_eq!(pass.apply(&skinning, &mut out).pushed, 0, "{method:?}");
+    }
 }
 
 /// A pushed vertex moves from inside the other part's skin towards its surface: it ends where
@@ -92,3 +107,26 @@ fn pushed_skin_stays_where_the_skin_was() {
     assert!(checked > 100, "{checked} pushed vertices checked");
 }
 
+
+/// A skin layer given the pass runs it after each of its methods: its skin is the deformer's
+/// with the pass applied, and the fist's skin comes out of itself.
+#[test]
+fn a_skin_layer_runs_the_pass_after_each_method() {
+    let model = Arc::new(build(&HandParams { vertices: 3000, ..HandParams::default() }).unwrap());
+    let mut hand = model.hand_kinematics(JointModel::Full).unwrap();
+    hand.pose(&dqhand::gesture::gesture("fist").unwrap().pose(JointModel::Full));
+    let mut layer = dqhand::skin::SkinLayer::new(Arc::clone(&model.mesh), dqhand::skin::MethodSet::ALL);
+    layer.set_contact_pass(Some(SelfContactPass::new(&model.mesh, &model.skeleton)));
+    layer.deform(hand.layer());
+    let mut pass = SelfContactPass::new(&model.mesh, &model.skeleton);
+    let parts = hand_parts(&model);
+    for method in Method::ALL {
+        let mut out = Deformed::new(&model.mesh);
+        Deformer::new(method, &model.mesh).deform(&model.mesh, hand.layer(), &mut out);
+        let before = self_contact(out.positions(), model.mesh.indices(), &parts);
+        assert!(pass.apply(hand.layer().skinning(), &mut out).pushed > 0, "{method:?}");
+        assert_eq!(layer.deformed(method).unwrap(), &out, "{method:?}");
+        let after = self_contact(out.positions(), model.mesh.indices(), &parts);
+        assert!(after.volume_m3 < before.volume_m3, "{method:?}: {before:?} → {after:?}");
+    }
+}

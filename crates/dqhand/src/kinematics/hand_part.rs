@@ -11,8 +11,8 @@ pub enum HandPart {
     /// The wrist and the four finger metacarpals: they move with the wrist (the ring and little
     /// ones also turn a little at their CMC joints as those fingers close).
     Palm,
-    /// A finger's phalanges (index into [`FINGERS`]); the thumb's include its metacarpal,
-    /// which moves at the CMC joint.
+    /// A finger's phalanges and tip (index into [`FINGERS`]); the thumb's include its
+    /// metacarpal, which moves at the CMC joint.
     Finger(usize),
 }
 
@@ -22,7 +22,7 @@ impl HandPart {
     pub fn of(name: &str) -> Self {
         match FINGERS.iter().position(|f| name.starts_with(f)) {
             Some(0) => HandPart::Finger(0),
-            Some(f) if name.contains("phalanx") => HandPart::Finger(f),
+            Some(f) if name.contains("phalanx") || name.ends_with("-tip") => HandPart::Finger(f),
             _ => HandPart::Palm,
         }
     }
@@ -40,5 +40,6 @@ mod tests {
         assert_eq!(HandPart::of("thumb-phalanx-distal"), HandPart::Finger(0));
         assert_eq!(HandPart::of("ring-finger-phalanx-intermediate"), HandPart::Finger(3));
         assert_eq!(HandPart::of("pinky-finger-phalanx-distal"), HandPart::Finger(4));
+        assert_eq!(HandPart::of("index-finger-tip"), HandPart::Finger(1), "a tip is its finger's, as the thumb's is");
     }
 }

@@ -13,12 +13,13 @@
 
 use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
-/// Cells round the axis: 24 of 15° (a 9 mm finger's arc of 2.4 mm).
+/// Cells round the axis: 24, equal steps of a pseudo-angle ([`sector`]), 11–18° each (a 9 mm
+/// finger's arc of 1.8–2.9 mm).
 pub(crate) const SECTORS: usize = 24;
 /// Cells along the axis are this long (m) at most.
 const CELL_LENGTH: f32 = 0.002;
 /// Samples per triangle edge (`n(n+1)/2` per triangle): the built-in hand's triangles are
-/// 1–3 mm, its cells 2 mm by 15°.
+/// 1–3 mm, its cells 2 mm by 11–18°.
 const SAMPLES: usize = 4;
 
 /// One bone's skin round its principal axis.
@@ -29,9 +30,10 @@ const SAMPLES: usize = 4;
 /// transform folded in.
 #[derive(Clone, Debug)]
 pub(crate) struct PhalanxField {
-    /// The mesh's rest (bind) space to the field's coordinates, and this frame's world to them
-    /// and back.
+    /// The mesh's rest (bind) space to the field's coordinates and back, and this frame's
+    /// world to them and back.
     from_rest: Affine3A,
+    to_rest: Affine3A,
     from_world: Affine3A,
     to_world: Affine3A,
     /// Steps along the axis, and the length of one (m).
@@ -74,16 +76,13 @@ impl PhalanxField {
         // Rows of the map: (axis / length, x, y) · (p − (centre + axis · lo)).
         let basis = Mat3A::from_cols(Vec3A::from(axis / length), Vec3A::from(x), Vec3A::from(y)).transpose();
         let from_rest = Affine3A { matrix3: basis, translation: -(basis * Vec3A::from(centre + axis * lo)) };
-        let mut field = Self { from_rest, from_world: from_rest, to_world: from_rest.inverse(), cells, step: length, rest: vec![0.0; cells * SECTORS], radius: Vec::new(), rest_rows: vec![0.0; cells], rows: Vec::new() };
+        let mut field = Self { from_rest, to_rest: from_rest.inverse(), from_world: from_rest, to_world: from_rest.inverse(), cells, step: length, rest: vec![0.0; cells * SECTORS], radius: Vec::new(), rest_rows: vec![0.0; cells], rows: Vec::new() };
         for p in points() {
-            if let Some(a) = field.locate(Vec3A::from(field.from_rest.transform_point3(p))) {
-                let r = &mut field.rest[a.cell];
-                *r = r.max(a.distance_squared.sqrt());
-            }
+            let a = field.locate_rest(p);
+            let r = &mut field.rest[a.cell];
+            *r = r.max(a.distance());
         }
-        field.settle_rows();
-        field.radius.clone_from(&field.rest);
-        field.rows.clone_from(&field.rest_rows);
+        field.settle();
         Some(field)
     }
 
@@ -92,10 +91,19 @@ impl PhalanxField {
         self.from_rest.transform_point3a(Vec3A::from(p))
     }
 
+    /// Where a point of the bone's own rest skin falls, its ends included (the farthest
+    /// samples are at the end, or past it by rounding: in the last step).
+    pub(crate) fn locate_rest(&self, p: Vec3) -> AxisPoint {
+        let mut local = self.rest_local(p);
+        local.x = local.x.clamp(0.0, self.cells as f32 * (1.0 - f32::EPSILON));
+        let cell = (local.x as usize).min(self.cells - 1) * SECTORS + sector(local.y, local.z);
+        AxisPoint { local, cell, distance_squared: local.y * local.y + local.z * local.z }
+    }
+
     /// Poses the field with its bone's skinning transform (`world · inverse_bind`) and
     /// brings it back to its rest skin, before this frame's [`Self::grow`]s.
     pub(crate) fn pose(&mut self, skinning: &Affine3A) {
-        self.to_world = *skinning * self.from_rest.inverse();
+        self.to_world = *skinning * self.to_rest;
         self.from_world = self.to_world.inverse();
         self.radius.copy_from_slice(&self.rest);
         self.rows.copy_from_slice(&self.rest_rows);
@@ -152,13 +160,10 @@ impl PhalanxField {
 
     /// Narrows `a`'s cell (rest) so that it holds `a` `clearance` outside: a point known to be
     /// out of this skin (another part's skin at rest) where the cell's largest radius, across
-    /// its 15°, reached past it.
+    /// its sector, reached past it. [`Self::settle`] after the last.
     pub(crate) fn exclude(&mut self, a: &AxisPoint, clearance: f32) {
         let r = &mut self.rest[a.cell];
-        *r = r.min((a.distance_squared.sqrt() - clearance).max(0.0));
-        self.radius[a.cell] = *r;
-        self.settle_rows();
-        self.rows.copy_from_slice(&self.rest_rows);
+        *r = r.min((a.distance() - clearance).max(0.0));
     }
 
     /// Grows the cell of `a` (a vertex of this bone's skin as posed) to hold `by` more than
@@ -171,11 +176,6 @@ impl PhalanxField {
         *row = row.max(*r);
     }
 
-    /// The distance from the axis of `a` (m).
-    pub(crate) fn distance(a: &AxisPoint) -> f32 {
-        a.distance_squared.sqrt()
-    }
-
     /// The world position of `a` pushed `depth` out from the axis, and the unit vector out
     /// from the axis there (world).
     pub(crate) fn pushed(&self, a: &AxisPoint, depth: f32) -> (Vec3, Vec3) {
@@ -184,14 +184,22 @@ impl PhalanxField {
         (Vec3::from(self.to_world.transform_point3a(a.local + out * depth)), Vec3::from(self.to_world.transform_vector3a(out)))
     }
 
-    fn settle_rows(&mut self) {
+    /// Takes the rest radii as they now are: each step's largest, and this frame's.
+    pub(crate) fn settle(&mut self) {
         for (row, cells) in self.rest_rows.iter_mut().zip(self.rest.chunks_exact(SECTORS)) {
             *row = cells.iter().copied().fold(0.0, f32::max);
         }
+        self.radius.clone_from(&self.rest);
+        self.rows.clone_from(&self.rest_rows);
     }
 }
 
 impl AxisPoint {
+    /// Its distance from the axis (m).
+    pub(crate) fn distance(&self) -> f32 {
+        self.distance_squared.sqrt()
+    }
+
     /// Its step along the axis.
     pub(crate) fn step(&self) -> usize {
         self.cell / SECTORS
@@ -290,7 +298,9 @@ mod tests {
         assert!(pose.inverse().transform_vector3(normal).abs_diff_eq(Vec3::new(0.0, 0.6, 0.8), 1e-5), "{normal}");
         // A sphere near the surface may meet it; one beyond its largest radius may not.
         let meets = |p: Vec3, r: f32| field.meets(Vec3A::from(pose.transform_point3(p)), r, 0.0);
-        assert_eq!(meets(Vec3::new(0.015, 0.0, 0.012), 0.0035), Some((5, 9)), "steps of 2 mm");
+        let step = 0.03 / field.steps() as f32;
+        let (first, last) = meets(Vec3::new(0.015, 0.0, 0.012), 0.0035).expect("it may meet");
+        assert_eq!((first, last), (((0.015 - 0.0035) / step) as usize, ((0.015 + 0.0035) / step) as usize), "the steps it spans");
         assert_eq!(meets(Vec3::new(0.015, 0.0, 0.014), 0.0035), None);
         assert_eq!(meets(Vec3::new(0.036, 0.0, 0.0), 0.004), None, "beyond its end");
     }

@@ -1,6 +1,7 @@
 //! The contact pass after skinning: skin of one part of the hand that a deformer has put
 //! inside another part's skin (a fingertip in the palm, the thumb in the index finger of a
-//! fist) is moved out of it, onto its surface, so that the skin never passes through itself.
+//! fist) is moved out of it, onto its surface. (Pushes run field after field: one may put a
+//! vertex back into a field it left; the self-contact metric measures what is left.)
 //!
 //! Each bone's rest skin is a field round its axis ([`PhalanxField`]); a vertex inside
 //! another part's bone there is pushed out along that bone's radius to its surface plus
@@ -10,15 +11,17 @@
 //! flattened against it as a pad presses on a finger (Vaillant et al. 2013 meet at a
 //! contact surface between both fields; here one side gives, which needs no composition).
 //! A pushed vertex only ever moves from the inside of the other part's skin towards its
-//! surface, so it stays where the posed skin already was: the pass cannot put skin into an
-//! object the skin was clear of (the manipulation loop's contact constraint holds).
+//! surface, so it stays where the posed skin already was, or within [`CLEARANCE`] and a
+//! field's sampling of it: the pass puts no skin more than that into an object the skin was
+//! clear of (the manipulation loop's contact constraint holds).
 //!
 //! Pressed skin's normal is the surface it rests on, turned to face it. The volume a pushed
 //! part loses is not given back (no bulge round the contact): `dqhand metrics` reports it.
 //!
-//! Per frame the pass poses each field's capsule once, bounds each cluster of a yielding
-//! bone's posed vertices by a sphere, and reads the fields only for vertices of clusters whose
-//! sphere meets a field's capsule; it allocates nothing.
+//! Per frame the pass poses each field once, bounds each cluster of a yielding bone's posed
+//! vertices by a sphere, and reads the fields only for vertices of clusters whose sphere may
+//! meet a field (within the largest radius of the steps along its axis it spans); it
+//! allocates nothing.
 
 use glam::{Affine3A, Vec3, Vec3A};
 
@@ -31,13 +34,20 @@ use crate::kinematics::{HandPart, Skeleton};
 pub const CLEARANCE: f32 = 0.0002;
 
 /// The most a bone's posed skin is taken to bulge out of its rest field (m): a cluster
-/// farther than that from a field's rest capsule cannot reach it.
+/// farther than that from a field's rest skin cannot reach it.
 const MAX_BULGE: f32 = 0.005;
 
 /// A vertex with at least this weight on a bone is skin of that bone too (the web between two
 /// fingers, a knuckle's skin on its metacarpal): it does not yield to it. Less is the blend's
 /// tail, which reaches a knuckle pressed on the next finger.
 const SHARED_WEIGHT: f32 = 0.02;
+
+/// Bones past this are not fields (the vertices' weights are kept as a 64-bit mask); a hand
+/// has 25 joints.
+const MAX_JOINTS: usize = 64;
+
+/// No step of a field needed this frame.
+const NOT_NEEDED: (usize, usize) = (usize::MAX, 0);
 
 /// Sectors per cluster round a bone, and cells per cluster along it.
 const CLUSTER_SECTORS: usize = SECTORS / 4;
@@ -69,7 +79,8 @@ pub struct SelfContactPass {
     /// Per bone that carries skin of a part that others yield to: its joint and field.
     fields: Vec<(usize, PhalanxField)>,
     /// Per field, whether its skin bends with a finger's joints, and so is grown as posed
-    /// (the palm's moves with its bones: its weights are the wrist's and the metacarpals').
+    /// (the palm's is taken to move with its bones, the wrist and the metacarpals; where it
+    /// blends with a finger at a knuckle, that finger's skin is the one grown).
     bends: Vec<bool>,
     /// Per field, the steps along its axis that a cluster may reach this frame (first, last;
     /// empty where first > last).
@@ -92,8 +103,10 @@ pub struct SelfContactPass {
     /// yielding bone, the sphere round its clusters'.
     spheres: Vec<(Vec3A, f32)>,
     bone_spheres: Vec<(Vec3A, f32)>,
-    /// This frame's (cluster, field) pairs that may meet, the fields grown by [`MAX_BULGE`].
+    /// This frame's (cluster, field) pairs that may meet, the fields grown by [`MAX_BULGE`],
+    /// and the most there can be.
     candidates: Vec<(u32, u32)>,
+    most_candidates: usize,
 }
 
 /// The part order of who yields to whom: a part yields to every part later in it.
@@ -108,8 +121,9 @@ fn rank(part: HandPart) -> usize {
 impl SelfContactPass {
     /// The pass for `mesh` on `skeleton` (a WebXR hand: its joints' names give the parts),
     /// built from the rest skin: the fields of the bones skin may yield to, each narrowed
-    /// where it would hold another part's rest skin (a field's cell is a 15° sector, wider
-    /// than a concave skin there), so a hand at rest is left as it is.
+    /// where it would hold another part's rest skin (a field's cell is a sector of 11–18°,
+    /// wider than a concave skin there), so a hand at rest is left as it is. Bones past the
+    /// 64th are no fields.
     ///
     /// # Panics
     /// If `skeleton` has fewer joints than the mesh's influences name.
@@ -126,24 +140,24 @@ impl SelfContactPass {
         let mut triangles: Vec<Vec<[Vec3; 3]>> = vec![Vec::new(); joints.len()];
         for t in mesh.indices().chunks_exact(3) {
             let corners = [0, 1, 2].map(|k| rest[t[k] as usize]);
-            let mut owners = t.iter().map(|&v| heaviest[v as usize]).collect::<Vec<_>>();
-            owners.dedup();
-            for o in owners {
-                triangles[o].push(corners);
+            let owners = [0, 1, 2].map(|k| heaviest[t[k] as usize]);
+            for (k, &o) in owners.iter().enumerate() {
+                if !owners[..k].contains(&o) {
+                    triangles[o].push(corners);
+                }
             }
         }
-        let mut fields: Vec<(usize, PhalanxField)> = (0..joints.len())
-            .filter(|&b| (0..joints.len()).any(|a| yields_to(a, b)))
-            .filter_map(|b| PhalanxField::new(&triangles[b]).map(|f| (b, f)))
-            .collect();
-        // Clusters: each yielding bone's vertices by where they sit round its own axis at rest.
+        // Every bone's field: the ones others yield to are kept, the rest cluster their own.
         let own_fields: Vec<Option<PhalanxField>> = triangles.iter().map(|t| PhalanxField::new(t)).collect();
-        let mask = |v: usize| mesh.influences(v).filter(|&(j, w)| j < 64 && w >= SHARED_WEIGHT).fold(0u64, |m, (j, _)| m | 1 << j);
+        let mut fields: Vec<(usize, PhalanxField)> =
+            own_fields.iter().enumerate().filter(|&(b, _)| b < MAX_JOINTS && (0..joints.len()).any(|a| yields_to(a, b))).filter_map(|(b, f)| f.clone().map(|f| (b, f))).collect();
+        // Clusters: each yielding bone's vertices by where they sit round its own axis at rest.
+        let mask = |v: usize| mesh.influences(v).filter(|&(j, w)| j < MAX_JOINTS && w >= SHARED_WEIGHT).fold(0u64, |m, (j, _)| m | 1 << j);
         let (mut members, mut clusters, mut yields, mut bones) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (a, own_field) in own_fields.iter().enumerate() {
             let targets: Vec<u32> = fields.iter().enumerate().filter(|(_, (b, _))| yields_to(a, *b)).map(|(i, _)| i as u32).collect();
             let Some(field) = own_field.as_ref().filter(|_| !targets.is_empty()) else { continue };
-            let mut keyed: Vec<(usize, u32)> = (0..n).filter(|&v| heaviest[v] == a).map(|v| (field.locate(field.rest_local(rest[v])).map_or(0, |p| cluster_of(p.cell())), v as u32)).collect();
+            let mut keyed: Vec<(usize, u32)> = (0..n).filter(|&v| heaviest[v] == a).map(|v| (cluster_of(field.locate_rest(rest[v]).cell()), v as u32)).collect();
             keyed.sort_unstable();
             let yield_start = yields.len() as u32;
             yields.extend_from_slice(&targets);
@@ -170,9 +184,15 @@ impl SelfContactPass {
                 }
             }
         }
+        for (_, field) in &mut fields {
+            field.settle();
+        }
         let (mut own, mut own_steps, mut own_start) = (Vec::new(), Vec::new(), Vec::new());
         for (b, field) in &fields {
-            let mut located: Vec<(usize, u32, f32)> = (0..n).filter(|&v| heaviest[v] == *b).filter_map(|v| field.locate(field.rest_local(rest[v])).map(|p| (p.step(), v as u32, PhalanxField::distance(&p)))).collect();
+            let mut located: Vec<(usize, u32, f32)> = (0..n).filter(|&v| heaviest[v] == *b).map(|v| {
+                let p = field.locate_rest(rest[v]);
+                (p.step(), v as u32, p.distance())
+            }).collect();
             located.sort_unstable_by_key(|&(s, v, _)| (s, v));
             own_start.push(own_steps.len() as u32);
             let base = own.len();
@@ -181,10 +201,11 @@ impl SelfContactPass {
             }
             own.extend(located.iter().map(|&(_, v, d)| (v, d)));
         }
+        let most_candidates = clusters.iter().map(|c| (c.yield_end - c.yield_start) as usize).sum();
         let bends = fields.iter().map(|(b, _)| matches!(part[*b], HandPart::Finger(_))).collect();
         Self {
             bends,
-            needed: vec![(1, 0); fields.len()],
+            needed: vec![NOT_NEEDED; fields.len()],
             fields,
             own,
             own_steps,
@@ -192,7 +213,8 @@ impl SelfContactPass {
             members,
             skinned_to,
             spheres: vec![(Vec3A::ZERO, 0.0); clusters.len()],
-            candidates: Vec::with_capacity(yields.len() + clusters.iter().map(|c| (c.yield_end - c.yield_start) as usize).sum::<usize>()),
+            most_candidates,
+            candidates: Vec::with_capacity(most_candidates),
             clusters,
             yields,
             bone_spheres: vec![(Vec3A::ZERO, 0.0); bones.len()],
@@ -203,6 +225,10 @@ impl SelfContactPass {
     /// Moves the skin `out` that `skinning` (one transform per joint, `world · inverse_bind`)
     /// deformed out of the other parts' skin; its normals, where it has them, face what it
     /// rests on. Allocates nothing.
+    ///
+    /// # Panics
+    /// If `skinning` has fewer transforms than the skeleton the pass was built on has joints
+    /// with skin, or `out` is not of the pass's mesh.
     pub fn apply(&mut self, skinning: &[Affine3A], out: &mut Deformed) -> ContactPassReport {
         let (positions, mut normals) = out.buffers_mut();
         let at = |v: u32| Vec3A::from(positions[v as usize]);
@@ -217,10 +243,12 @@ impl SelfContactPass {
         }
         for ((b, field), needed) in self.fields.iter_mut().zip(&mut self.needed) {
             field.pose(&skinning[*b]);
-            *needed = (usize::MAX, 0);
+            *needed = NOT_NEEDED;
         }
         // The pairs that may meet, as the fields were at rest and grown by the most bulge.
         self.candidates.clear();
+        // (A clone's buffer has its length's capacity, none: the most a frame has, once.)
+        self.candidates.reserve(self.most_candidates);
         for (&(first, end), &(centre, radius)) in self.bones.iter().zip(&self.bone_spheres) {
             let c = &self.clusters[first as usize];
             for &f in &self.yields[c.yield_start as usize..c.yield_end as usize] {
@@ -249,7 +277,7 @@ impl SelfContactPass {
             let (lo, hi) = (lo.saturating_sub(1), (hi + 1).min(field.steps() - 1));
             for &(v, rest) in &self.own[steps[lo] as usize..steps[hi + 1] as usize] {
                 if let Some(a) = field.locate(field.local(at(v))) {
-                    field.grow(&a, (PhalanxField::distance(&a) - rest).min(MAX_BULGE));
+                    field.grow(&a, (a.distance() - rest).min(MAX_BULGE));
                 }
             }
         }

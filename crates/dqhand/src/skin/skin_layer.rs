@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::{Bones, Deformed, Deformer, Method, MethodSet, SkinnedMesh, VertexBuffers};
+use super::{Bones, Deformed, Deformer, Method, MethodSet, SelfContactPass, SkinnedMesh, VertexBuffers};
 
 /// A skinned mesh with a deformer and an output per method of a [`MethodSet`], every buffer
 /// allocated when a method joins the set; deforming allocates nothing.
@@ -42,6 +42,8 @@ pub struct SkinLayer {
     deformers: [Option<Deformer>; 4],
     /// Per method: its output, once it has been in the set.
     outputs: [Option<Deformed>; 4],
+    /// Run after every method's deformation, where set.
+    contact_pass: Option<SelfContactPass>,
 }
 
 impl SkinLayer {
@@ -49,7 +51,7 @@ impl SkinLayer {
     /// kernel this CPU runs, on the calling thread.
     #[must_use]
     pub fn new(mesh: Arc<SkinnedMesh>, methods: MethodSet) -> Self {
-        let mut layer = Self { mesh, methods, deformers: Default::default(), outputs: Default::default() };
+        let mut layer = Self { mesh, methods, deformers: Default::default(), outputs: Default::default(), contact_pass: None };
         layer.set_methods(methods);
         layer
     }
@@ -68,6 +70,13 @@ impl SkinLayer {
                 self.outputs[m.index()] = Some(Deformed::new(&self.mesh));
             }
         }
+    }
+
+    /// Runs `pass` (built for this layer's mesh) after each method of every [`Self::deform`],
+    /// so that the skin of one part of the hand stays out of another's; none: the deformers'
+    /// skin as it is. [`Self::deform_into`] does not run it.
+    pub fn set_contact_pass(&mut self, pass: Option<SelfContactPass>) {
+        self.contact_pass = pass;
     }
 
     /// The next [`Self::deform`] does not follow the last one (a seek, another clip): see
@@ -115,6 +124,9 @@ impl SkinLayer {
                 unreachable!("every method of the set has its deformer and buffers")
             };
             deformer.deform(&self.mesh, bones, out);
+            if let Some(pass) = &mut self.contact_pass {
+                pass.apply(bones.skinning, out);
+            }
         }
     }
 
