@@ -14,7 +14,7 @@ use dqhand::input::mediapipe::WEBXR_INDEX;
 use dqhand::kinematics::{webxr::JOINT_NAMES, HandKinematics, JointModel, Limits, Pose, Side};
 use dqhand::math::DualQuat;
 use dqhand::model::Model;
-use dqhand::skin::{Deformer, Method, VertexBuffers};
+use dqhand::skin::{Deformer, Method, SelfContactPass, VertexBuffers};
 use numpy::{Element, PyArray, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
@@ -317,20 +317,26 @@ impl Hand {
     /// None (the rest wrist), `method` "dqb", "qb", "lb" or "cor", `limits` whether angles are clamped
     /// to their anatomical ranges. Returns the positions (B, V, 3), m, or with `normals` the
     /// positions and the unit normals. Each pose is skinned alone: a joint twisted past 180°
-    /// is blended the shortest way, as no previous frame says which way it turned.
-    #[pyo3(signature = (angles, wrist = None, method = "dqb", *, normals = false, limits = true))]
-    fn skin<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, method: &str, normals: bool, limits: bool) -> PyResult<Bound<'py, PyAny>> {
+    /// is blended the shortest way, as no previous frame says which way it turned. With
+    /// `contact_pass`, skin of one part of the hand inside another's (a fist's fingertips in
+    /// the palm) is then moved out onto it (the engine's `SelfContactPass`).
+    #[pyo3(signature = (angles, wrist = None, method = "dqb", *, normals = false, limits = true, contact_pass = false))]
+    fn skin<'py>(&self, py: Python<'py>, angles: &Bound<'py, PyAny>, wrist: Option<&Bound<'py, PyAny>>, method: &str, normals: bool, limits: bool, contact_pass: bool) -> PyResult<Bound<'py, PyAny>> {
         let method: Method = method.parse().map_err(to_py)?;
         let poses = self.batch_of(angles, wrist)?;
         let source = poses.source();
         let mesh = &self.model.mesh;
         let v = mesh.vertex_count();
-        let start = (self.kinematics(limits), Deformer::new(method, mesh));
-        let mut skinned = batch::<numpy::Ix3, _>(py, &[poses.count, v, 3], if normals { 2 } else { 1 }, start, |((k, pose), d), b, positions, normals| {
+        let pass = contact_pass.then(|| SelfContactPass::new(mesh, &self.model.skeleton));
+        let start = (self.kinematics(limits), Deformer::new(method, mesh), pass);
+        let mut skinned = batch::<numpy::Ix3, _>(py, &[poses.count, v, 3], if normals { 2 } else { 1 }, start, |((k, pose), d, pass), b, positions, mut normals| {
             k.pose(source.read(b, pose));
             // Each pose alone, whichever thread took the one before it.
             d.forget_previous_frame();
-            d.deform_into(mesh, k.layer(), VertexBuffers::Separate { positions, normals });
+            d.deform_into(mesh, k.layer(), VertexBuffers::Separate { positions: &mut *positions, normals: normals.as_deref_mut() });
+            if let Some(pass) = pass {
+                pass.apply_to(k.layer().skinning(), positions.as_chunks_mut::<3>().0, normals.map(|n| n.as_chunks_mut::<3>().0));
+            }
         })?;
         let positions = skinned.remove(0);
         Ok(match skinned.pop() {

@@ -576,3 +576,17 @@ def test_bad_export_arguments_are_refused(hand, tmp_path):
     with pytest.raises(ValueError, match="^wrist: not a rigid transform"):
         hand.export_posed(tmp_path / "posed.ply", np.zeros(23), scaled)
     assert not (tmp_path / "posed.ply").exists()
+
+
+def test_the_contact_pass_moves_a_fists_skin_and_leaves_the_open_hand(hand):
+    poses = hand.gesture_poses()
+    angles = np.stack([poses["open_palm"], poses["fist"]])
+    plain = hand.skin(angles)
+    passed, normals = hand.skin(angles, normals=True, contact_pass=True)
+    np.testing.assert_array_equal(passed[0], plain[0], err_msg="the open hand has no skin inside skin: nothing moves")
+    moved = np.linalg.norm(passed[1] - plain[1], axis=1)
+    # The fist's fingertips and thumb come out of the palm and the fingers: some hundreds of
+    # vertices, by millimetres; the rest of the skin stays.
+    assert 50 < (moved > 0).sum() < len(moved) // 10, (moved > 0).sum()
+    assert moved.max() < 0.01, moved.max()
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=2), 1, atol=1e-4)

@@ -230,7 +230,16 @@ impl SelfContactPass {
     /// If `skinning` has fewer transforms than the skeleton the pass was built on has joints
     /// with skin, or `out` is not of the pass's mesh.
     pub fn apply(&mut self, skinning: &[Affine3A], out: &mut Deformed) -> ContactPassReport {
-        let (positions, mut normals) = out.buffers_mut();
+        let (positions, normals) = out.buffers_mut();
+        self.apply_to(skinning, positions, normals)
+    }
+
+    /// [`Self::apply`] on the caller's buffers: the mesh's positions (#V, m) and, if given, its
+    /// unit normals (#V), in its vertex order.
+    ///
+    /// # Panics
+    /// As [`Self::apply`], and if a buffer is shorter than the mesh.
+    pub fn apply_to(&mut self, skinning: &[Affine3A], positions: &mut [[f32; 3]], mut normals: Option<&mut [[f32; 3]]>) -> ContactPassReport {
         let at = |v: u32| Vec3A::from(positions[v as usize]);
         for (&(first, end), bone) in self.bones.iter().zip(&mut self.bone_spheres) {
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
