@@ -46,6 +46,13 @@ pub(crate) struct PhalanxField {
     /// Per step along the axis, its largest radius: at rest and this frame.
     rest_rows: Vec<f32>,
     rows: Vec<f32>,
+    /// This frame's world box round the rest skin (centre, half extents), grown by the
+    /// largest rest radius of any step: a sphere outside it, by more than a slack, meets no
+    /// step (the cheap test before [`Self::meets`]' transform).
+    world_box: (Vec3A, Vec3A),
+    /// The largest radius of any step at rest, and this frame.
+    rest_reach: f32,
+    reach: f32,
 }
 
 /// A point in a field's coordinates inside its skin's length: its cell, and its squared
@@ -76,7 +83,7 @@ impl PhalanxField {
         // Rows of the map: (axis / length, x, y) · (p − (centre + axis · lo)).
         let basis = Mat3A::from_cols(Vec3A::from(axis / length), Vec3A::from(x), Vec3A::from(y)).transpose();
         let from_rest = Affine3A { matrix3: basis, translation: -(basis * Vec3A::from(centre + axis * lo)) };
-        let mut field = Self { from_rest, to_rest: from_rest.inverse(), from_world: from_rest, to_world: from_rest.inverse(), cells, step: length, rest: vec![0.0; cells * SECTORS], radius: Vec::new(), rest_rows: vec![0.0; cells], rows: Vec::new() };
+        let mut field = Self { from_rest, to_rest: from_rest.inverse(), from_world: from_rest, to_world: from_rest.inverse(), cells, step: length, rest: vec![0.0; cells * SECTORS], radius: Vec::new(), rest_rows: vec![0.0; cells], rows: Vec::new(), world_box: (Vec3A::ZERO, Vec3A::ZERO), rest_reach: 0.0, reach: 0.0 };
         for p in points() {
             let a = field.locate_rest(p);
             let r = &mut field.rest[a.cell];
@@ -107,6 +114,11 @@ impl PhalanxField {
         self.from_world = self.to_world.inverse();
         self.radius.copy_from_slice(&self.rest);
         self.rows.copy_from_slice(&self.rest_rows);
+        self.reach = self.rest_reach;
+        let (centre, half) = (Vec3A::new(self.cells as f32 * 0.5, 0.0, 0.0), Vec3A::new(self.cells as f32 * 0.5, self.rest_reach, self.rest_reach));
+        let m = self.to_world.matrix3;
+        let abs = glam::Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        self.world_box = (self.to_world.transform_point3a(centre), abs * half);
     }
 
     /// The field's coordinates of a posed point (world).
@@ -140,6 +152,13 @@ impl PhalanxField {
     /// skin grown by `slack`, first and last; none where it cannot (against the largest radius
     /// of the steps it spans).
     pub(crate) fn meets(&self, centre: Vec3A, radius: f32, slack: f32) -> Option<(usize, usize)> {
+        let (middle, half) = self.world_box;
+        let gap = ((centre - middle).abs() - half).max(Vec3A::ZERO);
+        // (Growth beyond the rest radius moves the box's sides out by at most twice as much.)
+        let reach = radius + slack + 2.0 * (self.reach - self.rest_reach);
+        if gap.length_squared() > reach * reach {
+            return None;
+        }
         let q = self.local(centre);
         let span = radius / self.step;
         // (Truncation is the floor here: both ends are cut to 0 and up first.)
@@ -174,6 +193,7 @@ impl PhalanxField {
         *r = r.max(self.rest[a.cell] + by);
         let row = &mut self.rows[a.cell / SECTORS];
         *row = row.max(*r);
+        self.reach = self.reach.max(*row);
     }
 
     /// The world position of `a` pushed `depth` out from the axis, and the unit vector out
@@ -191,6 +211,8 @@ impl PhalanxField {
         }
         self.radius.clone_from(&self.rest);
         self.rows.clone_from(&self.rest_rows);
+        self.rest_reach = self.rest_rows.iter().copied().fold(0.0, f32::max);
+        self.reach = self.rest_reach;
     }
 }
 
