@@ -74,6 +74,26 @@ struct Cluster {
 }
 
 /// The contact pass for one skinned hand mesh; build once, apply after every deformation.
+///
+/// ```
+/// # #[cfg(feature = "interaction")] {
+/// use dqhand::gesture::gesture;
+/// use dqhand::hand::{build, HandParams};
+/// use dqhand::kinematics::JointModel;
+/// use dqhand::skin::{Deformed, Deformer, Method, SelfContactPass};
+///
+/// let model = build(&HandParams { vertices: 2000, ..HandParams::default() })?;
+/// let mut hand = model.hand_kinematics(JointModel::Full)?;
+/// hand.pose(&gesture("fist")?.pose(JointModel::Full));
+/// let mut out = Deformed::new(&model.mesh);
+/// Deformer::new(Method::Dqb, &model.mesh).deform(&model.mesh, hand.layer(), &mut out);
+/// // The fist's fingertips are in the palm: the pass moves them out onto it.
+/// let mut pass = SelfContactPass::new(&model.mesh, &model.skeleton);
+/// let report = pass.apply(hand.layer().skinning(), &mut out);
+/// assert!(report.pushed > 0 && report.deepest_m < 0.01, "{report:?}");
+/// # }
+/// # Ok::<(), dqhand::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct SelfContactPass {
     /// Per bone that carries skin of a part that others yield to: its joint and field.
