@@ -103,8 +103,7 @@ impl PhalanxField {
     pub(crate) fn locate_rest(&self, p: Vec3) -> AxisPoint {
         let mut local = self.rest_local(p);
         local.x = local.x.clamp(0.0, self.cells as f32 * (1.0 - f32::EPSILON));
-        let cell = (local.x as usize).min(self.cells - 1) * SECTORS + sector(local.y, local.z);
-        AxisPoint { local, cell, distance_squared: local.y * local.y + local.z * local.z }
+        AxisPoint::at(local, (local.x as usize).min(self.cells - 1))
     }
 
     /// Poses the field with its bone's skinning transform (`world · inverse_bind`) and
@@ -117,7 +116,7 @@ impl PhalanxField {
         self.reach = self.rest_reach;
         let (centre, half) = (Vec3A::new(self.cells as f32 * 0.5, 0.0, 0.0), Vec3A::new(self.cells as f32 * 0.5, self.rest_reach, self.rest_reach));
         let m = self.to_world.matrix3;
-        let abs = glam::Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let abs = Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
         self.world_box = (self.to_world.transform_point3a(centre), abs * half);
     }
 
@@ -128,11 +127,7 @@ impl PhalanxField {
 
     /// Where a point (field coordinates) falls: none beyond the skin's ends along the axis.
     pub(crate) fn locate(&self, local: Vec3A) -> Option<AxisPoint> {
-        if !(0.0..self.cells as f32).contains(&local.x) {
-            return None;
-        }
-        let cell = local.x as usize * SECTORS + sector(local.y, local.z);
-        Some(AxisPoint { local, cell, distance_squared: local.y * local.y + local.z * local.z })
+        (0.0..self.cells as f32).contains(&local.x).then(|| AxisPoint::at(local, local.x as usize))
     }
 
     /// Whether a point (field coordinates) is farther than `clearance` outside the largest
@@ -217,6 +212,11 @@ impl PhalanxField {
 }
 
 impl AxisPoint {
+    /// The point at `local` (field coordinates) in step `step` along the axis.
+    fn at(local: Vec3A, step: usize) -> Self {
+        Self { local, cell: step * SECTORS + sector(local.y, local.z), distance_squared: local.y * local.y + local.z * local.z }
+    }
+
     /// Its distance from the axis (m).
     pub(crate) fn distance(&self) -> f32 {
         self.distance_squared.sqrt()

@@ -62,13 +62,19 @@ pub struct ContactPassReport {
     pub deepest_m: f32,
 }
 
-/// Some vertices of one bone, near each other at rest.
+/// Some vertices of one bone, near each other at rest: `members[start..end]`.
 #[derive(Clone, Debug)]
 struct Cluster {
-    /// Its vertices: `members[start..end]`.
     start: u32,
     end: u32,
-    /// The fields its bone's vertices yield to (indices into `fields`): `yields[yield_start..yield_end]`.
+}
+
+/// One bone whose skin yields: its clusters (`clusters[first..end]`) and the fields they
+/// yield to (indices into `fields`: `yields[yield_start..yield_end]`).
+#[derive(Clone, Debug)]
+struct YieldingBone {
+    first: u32,
+    end: u32,
     yield_start: u32,
     yield_end: u32,
 }
@@ -117,8 +123,7 @@ pub struct SelfContactPass {
     skinned_to: Vec<u64>,
     clusters: Vec<Cluster>,
     yields: Vec<u32>,
-    /// Per yielding bone, its clusters (`clusters[start..end]`).
-    bones: Vec<(u32, u32)>,
+    bones: Vec<YieldingBone>,
     /// Per cluster, the sphere round its posed vertices this frame (centre, radius); per
     /// yielding bone, the sphere round its clusters'.
     spheres: Vec<(Vec3A, f32)>,
@@ -185,15 +190,16 @@ impl SelfContactPass {
             for run in keyed.chunk_by(|x, y| x.0 == y.0) {
                 let start = members.len() as u32;
                 members.extend(run.iter().map(|&(_, v)| v));
-                clusters.push(Cluster { start, end: members.len() as u32, yield_start, yield_end: yields.len() as u32 });
+                clusters.push(Cluster { start, end: members.len() as u32 });
             }
-            bones.push((first, clusters.len() as u32));
+            bones.push(YieldingBone { first, end: clusters.len() as u32, yield_start, yield_end: yields.len() as u32 });
         }
         let skinned_to: Vec<u64> = members.iter().map(|&v| mask(v as usize)).collect();
         // At rest no skin is inside another part's: narrow each field where it says otherwise.
-        for c in &clusters {
-            for (&v, &to) in members[c.start as usize..c.end as usize].iter().zip(&skinned_to[c.start as usize..c.end as usize]) {
-                for &f in &yields[c.yield_start as usize..c.yield_end as usize] {
+        for bone in &bones {
+            let range = clusters[bone.first as usize].start as usize..clusters[bone.end as usize - 1].end as usize;
+            for (&v, &to) in members[range.clone()].iter().zip(&skinned_to[range]) {
+                for &f in &yields[bone.yield_start as usize..bone.yield_end as usize] {
                     let (b, field) = &mut fields[f as usize];
                     if skinned(to, *b) {
                         continue;
@@ -221,7 +227,7 @@ impl SelfContactPass {
             }
             own.extend(located.iter().map(|&(_, v, d)| (v, d)));
         }
-        let most_candidates = clusters.iter().map(|c| (c.yield_end - c.yield_start) as usize).sum();
+        let most_candidates = bones.iter().map(|b| ((b.end - b.first) * (b.yield_end - b.yield_start)) as usize).sum();
         let bends = fields.iter().map(|(b, _)| matches!(part[*b], HandPart::Finger(_))).collect();
         Self {
             bends,
@@ -261,14 +267,15 @@ impl SelfContactPass {
     /// As [`Self::apply`], and if a buffer is shorter than the mesh.
     pub fn apply_to(&mut self, skinning: &[Affine3A], positions: &mut [[f32; 3]], mut normals: Option<&mut [[f32; 3]]>) -> ContactPassReport {
         let at = |v: u32| Vec3A::from(positions[v as usize]);
-        for (&(first, end), bone) in self.bones.iter().zip(&mut self.bone_spheres) {
+        for (bone, sphere_of_bone) in self.bones.iter().zip(&mut self.bone_spheres) {
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            for (c, sphere) in self.clusters[first as usize..end as usize].iter().zip(&mut self.spheres[first as usize..end as usize]) {
+            let clusters = bone.first as usize..bone.end as usize;
+            for (c, sphere) in self.clusters[clusters.clone()].iter().zip(&mut self.spheres[clusters]) {
                 let (l, h) = self.members[c.start as usize..c.end as usize].iter().map(|&v| at(v)).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
                 *sphere = ((l + h) * 0.5, (h - l).length() * 0.5);
                 (lo, hi) = (lo.min(l), hi.max(h));
             }
-            *bone = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+            *sphere_of_bone = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
         }
         for ((b, field), needed) in self.fields.iter_mut().zip(&mut self.needed) {
             field.pose(&skinning[*b]);
@@ -278,14 +285,13 @@ impl SelfContactPass {
         self.candidates.clear();
         // (A clone's buffer has its length's capacity, none: the most a frame has, once.)
         self.candidates.reserve(self.most_candidates);
-        for (&(first, end), &(centre, radius)) in self.bones.iter().zip(&self.bone_spheres) {
-            let c = &self.clusters[first as usize];
-            for &f in &self.yields[c.yield_start as usize..c.yield_end as usize] {
+        for (bone, &(centre, radius)) in self.bones.iter().zip(&self.bone_spheres) {
+            for &f in &self.yields[bone.yield_start as usize..bone.yield_end as usize] {
                 let field = &self.fields[f as usize].1;
                 if field.meets(centre, radius, MAX_BULGE).is_none() {
                     continue;
                 }
-                for k in first..end {
+                for k in bone.first..bone.end {
                     let (centre, radius) = self.spheres[k as usize];
                     if let Some((lo, hi)) = field.meets(centre, radius, MAX_BULGE) {
                         self.candidates.push((k, f));
@@ -343,7 +349,7 @@ impl SelfContactPass {
 
 /// Whether a vertex skinned to the joints of bit mask `to` is skinned to joint `j`.
 fn skinned(to: u64, j: usize) -> bool {
-    j < 64 && to & 1 << j != 0
+    j < MAX_JOINTS && to & 1 << j != 0
 }
 
 /// The cluster of a cell of a bone's own field.
