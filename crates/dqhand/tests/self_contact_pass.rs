@@ -2,6 +2,8 @@
 //! the whole posed skin; it shares nothing with the pass's fields) on every gesture of the
 //! library under every method.
 
+mod support;
+
 use std::sync::{Arc, LazyLock};
 
 use dqhand::geometry::winding_number;
@@ -129,4 +131,28 @@ fn a_skin_layer_runs_the_pass_after_each_method() {
         let after = self_contact(out.positions(), model.mesh.indices(), &parts);
         assert!(after.volume_m3 < before.volume_m3, "{method:?}: {before:?} → {after:?}");
     }
+}
+
+/// On a hand the project did not make (the WebXR generic hand, 1,360 vertices, not closed, so
+/// the winding-number metric does not apply): a fist's skin is moved, by less than a finger's
+/// thickness, and the open hand an order of magnitude less. (It is not left as it is, as the
+/// built-in hand is: 2 vertices move by 1.9 mm in the open palm, 4 by 2.5 mm in the pinch, where
+/// nothing touches; its fields are narrowed on its bind pose only, and its triangles are coarse.
+/// A known defect, in docs/realism.md.)
+#[test]
+fn the_webxr_generic_hand_is_moved_in_a_fist() {
+    let model = support::webxr_hand();
+    let mut hand = model.hand_kinematics(JointModel::Full).unwrap();
+    let mut pass = SelfContactPass::new(&model.mesh, &model.skeleton);
+    let mut out = Deformed::new(&model.mesh);
+    let mut moved = std::collections::BTreeMap::new();
+    for name in ["open_palm", "pinch", "fist"] {
+        hand.pose(&dqhand::gesture::gesture(name).unwrap().pose(JointModel::Full));
+        Deformer::new(Method::Dqb, &model.mesh).deform(&model.mesh, hand.layer(), &mut out);
+        let report = pass.apply(hand.layer().skinning(), &mut out);
+        eprintln!("WebXR hand, {name}: {report:?}");
+        moved.insert(name, report);
+    }
+    assert!(moved["fist"].pushed > 0 && moved["fist"].deepest_m < 0.015, "{moved:?}");
+    assert!(10 * moved["open_palm"].pushed < moved["fist"].pushed, "{moved:?}");
 }
